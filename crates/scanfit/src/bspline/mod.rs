@@ -1,0 +1,11 @@
+//! The B-spline kernel: knot vectors, basis functions, curves and surfaces.
+
+mod basis;
+mod curve;
+mod knots;
+mod surface;
+
+pub use basis::{basis_funs, single_basis_ders, BasisWorkspace};
+pub use curve::Curve;
+pub use knots::KnotVector;
+pub use surface::{Direction, Surface};

@@ -1,0 +1,27 @@
+//! # scanfit
+//!
+//! B-spline curve and surface fitting for measured points (reverse engineering).
+//!
+//! The library holds geometry and algorithms only: no file formats, no printing.
+//! Every algorithm is a config struct with documented defaults (citing the paper
+//! equation it follows) and a function that takes data + config and returns a
+//! result struct with diagnostics.
+//!
+//! * [`bspline`]: knot vectors, basis functions and derivatives, curves and
+//!   tensor-product surfaces (rational weights carried), knot insertion/refinement.
+//! * [`param`]: the seven curve parameterization methods of the curve paper and
+//!   knot placement.
+//! * [`fit`]: curve interpolation (open, with end tangents, closed/periodic) and
+//!   least-squares approximation with optional bending-energy smoothing, on banded
+//!   solvers.
+//! * [`quality`]: per-curve quality report (deviation, curvature, loops, length).
+
+pub mod bspline;
+mod error;
+pub mod fit;
+mod geom;
+pub mod param;
+pub mod quality;
+
+pub use error::{Error, Result};
+pub use geom::{validate_points, Point3, Vector3};
