@@ -1,1 +1,1 @@
-//! stub
+//! Quality measures of fitted curves.

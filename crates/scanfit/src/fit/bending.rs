@@ -1,0 +1,104 @@
+//! Bending energy `∫ |C''(u)|^2 du` of a B-spline curve as a quadratic form in
+//! its control points: `G_ij = ∫ N_i''(u) N_j''(u) du`, integrated exactly by
+//! Gauss-Legendre quadrature on each knot span (`N''` has degree `p-2`, so
+//! `p - 1` nodes integrate the product of degree `2p-4` exactly).
+
+use crate::bspline::{BasisWorkspace, KnotVector};
+
+/// Gauss-Legendre nodes and weights on `[-1, 1]` (Newton on the Legendre
+/// polynomial from the Chebyshev-like initial guess; accurate to rounding).
+pub fn gauss_legendre(k: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut x = vec![0.0; k];
+    let mut w = vec![0.0; k];
+    for i in 0..k {
+        let mut z = (std::f64::consts::PI * (i as f64 + 0.75) / (k as f64 + 0.5)).cos();
+        for _ in 0..100 {
+            // P_k(z) and P_k'(z) by the three-term recurrence
+            let (mut p0, mut p1) = (1.0, z);
+            for j in 2..=k {
+                let p2 = ((2 * j - 1) as f64 * z * p1 - (j - 1) as f64 * p0) / j as f64;
+                p0 = p1;
+                p1 = p2;
+            }
+            let (pk, pkm1) = if k == 1 { (z, 1.0) } else { (p1, p0) };
+            let dp = k as f64 * (z * pk - pkm1) / (z * z - 1.0);
+            let dz = pk / dp;
+            z -= dz;
+            if dz.abs() < 1e-16 {
+                let (mut q0, mut q1) = (1.0, z);
+                for j in 2..=k {
+                    let q2 = ((2 * j - 1) as f64 * z * q1 - (j - 1) as f64 * q0) / j as f64;
+                    q0 = q1;
+                    q1 = q2;
+                }
+                let (qk, qkm1) = if k == 1 { (z, 1.0) } else { (q1, q0) };
+                let dq = k as f64 * (z * qk - qkm1) / (z * z - 1.0);
+                x[i] = z;
+                w[i] = 2.0 / ((1.0 - z * z) * dq * dq);
+                break;
+            }
+        }
+    }
+    (x, w)
+}
+
+/// Calls `add(i, j, G_ij)` for every non-zero entry of the bending-energy
+/// matrix (each pair within one span once per span; entries accumulate).
+pub fn for_each_entry(kv: &KnotVector, mut add: impl FnMut(usize, usize, f64)) {
+    let p = kv.degree();
+    if p < 2 {
+        return; // piecewise linear: C'' vanishes inside every span
+    }
+    let t = kv.as_slice();
+    let (nodes, weights) = gauss_legendre(p - 1);
+    let mut ws = BasisWorkspace::new(p, 2);
+    let q = p + 1;
+    let (a, b) = kv.domain();
+    for s in p..kv.basis_count() {
+        let (lo, hi) = (t[s], t[s + 1]);
+        if hi <= lo || lo < a || hi > b {
+            continue;
+        }
+        let half = 0.5 * (hi - lo);
+        let mid = 0.5 * (hi + lo);
+        for (x, w) in nodes.iter().zip(&weights) {
+            let u = mid + half * x;
+            let d = ws.ders(t, s, u, 2);
+            let d2 = &d[2 * q..3 * q];
+            for r in 0..q {
+                for c in 0..q {
+                    add(s - p + r, s - p + c, w * half * d2[r] * d2[c]);
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gauss_rules_integrate_polynomials() {
+        for k in 1..=6 {
+            let (x, w) = gauss_legendre(k);
+            for deg in 0..2 * k {
+                let approx: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(deg as i32)).sum();
+                let exact = if deg % 2 == 1 { 0.0 } else { 2.0 / (deg as f64 + 1.0) };
+                assert!((approx - exact).abs() < 1e-14, "k={k} deg={deg}");
+            }
+        }
+    }
+
+    #[test]
+    fn energy_of_a_parabola() {
+        // C(u) = (u, u^2) as a clamped quadratic on [0,1]: C'' = (0, 2), energy = 4
+        let kv = KnotVector::new(vec![0., 0., 0., 0.5, 1., 1., 1.], 2).unwrap();
+        // control points of (u, u^2) on these knots (blossoming): y: 0, 0, 0.5, 1
+        let cx = [0.0, 0.25, 0.75, 1.0];
+        let cy = [0.0, 0.0, 0.5, 1.0];
+        let mut e = 0.0;
+        for_each_entry(&kv, |i, j, g| e += g * (cx[i] * cx[j] + cy[i] * cy[j]));
+        assert!((e - 4.0).abs() < 1e-13, "{e}");
+    }
+}

@@ -1,0 +1,234 @@
+//! Global curve interpolation (*The NURBS Book* section 9.2.1, A9.1), with end
+//! derivatives (section 9.2.2) and closed (periodic) interpolation.
+
+use super::banded::BandMatrix;
+use super::cyclic::CyclicBandMatrix;
+use super::{CurveFit, CONDITION_LIMIT};
+use crate::bspline::{BasisWorkspace, Curve, KnotVector};
+use crate::geom::validate_distinct_consecutive;
+use crate::param::{self, Method};
+use crate::{Error, Point3, Result, Vector3};
+
+/// Configuration of [`interpolate`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct InterpolationConfig {
+    /// Degree (default 3).
+    pub degree: usize,
+    /// Parameterization (default: the curve paper's new method, a = 0.8).
+    pub method: Method,
+    /// Prescribed first derivatives `C'(0)` and `C'(1)` (open curves only).
+    pub end_derivatives: Option<(Vector3, Vector3)>,
+    /// Closed loop: periodic interpolation, `C^{p-1}` at the seam (default false).
+    pub closed: bool,
+}
+
+impl Default for InterpolationConfig {
+    fn default() -> Self {
+        Self {
+            degree: 3,
+            method: Method::Proposed(param::DEFAULT_EXPONENT),
+            end_derivatives: None,
+            closed: false,
+        }
+    }
+}
+
+/// Interpolates `points` with the configured degree and parameterization.
+pub fn interpolate(points: &[Point3], cfg: &InterpolationConfig) -> Result<CurveFit> {
+    let p = cfg.degree;
+    if p == 0 {
+        return Err(Error::InvalidInput("degree must be at least 1".into()));
+    }
+    crate::validate_points(points)?;
+    let mut pts = points;
+    if cfg.closed && pts.len() > 2 && pts[0] == pts[pts.len() - 1] {
+        pts = &pts[..pts.len() - 1]; // the loop was given closed explicitly
+    }
+    let needed = p + 1;
+    if pts.len() < needed {
+        return Err(Error::TooFewPoints {
+            got: pts.len(),
+            needed,
+            what: format!(
+                "{}interpolation of degree {p}",
+                if cfg.closed { "closed " } else { "" }
+            ),
+        });
+    }
+    validate_distinct_consecutive(pts, cfg.closed)?;
+    let par = param::parameterize(pts, cfg.method, p, cfg.closed)?;
+    if cfg.closed {
+        if cfg.end_derivatives.is_some() {
+            return Err(Error::InvalidInput(
+                "end derivatives cannot be prescribed for a closed curve".into(),
+            ));
+        }
+        let kv = param::knots::periodic(&par.params, p)?;
+        let (curve, condition) = interpolate_closed_with(pts, &par.params[..pts.len()], kv)?;
+        let mut params = par.params;
+        params.pop();
+        return Ok(CurveFit {
+            curve,
+            params,
+            method: cfg.method,
+            condition,
+        });
+    }
+    let kv = match (&cfg.end_derivatives, par.knots) {
+        (Some(_), _) => param::knots::with_end_derivatives(&par.params, p)?,
+        (None, Some(k)) => k,
+        (None, None) => param::knots::averaging(&par.params, p)?,
+    };
+    let (curve, condition) = interpolate_with(pts, &par.params, kv, cfg.end_derivatives)?;
+    Ok(CurveFit {
+        curve,
+        params: par.params,
+        method: cfg.method,
+        condition,
+    })
+}
+
+/// Interpolation with given parameters and clamped knots. Without end
+/// derivatives the knot vector must carry `points.len()` basis functions, with
+/// them `points.len() + 2` (rows `C'(u_0) = D_0` and `C'(u_n) = D_n` are added
+/// next to the end rows). Returns the curve and the condition estimate.
+pub fn interpolate_with(
+    points: &[Point3],
+    params: &[f64],
+    kv: KnotVector,
+    end_derivatives: Option<(Vector3, Vector3)>,
+) -> Result<(Curve, f64)> {
+    let n = points.len();
+    let p = kv.degree();
+    let extra = if end_derivatives.is_some() { 2 } else { 0 };
+    let count = kv.basis_count();
+    if count != n + extra || params.len() != n {
+        return Err(Error::InvalidInput(format!(
+            "interpolation of {n} points{} needs {} basis functions and {n} parameters; got {count} and {}",
+            if extra > 0 { " with end derivatives" } else { "" },
+            n + extra,
+            params.len()
+        )));
+    }
+    let t = kv.as_slice();
+    let mut ws = BasisWorkspace::new(p, 1);
+    // rows: (parameter, derivative order, right-hand side)
+    let mut rows: Vec<(f64, usize, Vector3)> = Vec::with_capacity(count);
+    for (k, (&u, q)) in params.iter().zip(points).enumerate() {
+        if let (Some((d0, _)), 1) = (end_derivatives, k) {
+            rows.push((params[0], 1, d0));
+        }
+        if let (Some((_, dn)), true) = (end_derivatives, k + 1 == n) {
+            rows.push((params[n - 1], 1, dn));
+        }
+        rows.push((u, 0, q.coords));
+    }
+    if n == 1 {
+        return Err(Error::TooFewPoints {
+            got: 1,
+            needed: p + 1,
+            what: "interpolation".into(),
+        });
+    }
+    // band widths from the actual structure
+    let spans: Vec<usize> = rows.iter().map(|r| kv.find_span(r.0)).collect();
+    let (mut kl, mut ku) = (0usize, 0usize);
+    for (i, &s) in spans.iter().enumerate() {
+        kl = kl.max(i.saturating_sub(s - p));
+        ku = ku.max(s.saturating_sub(i));
+    }
+    let mut a = BandMatrix::zeros(count, kl, ku);
+    let mut rhs = vec![0.0; count * 3];
+    for (i, ((u, order, r), &s)) in rows.iter().zip(&spans).enumerate() {
+        let d = ws.ders(t, s, *u, *order);
+        for j in 0..=p {
+            a.set(i, s - p + j, d[order * (p + 1) + j]);
+        }
+        rhs[i * 3..i * 3 + 3].copy_from_slice(r.as_slice());
+    }
+    let lu = a.factor("curve interpolation").map_err(|e| with_hint(e, params))?;
+    lu.check_condition(
+        "curve interpolation",
+        CONDITION_LIMIT,
+        "the parameters crowd together; try centripetal or the proposed method",
+    )?;
+    lu.solve_in_place(&mut rhs, 3);
+    let ctrl = rhs.chunks(3).map(|c| Point3::new(c[0], c[1], c[2])).collect();
+    Ok((Curve::new(kv, ctrl)?, lu.condition()))
+}
+
+/// Closed (periodic) interpolation: `points.len()` distinct points with
+/// parameters in `[0, 1)` on a periodic knot vector (see
+/// [`param::knots::periodic`]). The result is a periodic curve with
+/// `points.len()` distinct control points.
+pub fn interpolate_closed_with(points: &[Point3], params: &[f64], kv: KnotVector) -> Result<(Curve, f64)> {
+    let n = points.len();
+    let p = kv.degree();
+    if kv.basis_count() != n + p || params.len() != n {
+        return Err(Error::InvalidInput(format!(
+            "closed interpolation of {n} points needs {} basis functions and {n} parameters; got {} and {}",
+            n + p,
+            kv.basis_count(),
+            params.len()
+        )));
+    }
+    if n < 2 * p + 1 {
+        return Err(Error::TooFewPoints {
+            got: n,
+            needed: 2 * p + 1,
+            what: format!("closed interpolation of degree {p}"),
+        });
+    }
+    let t = kv.as_slice();
+    let mut ws = BasisWorkspace::new(p, 0);
+    let mut a = CyclicBandMatrix::zeros(n, p)?;
+    let mut rhs = vec![0.0; n * 3];
+    for (k, (&u, q)) in params.iter().zip(points).enumerate() {
+        let s = kv.find_span(u);
+        let vals = ws.values(t, s, u);
+        for (j, &v) in vals.iter().enumerate() {
+            a.add(k, (s - p + j) % n, v);
+        }
+        rhs[k * 3..k * 3 + 3].copy_from_slice(q.coords.as_slice());
+    }
+    let cond = a.solve(&mut rhs, 3, "closed curve interpolation")?;
+    if cond > CONDITION_LIMIT {
+        return Err(Error::Singular {
+            what: "closed curve interpolation".into(),
+            condition: cond,
+            hint: "the parameters crowd together; try centripetal".into(),
+        });
+    }
+    let mut ctrl: Vec<Point3> = rhs.chunks(3).map(|c| Point3::new(c[0], c[1], c[2])).collect();
+    for j in 0..p {
+        ctrl.push(ctrl[j]);
+    }
+    Ok((Curve::new_periodic(kv, ctrl, None)?, cond))
+}
+
+/// Adds the parameter values to a singular-system error, since crowded or
+/// coincident parameters are its usual cause.
+fn with_hint(e: Error, params: &[f64]) -> Error {
+    match e {
+        Error::Singular { what, condition, hint } => {
+            let closest = params
+                .windows(2)
+                .enumerate()
+                .min_by(|a, b| (a.1[1] - a.1[0]).total_cmp(&(b.1[1] - b.1[0])));
+            let extra = closest.map_or(String::new(), |(i, w)| {
+                format!(
+                    "; closest parameters: points {i} and {} (u = {} and {})",
+                    i + 1,
+                    w[0],
+                    w[1]
+                )
+            });
+            Error::Singular {
+                what,
+                condition,
+                hint: format!("{hint}{extra}"),
+            }
+        }
+        other => other,
+    }
+}

@@ -1,0 +1,319 @@
+//! Least-squares curve approximation (*The NURBS Book* section 9.4.1, A9.6
+//! without weights in the constraints), with optional point weights and an
+//! optional smoothing term:
+//!
+//! ```text
+//! minimise  sum_k w_k |Q_k - C(u_k)|^2 + lambda * ∫ |C''(u)|^2 du
+//! ```
+//!
+//! The normal equations `(N^T W N + lambda G) P = N^T W Q` are assembled point by
+//! point into a band matrix (half-bandwidth `p`; `G` from [`super::bending`]) and
+//! solved without pivoting (SPD). With `fix_ends` the first and last control
+//! points are the first and last data points and drop out of the system
+//! (eq. 9.63-9.67). Closed curves use periodic knots and the cyclic solver.
+
+use super::banded::BandMatrix;
+use super::bending;
+use super::cyclic::CyclicBandMatrix;
+use super::{CurveFit, CONDITION_LIMIT};
+use crate::bspline::{BasisWorkspace, Curve, KnotVector};
+use crate::geom::validate_distinct_consecutive;
+use crate::param::{self, Method};
+use crate::{Error, Point3, Result};
+
+/// Configuration of [`approximate`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ApproximationConfig {
+    /// Degree (default 3).
+    pub degree: usize,
+    /// Number of control points (distinct ones for a closed curve).
+    pub ctrl_count: usize,
+    /// Parameterization (default: the curve paper's new method, a = 0.8).
+    pub method: Method,
+    /// Pin the curve's ends to the first and last points (default true; open only).
+    pub fix_ends: bool,
+    /// Smoothing weight `lambda` on the bending energy (default 0). It multiplies
+    /// `∫|C''(u)|^2 du` over the parameter domain `[0, 1]`, so its scale is
+    /// (data length)^2 relative to the squared residuals.
+    pub smoothing: f64,
+    /// Optional positive weight per point.
+    pub weights: Option<Vec<f64>>,
+    /// Closed loop: periodic curve (default false).
+    pub closed: bool,
+}
+
+impl Default for ApproximationConfig {
+    fn default() -> Self {
+        Self {
+            degree: 3,
+            ctrl_count: 10,
+            method: Method::Proposed(param::DEFAULT_EXPONENT),
+            fix_ends: true,
+            smoothing: 0.0,
+            weights: None,
+            closed: false,
+        }
+    }
+}
+
+/// Options of the low-level least-squares solvers.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct LeastSquaresOptions<'a> {
+    /// Pin the first and last control points to the first and last data points.
+    pub fix_ends: bool,
+    /// Bending-energy weight `lambda` (0 = none).
+    pub smoothing: f64,
+    /// Optional positive weight per point.
+    pub weights: Option<&'a [f64]>,
+}
+
+/// Approximates `points` by a curve with `cfg.ctrl_count` control points.
+pub fn approximate(points: &[Point3], cfg: &ApproximationConfig) -> Result<CurveFit> {
+    let p = cfg.degree;
+    if p == 0 {
+        return Err(Error::InvalidInput("degree must be at least 1".into()));
+    }
+    crate::validate_points(points)?;
+    let mut pts = points;
+    if cfg.closed && pts.len() > 2 && pts[0] == pts[pts.len() - 1] {
+        pts = &pts[..pts.len() - 1];
+    }
+    if pts.len() < p + 1 {
+        return Err(Error::TooFewPoints {
+            got: pts.len(),
+            needed: p + 1,
+            what: format!("least squares of degree {p}"),
+        });
+    }
+    if cfg.ctrl_count > pts.len() {
+        return Err(Error::InvalidInput(format!(
+            "{} control points requested but only {} data points; use --ctrl {} or fewer, or --interpolate",
+            cfg.ctrl_count,
+            pts.len(),
+            pts.len()
+        )));
+    }
+    validate_distinct_consecutive(pts, cfg.closed)?;
+    let par = param::parameterize(pts, cfg.method, p, cfg.closed)?;
+    let opts = LeastSquaresOptions {
+        fix_ends: cfg.fix_ends,
+        smoothing: cfg.smoothing,
+        weights: cfg.weights.as_deref(),
+    };
+    let (curve, condition, params) = if cfg.closed {
+        let kv = KnotVector::uniform_periodic(p, cfg.ctrl_count)?;
+        let u = &par.params[..pts.len()];
+        let (c, k) = least_squares_closed_with(pts, u, kv, opts)?;
+        (c, k, u.to_vec())
+    } else {
+        let kv = param::knots::least_squares(&par.params, p, cfg.ctrl_count)?;
+        let (c, k) = least_squares_with(pts, &par.params, kv, opts)?;
+        (c, k, par.params)
+    };
+    Ok(CurveFit {
+        curve,
+        params,
+        method: cfg.method,
+        condition,
+    })
+}
+
+fn check_inputs(points: &[Point3], params: &[f64], opts: &LeastSquaresOptions) -> Result<()> {
+    if params.len() != points.len() {
+        return Err(Error::InvalidInput(format!(
+            "{} parameters for {} points",
+            params.len(),
+            points.len()
+        )));
+    }
+    if let Some(w) = opts.weights {
+        if w.len() != points.len() {
+            return Err(Error::InvalidInput(format!(
+                "{} weights for {} points",
+                w.len(),
+                points.len()
+            )));
+        }
+        if let Some(i) = w.iter().position(|&v| !(v.is_finite() && v >= 0.0)) {
+            return Err(Error::InvalidInput(format!(
+                "weight of point {i} is {}; weights must be finite and non-negative",
+                w[i]
+            )));
+        }
+    }
+    if !(opts.smoothing.is_finite() && opts.smoothing >= 0.0) {
+        return Err(Error::InvalidInput(format!(
+            "smoothing weight {} must be finite and non-negative",
+            opts.smoothing
+        )));
+    }
+    Ok(())
+}
+
+/// Least squares with given parameters and a clamped knot vector.
+/// Returns the curve and the condition estimate of the normal equations.
+pub fn least_squares_with(
+    points: &[Point3],
+    params: &[f64],
+    kv: KnotVector,
+    opts: LeastSquaresOptions,
+) -> Result<(Curve, f64)> {
+    check_inputs(points, params, &opts)?;
+    let p = kv.degree();
+    let count = kv.basis_count();
+    let fixed = if opts.fix_ends { 2 } else { 0 };
+    if count < fixed + 1 {
+        return Err(Error::InvalidInput(format!(
+            "{count} control points leave nothing to fit with fixed ends"
+        )));
+    }
+    let t = kv.as_slice();
+    let mut m = BandMatrix::zeros(count, p, p);
+    let mut rhs = vec![0.0; count * 3];
+    let mut ws = BasisWorkspace::new(p, 0);
+    let mut s = p;
+    let last = count - 1;
+    for (k, (&u, q)) in params.iter().zip(points).enumerate() {
+        if !(t[s] <= u && (u < t[s + 1] || (s == last && u <= t[s + 1]))) {
+            s = kv.find_span(u);
+        }
+        let w = opts.weights.map_or(1.0, |w| w[k]);
+        let n = ws.values(t, s, u);
+        for a in 0..=p {
+            let wa = w * n[a];
+            let row = s - p + a;
+            for b in 0..=p {
+                m.add(row, s - p + b, wa * n[b]);
+            }
+            rhs[row * 3] += wa * q.x;
+            rhs[row * 3 + 1] += wa * q.y;
+            rhs[row * 3 + 2] += wa * q.z;
+        }
+    }
+    if opts.smoothing > 0.0 {
+        bending::for_each_entry(&kv, |i, j, g| m.add(i, j, opts.smoothing * g));
+    }
+    let (ctrl, cond) = if opts.fix_ends {
+        let (q0, qn) = (points[0], points[points.len() - 1]);
+        let r = count - 2;
+        let mut red = BandMatrix::zeros(r, p, p);
+        let mut f = vec![0.0; r * 3];
+        for i in 1..=r {
+            for j in i.saturating_sub(p).max(1)..=(i + p).min(r) {
+                red.set(i - 1, j - 1, m.get(i, j));
+            }
+            let (a0, an) = (m.get(i, 0), m.get(i, count - 1));
+            for c in 0..3 {
+                f[(i - 1) * 3 + c] = rhs[i * 3 + c] - a0 * q0[c] - an * qn[c];
+            }
+        }
+        let cond = solve_normal(red, &mut f, &kv, params)?;
+        let mut ctrl = vec![q0];
+        ctrl.extend(f.chunks(3).map(|c| Point3::new(c[0], c[1], c[2])));
+        ctrl.push(qn);
+        (ctrl, cond)
+    } else {
+        let cond = solve_normal(m, &mut rhs, &kv, params)?;
+        (rhs.chunks(3).map(|c| Point3::new(c[0], c[1], c[2])).collect(), cond)
+    };
+    Ok((Curve::new(kv, ctrl)?, cond))
+}
+
+/// Least squares for a closed (periodic) curve: parameters in `[0, 1)`, a
+/// periodic knot vector with `count + p` basis functions (`count` distinct
+/// control points).
+pub fn least_squares_closed_with(
+    points: &[Point3],
+    params: &[f64],
+    kv: KnotVector,
+    opts: LeastSquaresOptions,
+) -> Result<(Curve, f64)> {
+    check_inputs(points, params, &opts)?;
+    let p = kv.degree();
+    let count = kv.basis_count() - p;
+    let t = kv.as_slice();
+    let mut m = CyclicBandMatrix::zeros(count, p)?;
+    let mut rhs = vec![0.0; count * 3];
+    let mut ws = BasisWorkspace::new(p, 0);
+    for (k, (&u, q)) in params.iter().zip(points).enumerate() {
+        let s = kv.find_span(u);
+        let w = opts.weights.map_or(1.0, |w| w[k]);
+        let n = ws.values(t, s, u);
+        for a in 0..=p {
+            let row = (s - p + a) % count;
+            for b in 0..=p {
+                m.add(row, (s - p + b) % count, w * n[a] * n[b]);
+            }
+            for c in 0..3 {
+                rhs[row * 3 + c] += w * n[a] * q[c];
+            }
+        }
+    }
+    if opts.smoothing > 0.0 {
+        bending::for_each_entry(&kv, |i, j, g| m.add(i % count, j % count, opts.smoothing * g));
+    }
+    let cond = m.solve(&mut rhs, 3, "closed least-squares curve").map_err(|e| {
+        empty_span_hint(e, &kv, params)
+    })?;
+    if cond > CONDITION_LIMIT {
+        return Err(empty_span_hint(
+            Error::Singular {
+                what: "closed least-squares curve".into(),
+                condition: cond,
+                hint: String::new(),
+            },
+            &kv,
+            params,
+        ));
+    }
+    let mut ctrl: Vec<Point3> = rhs.chunks(3).map(|c| Point3::new(c[0], c[1], c[2])).collect();
+    for j in 0..p {
+        ctrl.push(ctrl[j]);
+    }
+    Ok((Curve::new_periodic(kv, ctrl, None)?, cond))
+}
+
+fn solve_normal(m: BandMatrix, rhs: &mut [f64], kv: &KnotVector, params: &[f64]) -> Result<f64> {
+    let lu = m
+        .factor("least-squares curve")
+        .map_err(|e| empty_span_hint(e, kv, params))?;
+    if lu.condition() > CONDITION_LIMIT {
+        return Err(empty_span_hint(
+            Error::Singular {
+                what: "least-squares curve".into(),
+                condition: lu.condition(),
+                hint: String::new(),
+            },
+            kv,
+            params,
+        ));
+    }
+    lu.solve_in_place(rhs, 3);
+    Ok(lu.condition())
+}
+
+/// Names the first knot span without data (the usual cause of a singular
+/// normal matrix) and what to change.
+fn empty_span_hint(e: Error, kv: &KnotVector, params: &[f64]) -> Error {
+    let Error::Singular { what, condition, .. } = e else {
+        return e;
+    };
+    let bps = kv.breakpoints();
+    let empty = bps.windows(2).find(|w| {
+        !params
+            .iter()
+            .any(|&u| u >= w[0] && (u < w[1] || (w[1] == bps[bps.len() - 1] && u <= w[1])))
+    });
+    let hint = match empty {
+        Some(w) => format!(
+            "knot span [{}, {}] holds no data point; use fewer control points or add smoothing (--smooth)",
+            w[0], w[1]
+        ),
+        None => "use fewer control points or add smoothing (--smooth)".to_string(),
+    };
+    Error::Singular {
+        what,
+        condition,
+        hint,
+    }
+}
