@@ -45,8 +45,11 @@ pub fn basis_maximum(kv: &KnotVector, i: usize, ws: &mut BasisWorkspace) -> (f64
         if na > 0.0 && da <= tol {
             return (a, na);
         }
-        if db < 0.0 {
-            // root of N' inside (a, b): safeguarded Newton on N' = 0
+        if db <= 0.0 {
+            // N' changes sign in (a, b], safeguarded Newton on N' = 0. `db` can be
+            // exactly 0 where the support ends at a clamped domain end (N_{n-2}
+            // of a clamped cubic), so `<=`: the bracket still converges to the
+            // interior root, or to `b` if N rises all the way.
             let (mut l, mut r) = (a, b);
             let mut x = 0.5 * (a + b);
             for _ in 0..100 {
@@ -112,6 +115,18 @@ mod tests {
             assert!(b >= best - 1e-12, "i={i}: {b} < sampled {best}");
             assert!((0.0..=1.0).contains(&theta));
         }
+    }
+
+    #[test]
+    fn support_ending_at_clamped_end() {
+        // N_7 of a clamped cubic with 10 functions: N'(1) = 0 and N(1) = 0, the
+        // maximum is inside the last span (regression: was reported at u = 1)
+        let t = vec![0., 0., 0., 0., 0.24, 0.356, 0.468, 0.5675, 0.6688, 0.7804, 1., 1., 1., 1.];
+        let kv = KnotVector::new(t, 3).unwrap();
+        let mut ws = BasisWorkspace::new(3, 2);
+        let (theta, b) = basis_maximum(&kv, 7, &mut ws);
+        assert!(theta > 0.6688 && theta < 1.0, "{theta}");
+        assert!(b > 0.5, "{b}");
     }
 
     #[test]
