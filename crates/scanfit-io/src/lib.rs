@@ -1,1 +1,16 @@
-//! io
+//! # scanfit-io
+//!
+//! File formats for scanfit: point files in (XYZ/CSV/TXT), curves out and back
+//! (JSON), pictures out (SVG). Every writer is atomic: it writes a temporary
+//! file next to the target and renames it on success, so a failed run never
+//! leaves a half-written file.
+
+mod atomic;
+mod error;
+pub mod json;
+pub mod svg;
+pub mod xyz;
+
+pub use atomic::write_atomic;
+pub use error::{Error, Result};
+pub use xyz::{read_points, PointTable};

@@ -1,0 +1,45 @@
+//! Errors of the IO crate: each names the file and, where it applies, the line.
+
+use std::path::PathBuf;
+
+/// What went wrong reading or writing a file.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// The file could not be opened, read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// the file
+        path: PathBuf,
+        /// the OS error
+        source: std::io::Error,
+    },
+    /// The file's content is malformed at a given line.
+    #[error("{path}:{line}: {message}")]
+    Parse {
+        /// the file
+        path: PathBuf,
+        /// 1-based line number
+        line: usize,
+        /// what is wrong and what to change
+        message: String,
+    },
+    /// The file as a whole is unusable (empty, wrong format).
+    #[error("{path}: {message}")]
+    Invalid {
+        /// the file
+        path: PathBuf,
+        /// what is wrong and what to change
+        message: String,
+    },
+    /// The geometry read from a file is invalid.
+    #[error("{path}: {source}")]
+    Geometry {
+        /// the file
+        path: PathBuf,
+        /// the library's error
+        source: scanfit::Error,
+    },
+}
+
+/// Result alias of the IO crate.
+pub type Result<T> = std::result::Result<T, Error>;

@@ -1,0 +1,235 @@
+//! The JSON document for curves (schema `scanfit/1`).
+//!
+//! ```json
+//! {
+//!   "schema": "scanfit/1",
+//!   "type": "bspline_curve",
+//!   "degree": 3,
+//!   "periodic": false,
+//!   "knots": [0, 0, 0, 0, 0.5, 1, 1, 1, 1],
+//!   "control_points": [[x, y, z], ...],
+//!   "weights": null,
+//!   "provenance": {"tool": "scanfit 0.1.0", "operation": "curve fit (interpolation)",
+//!                  "parameterization": "proposed", "input": "data.csv", "point_count": 10,
+//!                  "settings": {"degree": 3, "smoothing": 0}},
+//!   "params": [0, 0.12, ...],
+//!   "quality": {"max_deviation": 3.5e-15, ...}
+//! }
+//! ```
+//!
+//! A periodic curve lists all `n + p` control points (the last `p` repeat the
+//! first `p`) and its unclamped knots. Numbers are written in the shortest form
+//! that reads back to the same `f64`, so a write/read round trip is exact.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use scanfit::bspline::{Curve, KnotVector};
+use scanfit::quality::CurveQuality;
+use scanfit::Point3;
+use serde::{Deserialize, Serialize};
+
+use crate::{Error, Result};
+
+/// Schema identifier written into every document.
+pub const SCHEMA: &str = "scanfit/1";
+
+/// Where a curve came from: the tool, the operation and its settings.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Provenance {
+    /// Tool and version.
+    pub tool: String,
+    /// What produced the curve (e.g. `curve fit (interpolation)`).
+    pub operation: String,
+    /// Parameterization method, if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub parameterization: Option<String>,
+    /// Input file, if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub input: Option<String>,
+    /// Number of input points.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point_count: Option<usize>,
+    /// Further settings (degree, control points, smoothing, ...).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub settings: BTreeMap<String, serde_json::Value>,
+}
+
+/// The quality report as stored in JSON (see [`scanfit::quality::CurveQuality`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct QualityDoc {
+    /// Largest deviation at the fit parameters (data units).
+    pub max_deviation: f64,
+    /// Index of the point with the largest deviation.
+    pub max_deviation_index: usize,
+    /// Mean deviation.
+    pub mean_deviation: f64,
+    /// RMS deviation.
+    pub rms_deviation: f64,
+    /// Largest orthogonal distance from a point to the curve.
+    pub max_distance: f64,
+    /// Largest curvature (1 / data units).
+    pub max_curvature: f64,
+    /// Parameter of the largest curvature.
+    pub max_curvature_at: f64,
+    /// Curvature sign changes (inflections).
+    pub curvature_sign_changes: usize,
+    /// Self-intersections (loops).
+    pub self_intersections: usize,
+    /// Curve length.
+    pub length: f64,
+    /// Data polygon length.
+    pub polygon_length: f64,
+    /// Ratio of the two.
+    pub length_ratio: f64,
+}
+
+impl From<&CurveQuality> for QualityDoc {
+    fn from(q: &CurveQuality) -> Self {
+        Self {
+            max_deviation: q.max_deviation,
+            max_deviation_index: q.max_deviation_index,
+            mean_deviation: q.mean_deviation,
+            rms_deviation: q.rms_deviation,
+            max_distance: q.max_distance,
+            max_curvature: q.max_curvature,
+            max_curvature_at: q.max_curvature_at,
+            curvature_sign_changes: q.curvature_sign_changes,
+            self_intersections: q.self_intersections,
+            length: q.length,
+            polygon_length: q.polygon_length,
+            length_ratio: q.length_ratio,
+        }
+    }
+}
+
+/// A curve document as written to and read from JSON.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CurveDoc {
+    /// Always [`SCHEMA`].
+    pub schema: String,
+    /// Always `bspline_curve`.
+    #[serde(rename = "type")]
+    pub kind: String,
+    /// Degree.
+    pub degree: usize,
+    /// Periodic (closed, smooth at the seam).
+    pub periodic: bool,
+    /// Knot vector.
+    pub knots: Vec<f64>,
+    /// Control points.
+    pub control_points: Vec<[f64; 3]>,
+    /// Weights (rational curves only).
+    pub weights: Option<Vec<f64>>,
+    /// Where the curve came from.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<Provenance>,
+    /// Parameter of each input point.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub params: Option<Vec<f64>>,
+    /// Quality report.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quality: Option<QualityDoc>,
+}
+
+impl CurveDoc {
+    /// A document for `curve` without provenance, parameters or quality.
+    pub fn new(curve: &Curve) -> Self {
+        Self {
+            schema: SCHEMA.into(),
+            kind: "bspline_curve".into(),
+            degree: curve.degree(),
+            periodic: curve.is_periodic(),
+            knots: curve.knots().as_slice().to_vec(),
+            control_points: curve.control_points().iter().map(|p| [p.x, p.y, p.z]).collect(),
+            weights: curve.weights().map(|w| w.to_vec()),
+            provenance: None,
+            params: None,
+            quality: None,
+        }
+    }
+
+    /// Pretty JSON text.
+    pub fn to_json(&self) -> String {
+        // serialising plain data with string keys cannot fail
+        serde_json::to_string_pretty(self).unwrap_or_default() + "\n"
+    }
+
+    /// The curve this document describes (validated).
+    pub fn curve(&self) -> scanfit::Result<Curve> {
+        let kv = KnotVector::new(self.knots.clone(), self.degree)?;
+        let ctrl: Vec<Point3> = self.control_points.iter().map(|c| Point3::new(c[0], c[1], c[2])).collect();
+        match (self.periodic, &self.weights) {
+            (true, w) => Curve::new_periodic(kv, ctrl, w.clone()),
+            (false, Some(w)) => Curve::new_rational(kv, ctrl, w.clone()),
+            (false, None) => Curve::new(kv, ctrl),
+        }
+    }
+}
+
+/// Reads a curve document from `path` and builds its curve.
+pub fn read_curve(path: &Path) -> Result<(CurveDoc, Curve)> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse_curve(path, &text)
+}
+
+/// Parses a curve document (`path` for messages only).
+pub fn parse_curve(path: &Path, text: &str) -> Result<(CurveDoc, Curve)> {
+    let doc: CurveDoc = serde_json::from_str(text).map_err(|e| Error::Parse {
+        path: path.to_path_buf(),
+        line: e.line(),
+        message: format!("not a scanfit curve document: {e}"),
+    })?;
+    if doc.kind != "bspline_curve" {
+        return Err(Error::Invalid {
+            path: path.to_path_buf(),
+            message: format!("type is '{}', expected 'bspline_curve'", doc.kind),
+        });
+    }
+    let curve = doc.curve().map_err(|source| Error::Geometry {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    Ok((doc, curve))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trip_is_exact() {
+        let kv = KnotVector::new(vec![0., 0., 0., 0.1 + 0.2, 1. / 3., 1., 1., 1.], 2).unwrap();
+        let ctrl = vec![
+            Point3::new(0.1, -3.47e-15, 1e300),
+            Point3::new(std::f64::consts::PI, 2.0, -0.0),
+            Point3::new(1.0 / 7.0, 5e-324, 3.0),
+            Point3::new(-64.9885, 33.602, 10.0),
+            Point3::new(1., 2., 3.),
+        ];
+        let w = vec![1.0, 0.3, 2.0 / 3.0, 1.5, 1.0];
+        let c = Curve::new_rational(kv, ctrl, w).unwrap();
+        let mut doc = CurveDoc::new(&c);
+        doc.params = Some(vec![0.0, 0.1 + 0.2, 1.0]);
+        let text = doc.to_json();
+        let (back, c2) = parse_curve(Path::new("x.json"), &text).unwrap();
+        assert_eq!(back, doc);
+        assert_eq!(c2, c);
+        for (a, b) in c.control_points().iter().zip(c2.control_points()) {
+            assert_eq!(a.x.to_bits(), b.x.to_bits());
+        }
+    }
+
+    #[test]
+    fn malformed_documents_are_reported() {
+        let e = parse_curve(Path::new("c.json"), "{\"schema\": 1}").unwrap_err().to_string();
+        assert!(e.starts_with("c.json:1:"), "{e}");
+        let doc = r#"{"schema":"scanfit/1","type":"bspline_curve","degree":2,"periodic":false,
+            "knots":[0,0,0,1,0.5,1],"control_points":[[0,0,0],[1,1,1],[2,2,2]],"weights":null}"#;
+        let e = parse_curve(Path::new("c.json"), doc).unwrap_err().to_string();
+        assert!(e.contains("non-decreasing"), "{e}");
+    }
+}
