@@ -1,1 +1,37 @@
-fn main(){}
+//! `scanfit`: turn measured points into B-spline curves and surfaces.
+//!
+//! A thin layer over the `scanfit` library and `scanfit-io`: parse arguments,
+//! read files, call the library, print tables, write outputs.
+
+mod curve;
+mod progress;
+mod table;
+
+use clap::{Parser, Subcommand};
+
+/// Fit CAD-grade B-spline curves and surfaces to measured points.
+#[derive(Parser, Debug)]
+#[command(name = "scanfit", version, about, long_about = None)]
+#[command(after_help = "Examples:\n  scanfit curve compare examples/data/dataset5.csv\n  scanfit curve fit examples/data/dataset6.csv --ctrl 20 -o curve.json")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// B-spline curves through or near a sequence of points.
+    #[command(subcommand)]
+    Curve(curve::CurveCommand),
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Curve(c) => curve::run(c),
+    };
+    if let Err(e) = result {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}

@@ -1,0 +1,439 @@
+//! `scanfit curve fit` and `scanfit curve compare`.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, Subcommand};
+use scanfit::fit::{self, ApproximationConfig, CurveFit, InterpolationConfig};
+use scanfit::param::Method;
+use scanfit::quality::{curve_quality, CurveQuality, QualityConfig};
+use scanfit::Vector3;
+use scanfit_io::json::{CurveDoc, Provenance, QualityDoc};
+use scanfit_io::svg::{curve_panels, Panel, PanelSize};
+use scanfit_io::{read_points, write_atomic, PointTable};
+use serde::Serialize;
+
+use crate::progress::Progress;
+use crate::table::{num, Table};
+
+/// Curve subcommands.
+#[derive(Subcommand, Debug)]
+pub enum CurveCommand {
+    /// Fit one B-spline curve (interpolation or least squares) and report its quality.
+    #[command(after_help = FIT_EXAMPLES)]
+    Fit(FitArgs),
+    /// Interpolate with every parameterization method and compare them side by side.
+    #[command(after_help = COMPARE_EXAMPLES)]
+    Compare(CompareArgs),
+}
+
+const FIT_EXAMPLES: &str = "Examples:
+  scanfit curve fit examples/data/dataset1.csv -o curve.json
+  scanfit curve fit examples/data/dataset6.csv --ctrl 20 --smooth 1e-4 --svg fit.svg
+  scanfit curve fit loop.xyz --closed --param centripetal --json
+
+Parameterization methods (--param): uniform, chord, centripetal, exponential[:a]
+(a = 0.8 by default), universal, hybrid, proposed[:a] (the curve paper's new method,
+the default). Input: XYZ/CSV/TXT text, one point per line, optional header.";
+
+const COMPARE_EXAMPLES: &str = "Examples:
+  scanfit curve compare examples/data/dataset5.csv
+  scanfit curve compare examples/data/dataset3.csv --degree 2 -o ds3.svg --json";
+
+/// Arguments of `scanfit curve fit`.
+#[derive(Args, Debug)]
+pub struct FitArgs {
+    /// Input point file (XYZ, CSV or TXT; points in curve order).
+    pub input: PathBuf,
+    /// Parameterization method.
+    #[arg(short, long = "param", default_value = "proposed", value_name = "METHOD")]
+    pub param: String,
+    /// Degree of the curve.
+    #[arg(short, long, default_value_t = 3)]
+    pub degree: usize,
+    /// Least squares with this many control points (distinct ones when --closed).
+    #[arg(long, value_name = "N", conflicts_with = "interpolate")]
+    pub ctrl: Option<usize>,
+    /// Interpolate every point (the default when --ctrl is not given).
+    #[arg(long)]
+    pub interpolate: bool,
+    /// The points form a closed loop: fit a periodic curve.
+    #[arg(long)]
+    pub closed: bool,
+    /// Smoothing weight on the bending energy ∫|C''|² du (least squares only).
+    #[arg(long, value_name = "W", default_value_t = 0.0, requires = "ctrl")]
+    pub smooth: f64,
+    /// Let the curve's ends move (least squares only; default: pinned to the first and last points).
+    #[arg(long, requires = "ctrl")]
+    pub free_ends: bool,
+    /// End derivatives for interpolation, "dx,dy,dz;dx,dy,dz" (start; end).
+    #[arg(long, value_name = "D0;D1", conflicts_with_all = ["ctrl", "closed"])]
+    pub end_tangents: Option<String>,
+    /// Write the curve as JSON (schema scanfit/1) to this file.
+    #[arg(short, long, value_name = "OUT.json")]
+    pub output: Option<PathBuf>,
+    /// Write a picture of the data, curve and control polygon.
+    #[arg(long, value_name = "OUT.svg")]
+    pub svg: Option<PathBuf>,
+    /// Print the result as JSON on stdout instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// No progress display.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// Arguments of `scanfit curve compare`.
+#[derive(Args, Debug)]
+pub struct CompareArgs {
+    /// Input point file (XYZ, CSV or TXT; points in curve order).
+    pub input: PathBuf,
+    /// Degree of the interpolating curves.
+    #[arg(short, long, default_value_t = 3)]
+    pub degree: usize,
+    /// The SVG with one panel per method [default: INPUT-compare.svg].
+    #[arg(short, long, value_name = "OUT.svg")]
+    pub output: Option<PathBuf>,
+    /// Print the comparison as JSON on stdout instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// No progress display.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// Runs a curve subcommand.
+pub fn run(cmd: CurveCommand) -> Result<()> {
+    match cmd {
+        CurveCommand::Fit(a) => fit_cmd(a),
+        CurveCommand::Compare(a) => compare_cmd(a),
+    }
+}
+
+/// Reads the input, with a file-level error message.
+fn load(path: &Path) -> Result<PointTable> {
+    Ok(read_points(path)?)
+}
+
+/// Adds `file:line` to library errors that name point indices.
+fn locate(e: scanfit::Error, table: &PointTable) -> anyhow::Error {
+    use scanfit::Error as E;
+    let at = |i: usize| table.locate(i);
+    let place = match &e {
+        E::NonFinite { index, .. } => Some(format!("point {index} is at {}", at(*index))),
+        E::DuplicatePoints { first, second, .. } | E::CoincidentParameters { first, second, .. } => {
+            Some(format!("points {first} and {second} are at {} and {}", at(*first), at(*second)))
+        }
+        _ => None,
+    };
+    match place {
+        Some(p) => anyhow::anyhow!("{e} ({p})"),
+        None => anyhow::anyhow!("{e}"),
+    }
+}
+
+fn parse_vec(s: &str) -> Result<Vector3> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .with_context(|| format!("'{s}' is not a vector dx,dy,dz"))?;
+    match v.as_slice() {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Vector3::new(*x, *y, *z)),
+        [x, y] if v.iter().all(|c| c.is_finite()) => Ok(Vector3::new(*x, *y, 0.0)),
+        _ => bail!("'{s}' is not a finite vector dx,dy,dz"),
+    }
+}
+
+#[derive(Serialize)]
+struct FitReport<'a> {
+    input: String,
+    point_count: usize,
+    fit: &'a str,
+    parameterization: String,
+    degree: usize,
+    control_points: usize,
+    closed: bool,
+    condition: f64,
+    quality: QualityDoc,
+    output: Option<String>,
+}
+
+fn fit_cmd(a: FitArgs) -> Result<()> {
+    let method = Method::parse(&a.param)?;
+    let progress = Progress::spinner(a.quiet);
+    progress.stage(format!("reading {}", a.input.display()));
+    let table = load(&a.input)?;
+    let pts = &table.points;
+    progress.stage(format!("fitting {} points", pts.len()));
+    let (fit, kind) = match a.ctrl {
+        Some(n) => {
+            let cfg = ApproximationConfig {
+                degree: a.degree,
+                ctrl_count: n,
+                method,
+                fix_ends: !a.free_ends,
+                smoothing: a.smooth,
+                weights: None,
+                closed: a.closed,
+            };
+            (fit::approximate(pts, &cfg), "least squares")
+        }
+        None => {
+            let end_derivatives = match &a.end_tangents {
+                Some(s) => {
+                    let (d0, d1) = s
+                        .split_once(';')
+                        .context("--end-tangents needs two vectors separated by ';'")?;
+                    Some((parse_vec(d0)?, parse_vec(d1)?))
+                }
+                None => None,
+            };
+            let cfg = InterpolationConfig {
+                degree: a.degree,
+                method,
+                end_derivatives,
+                closed: a.closed,
+            };
+            (fit::interpolate(pts, &cfg), "interpolation")
+        }
+    };
+    let fit = fit.map_err(|e| locate(e, &table))?;
+    progress.stage("measuring");
+    let used = &pts[..fit.params.len()];
+    let q = curve_quality(&fit.curve, used, &fit.params, &QualityConfig::default());
+    progress.finish();
+
+    let mut doc = CurveDoc::new(&fit.curve);
+    let mut settings = std::collections::BTreeMap::new();
+    settings.insert("degree".to_string(), a.degree.into());
+    settings.insert("closed".to_string(), a.closed.into());
+    if let Some(n) = a.ctrl {
+        settings.insert("ctrl".to_string(), n.into());
+        settings.insert("smoothing".to_string(), a.smooth.into());
+        settings.insert("fix_ends".to_string(), (!a.free_ends).into());
+    }
+    doc.provenance = Some(Provenance {
+        tool: format!("scanfit {}", env!("CARGO_PKG_VERSION")),
+        operation: format!("curve fit ({kind})"),
+        parameterization: Some(method.to_string()),
+        input: Some(a.input.display().to_string()),
+        point_count: Some(pts.len()),
+        settings,
+    });
+    doc.params = Some(fit.params.clone());
+    doc.quality = Some(QualityDoc::from(&q));
+    // outputs are written only after everything succeeded, each atomically
+    if let Some(out) = &a.output {
+        write_atomic(out, doc.to_json().as_bytes())?;
+    }
+    if let Some(svg) = &a.svg {
+        let panel = Panel {
+            title: format!("{method} ({kind}, degree {})", a.degree),
+            subtitle: summary(&q),
+            points: used,
+            curve: Some(&fit.curve),
+        };
+        write_atomic(svg, curve_panels(&[panel], 1, "", PanelSize::SINGLE).as_bytes())?;
+    }
+    if a.json {
+        let report = FitReport {
+            input: a.input.display().to_string(),
+            point_count: pts.len(),
+            fit: kind,
+            parameterization: method.to_string(),
+            degree: a.degree,
+            control_points: fit.curve.control_points().len(),
+            closed: a.closed,
+            condition: fit.condition,
+            quality: QualityDoc::from(&q),
+            output: a.output.as_ref().map(|p| p.display().to_string()),
+        };
+        println!("{}", serde_json::to_string_pretty(&report)?);
+        return Ok(());
+    }
+    print_fit(&a, &fit, &q, kind, pts.len());
+    Ok(())
+}
+
+fn summary(q: &CurveQuality) -> String {
+    format!(
+        "loops {} · inflections {} · length ratio {:.3} · max curvature {} · max deviation {}",
+        q.self_intersections,
+        q.curvature_sign_changes,
+        q.length_ratio,
+        num(q.max_curvature),
+        num(q.max_deviation),
+    )
+}
+
+fn print_fit(a: &FitArgs, fit: &CurveFit, q: &CurveQuality, kind: &str, n: usize) {
+    let c = &fit.curve;
+    println!(
+        "{}: {n} points -> {} B-spline of degree {} by {kind}, {} parameterization",
+        a.input.display(),
+        if c.is_periodic() { "closed (periodic)" } else { "open" },
+        c.degree(),
+        fit.method
+    );
+    println!(
+        "{} control points, {} knots, condition estimate {:.1e}\n",
+        c.control_points().len(),
+        c.knots().len(),
+        fit.condition
+    );
+    let mut t = Table::new(&["measure", "value", "unit"], &[true, false, true]);
+    let rows: [(&str, String, &str); 11] = [
+        ("max deviation (at point parameters)", num(q.max_deviation), "data units"),
+        ("  at point", q.max_deviation_index.to_string(), "index"),
+        ("mean deviation", num(q.mean_deviation), "data units"),
+        ("RMS deviation", num(q.rms_deviation), "data units"),
+        ("max orthogonal distance", num(q.max_distance), "data units"),
+        ("max curvature", num(q.max_curvature), "1/data units"),
+        ("curvature sign changes", q.curvature_sign_changes.to_string(), "count"),
+        ("self-intersections (loops)", q.self_intersections.to_string(), "count"),
+        ("curve length", num(q.length), "data units"),
+        ("data polygon length", num(q.polygon_length), "data units"),
+        ("length ratio curve/polygon", format!("{:.4}", q.length_ratio), "-"),
+    ];
+    for (m, v, u) in rows {
+        t.row(vec![m.into(), v, u.into()]);
+    }
+    print!("{}", t.render());
+    for (what, p) in [("curve", &a.output), ("picture", &a.svg)] {
+        if let Some(p) = p {
+            println!("wrote {what}: {}", p.display());
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct CompareRow {
+    method: String,
+    ok: bool,
+    error: Option<String>,
+    quality: Option<QualityDoc>,
+    condition: Option<f64>,
+}
+
+fn compare_cmd(a: CompareArgs) -> Result<()> {
+    let table = load(&a.input)?;
+    let pts = &table.points;
+    let progress = Progress::bar(a.quiet, Method::ALL.len() as u64);
+    let mut results = Vec::new();
+    for m in Method::ALL {
+        progress.stage(m.to_string());
+        let cfg = InterpolationConfig {
+            degree: a.degree,
+            method: m,
+            ..Default::default()
+        };
+        let r = fit::interpolate(pts, &cfg).map(|f| {
+            let q = curve_quality(&f.curve, pts, &f.params, &QualityConfig::default());
+            (f, q)
+        });
+        results.push((m, r));
+        progress.inc();
+    }
+    progress.finish();
+    // every method failing the same way is an input problem, not a comparison
+    if results.iter().all(|(_, r)| r.is_err()) {
+        if let Some((_, Err(e))) = results.first() {
+            return Err(locate(e.clone(), &table));
+        }
+    }
+    let out = a.output.clone().unwrap_or_else(|| {
+        let stem = a.input.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "curve".into());
+        PathBuf::from(format!("{stem}-compare.svg"))
+    });
+    let panels: Vec<Panel> = results
+        .iter()
+        .map(|(m, r)| match r {
+            Ok((f, q)) => Panel {
+                title: m.to_string(),
+                subtitle: summary(q),
+                points: pts,
+                curve: Some(&f.curve),
+            },
+            Err(e) => Panel {
+                title: m.to_string(),
+                subtitle: format!("error: {e}"),
+                points: pts,
+                curve: None,
+            },
+        })
+        .collect();
+    let title = format!(
+        "{}: degree-{} interpolation, {} points",
+        a.input.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default(),
+        a.degree,
+        pts.len()
+    );
+    write_atomic(&out, curve_panels(&panels, 4, &title, PanelSize::GRID).as_bytes())?;
+
+    if a.json {
+        let rows: Vec<CompareRow> = results
+            .iter()
+            .map(|(m, r)| match r {
+                Ok((f, q)) => CompareRow {
+                    method: m.to_string(),
+                    ok: true,
+                    error: None,
+                    quality: Some(q.into()),
+                    condition: Some(f.condition),
+                },
+                Err(e) => CompareRow {
+                    method: m.to_string(),
+                    ok: false,
+                    error: Some(locate(e.clone(), &table).to_string()),
+                    quality: None,
+                    condition: None,
+                },
+            })
+            .collect();
+        let doc = serde_json::json!({
+            "input": a.input.display().to_string(),
+            "point_count": pts.len(),
+            "degree": a.degree,
+            "picture": out.display().to_string(),
+            "methods": rows,
+        });
+        println!("{}", serde_json::to_string_pretty(&doc)?);
+        return Ok(());
+    }
+    println!(
+        "{}: {} points, degree-{} interpolation with every parameterization\n",
+        a.input.display(),
+        pts.len(),
+        a.degree
+    );
+    let mut t = Table::new(
+        &["method", "result", "max curvature [1/unit]", "inflections", "loops", "length ratio", "condition"],
+        &[true, true, false, false, false, false, false],
+    );
+    let mut errors = Vec::new();
+    for (m, r) in &results {
+        match r {
+            Ok((f, q)) => t.row(vec![
+                m.to_string(),
+                "ok".into(),
+                num(q.max_curvature),
+                q.curvature_sign_changes.to_string(),
+                q.self_intersections.to_string(),
+                format!("{:.4}", q.length_ratio),
+                format!("{:.1e}", f.condition),
+            ]),
+            Err(e) => {
+                t.row(vec![m.to_string(), "error".into(), "-".into(), "-".into(), "-".into(), "-".into(), "-".into()]);
+                errors.push(format!("{m}: {}", locate(e.clone(), &table)));
+            }
+        }
+    }
+    print!("{}", t.render());
+    for e in errors {
+        println!("  {e}");
+    }
+    println!("\nlength ratio = curve length / data polygon length (1 = tight; large = bulges).");
+    println!("wrote picture: {}", out.display());
+    Ok(())
+}
