@@ -46,7 +46,12 @@ pub struct FitArgs {
     /// Input point file (XYZ, CSV or TXT; points in curve order).
     pub input: PathBuf,
     /// Parameterization method.
-    #[arg(short, long = "param", default_value = "proposed", value_name = "METHOD")]
+    #[arg(
+        short,
+        long = "param",
+        default_value = "proposed",
+        value_name = "METHOD"
+    )]
     pub param: String,
     /// Degree of the curve.
     #[arg(short, long, default_value_t = 3)]
@@ -60,7 +65,9 @@ pub struct FitArgs {
     /// The points form a closed loop: fit a periodic curve.
     #[arg(long)]
     pub closed: bool,
-    /// Smoothing weight on the bending energy ∫|C''|² du (least squares only).
+    /// Smoothing weight λ (least squares only): minimises Σ|Q_k − C(u_k)|² + λ ∫₀¹|C''(u)|² du.
+    /// Both terms scale alike with the data's size, so λ is scale-free; it grows with
+    /// the number of points (try 1e-6 … 1e-2 times the point count).
     #[arg(long, value_name = "W", default_value_t = 0.0, requires = "ctrl")]
     pub smooth: f64,
     /// Let the curve's ends move (least squares only; default: pinned to the first and last points).
@@ -121,9 +128,12 @@ fn locate(e: scanfit::Error, table: &PointTable) -> anyhow::Error {
     let at = |i: usize| table.locate(i);
     let place = match &e {
         E::NonFinite { index, .. } => Some(format!("point {index} is at {}", at(*index))),
-        E::DuplicatePoints { first, second, .. } | E::CoincidentParameters { first, second, .. } => {
-            Some(format!("points {first} and {second} are at {} and {}", at(*first), at(*second)))
-        }
+        E::DuplicatePoints { first, second, .. }
+        | E::CoincidentParameters { first, second, .. } => Some(format!(
+            "points {first} and {second} are at {} and {}",
+            at(*first),
+            at(*second)
+        )),
         _ => None,
     };
     match place {
@@ -234,7 +244,10 @@ fn fit_cmd(a: FitArgs) -> Result<()> {
             points: used,
             curve: Some(&fit.curve),
         };
-        write_atomic(svg, curve_panels(&[panel], 1, "", PanelSize::SINGLE).as_bytes())?;
+        write_atomic(
+            svg,
+            curve_panels(&[panel], 1, "", PanelSize::SINGLE).as_bytes(),
+        )?;
     }
     if a.json {
         let report = FitReport {
@@ -272,7 +285,11 @@ fn print_fit(a: &FitArgs, fit: &CurveFit, q: &CurveQuality, kind: &str, n: usize
     println!(
         "{}: {n} points -> {} B-spline of degree {} by {kind}, {} parameterization",
         a.input.display(),
-        if c.is_periodic() { "closed (periodic)" } else { "open" },
+        if c.is_periodic() {
+            "closed (periodic)"
+        } else {
+            "open"
+        },
         c.degree(),
         fit.method
     );
@@ -284,17 +301,33 @@ fn print_fit(a: &FitArgs, fit: &CurveFit, q: &CurveQuality, kind: &str, n: usize
     );
     let mut t = Table::new(&["measure", "value", "unit"], &[true, false, true]);
     let rows: [(&str, String, &str); 11] = [
-        ("max deviation (at point parameters)", num(q.max_deviation), "data units"),
+        (
+            "max deviation (at point parameters)",
+            num(q.max_deviation),
+            "data units",
+        ),
         ("  at point", q.max_deviation_index.to_string(), "index"),
         ("mean deviation", num(q.mean_deviation), "data units"),
         ("RMS deviation", num(q.rms_deviation), "data units"),
         ("max orthogonal distance", num(q.max_distance), "data units"),
         ("max curvature", num(q.max_curvature), "1/data units"),
-        ("curvature sign changes", q.curvature_sign_changes.to_string(), "count"),
-        ("self-intersections (loops)", q.self_intersections.to_string(), "count"),
+        (
+            "curvature sign changes",
+            q.curvature_sign_changes.to_string(),
+            "count",
+        ),
+        (
+            "self-intersections (loops)",
+            q.self_intersections.to_string(),
+            "count",
+        ),
         ("curve length", num(q.length), "data units"),
         ("data polygon length", num(q.polygon_length), "data units"),
-        ("length ratio curve/polygon", format!("{:.4}", q.length_ratio), "-"),
+        (
+            "length ratio curve/polygon",
+            format!("{:.4}", q.length_ratio),
+            "-",
+        ),
     ];
     for (m, v, u) in rows {
         t.row(vec![m.into(), v, u.into()]);
@@ -343,7 +376,11 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
         }
     }
     let out = a.output.clone().unwrap_or_else(|| {
-        let stem = a.input.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "curve".into());
+        let stem = a
+            .input
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "curve".into());
         PathBuf::from(format!("{stem}-compare.svg"))
     });
     let panels: Vec<Panel> = results
@@ -365,11 +402,17 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
         .collect();
     let title = format!(
         "{}: degree-{} interpolation, {} points",
-        a.input.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default(),
+        a.input
+            .file_name()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default(),
         a.degree,
         pts.len()
     );
-    write_atomic(&out, curve_panels(&panels, 4, &title, PanelSize::GRID).as_bytes())?;
+    write_atomic(
+        &out,
+        curve_panels(&panels, 4, &title, PanelSize::GRID).as_bytes(),
+    )?;
 
     if a.json {
         let rows: Vec<CompareRow> = results
@@ -408,7 +451,15 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
         a.degree
     );
     let mut t = Table::new(
-        &["method", "result", "max curvature [1/unit]", "inflections", "loops", "length ratio", "condition"],
+        &[
+            "method",
+            "result",
+            "max curvature [1/unit]",
+            "inflections",
+            "loops",
+            "length ratio",
+            "condition",
+        ],
         &[true, true, false, false, false, false, false],
     );
     let mut errors = Vec::new();
@@ -424,7 +475,15 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
                 format!("{:.1e}", f.condition),
             ]),
             Err(e) => {
-                t.row(vec![m.to_string(), "error".into(), "-".into(), "-".into(), "-".into(), "-".into(), "-".into()]);
+                t.row(vec![
+                    m.to_string(),
+                    "error".into(),
+                    "-".into(),
+                    "-".into(),
+                    "-".into(),
+                    "-".into(),
+                    "-".into(),
+                ]);
                 errors.push(format!("{m}: {}", locate(e.clone(), &table)));
             }
         }

@@ -12,7 +12,9 @@ use clap::{Parser, Subcommand};
 /// Fit CAD-grade B-spline curves and surfaces to measured points.
 #[derive(Parser, Debug)]
 #[command(name = "scanfit", version, about, long_about = None)]
-#[command(after_help = "Examples:\n  scanfit curve compare examples/data/dataset5.csv\n  scanfit curve fit examples/data/dataset6.csv --ctrl 20 -o curve.json")]
+#[command(
+    after_help = "Examples:\n  scanfit curve compare examples/data/dataset5.csv\n  scanfit curve fit examples/data/dataset6.csv --ctrl 20 -o curve.json"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

@@ -141,7 +141,11 @@ impl CurveDoc {
             degree: curve.degree(),
             periodic: curve.is_periodic(),
             knots: curve.knots().as_slice().to_vec(),
-            control_points: curve.control_points().iter().map(|p| [p.x, p.y, p.z]).collect(),
+            control_points: curve
+                .control_points()
+                .iter()
+                .map(|p| [p.x, p.y, p.z])
+                .collect(),
             weights: curve.weights().map(|w| w.to_vec()),
             provenance: None,
             params: None,
@@ -158,7 +162,11 @@ impl CurveDoc {
     /// The curve this document describes (validated).
     pub fn curve(&self) -> scanfit::Result<Curve> {
         let kv = KnotVector::new(self.knots.clone(), self.degree)?;
-        let ctrl: Vec<Point3> = self.control_points.iter().map(|c| Point3::new(c[0], c[1], c[2])).collect();
+        let ctrl: Vec<Point3> = self
+            .control_points
+            .iter()
+            .map(|c| Point3::new(c[0], c[1], c[2]))
+            .collect();
         match (self.periodic, &self.weights) {
             (true, w) => Curve::new_periodic(kv, ctrl, w.clone()),
             (false, Some(w)) => Curve::new_rational(kv, ctrl, w.clone()),
@@ -225,11 +233,15 @@ mod tests {
 
     #[test]
     fn malformed_documents_are_reported() {
-        let e = parse_curve(Path::new("c.json"), "{\"schema\": 1}").unwrap_err().to_string();
+        let e = parse_curve(Path::new("c.json"), "{\"schema\": 1}")
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("c.json:1:"), "{e}");
         let doc = r#"{"schema":"scanfit/1","type":"bspline_curve","degree":2,"periodic":false,
             "knots":[0,0,0,1,0.5,1],"control_points":[[0,0,0],[1,1,1],[2,2,2]],"weights":null}"#;
-        let e = parse_curve(Path::new("c.json"), doc).unwrap_err().to_string();
+        let e = parse_curve(Path::new("c.json"), doc)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("non-decreasing"), "{e}");
     }
 }

@@ -37,7 +37,10 @@ impl Projection {
         let n = points.len().max(1) as f64;
         let c = points.iter().fold(Vector3::zeros(), |a, p| a + p.coords) / n;
         let (lo, hi) = points.iter().fold(
-            (Vector3::repeat(f64::INFINITY), Vector3::repeat(f64::NEG_INFINITY)),
+            (
+                Vector3::repeat(f64::INFINITY),
+                Vector3::repeat(f64::NEG_INFINITY),
+            ),
             |(lo, hi), p| (lo.inf(&p.coords), hi.sup(&p.coords)),
         );
         let ext = hi - lo;
@@ -83,9 +86,15 @@ pub struct PanelSize {
 
 impl PanelSize {
     /// Small panels for a grid (360 x 310).
-    pub const GRID: PanelSize = PanelSize { width: 360.0, height: 310.0 };
+    pub const GRID: PanelSize = PanelSize {
+        width: 360.0,
+        height: 310.0,
+    };
     /// One large picture (900 x 600).
-    pub const SINGLE: PanelSize = PanelSize { width: 900.0, height: 600.0 };
+    pub const SINGLE: PanelSize = PanelSize {
+        width: 900.0,
+        height: 600.0,
+    };
 }
 
 /// An SVG document with the panels in a grid of `columns` columns.
@@ -140,7 +149,12 @@ fn draw_panel(s: &mut String, panel: &Panel, x0: f64, y0: f64, id: usize, size: 
     // each side, so that a wild curve does not shrink the data to a dot
     let bbox = |pts: &[(f64, f64)]| {
         pts.iter().fold(
-            (f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY),
+            (
+                f64::INFINITY,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                f64::NEG_INFINITY,
+            ),
             |b, p| (b.0.min(p.0), b.1.min(p.1), b.2.max(p.0), b.3.max(p.1)),
         )
     };
@@ -182,7 +196,11 @@ fn draw_panel(s: &mut String, panel: &Panel, x0: f64, y0: f64, id: usize, size: 
         y0 + 18.0,
         escape(&panel.title)
     );
-    let colour = if panel.curve.is_some() { "#333" } else { "#b00" };
+    let colour = if panel.curve.is_some() {
+        "#333"
+    } else {
+        "#b00"
+    };
     // about 6 px per character at 10.5 px
     let per_line = ((panel_w - 20.0) / 6.0) as usize;
     for (k, line) in wrap(&panel.subtitle, per_line, 2).iter().enumerate() {
@@ -273,7 +291,9 @@ fn wrap(s: &str, width: usize, max_lines: usize) -> Vec<String> {
 }
 
 fn escape(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
 }
 
 #[cfg(test)]
@@ -283,12 +303,26 @@ mod tests {
 
     #[test]
     fn panels_contain_every_element() {
-        let pts = vec![Point3::new(0., 0., 0.), Point3::new(1., 1., 0.), Point3::new(2., 0., 0.)];
+        let pts = vec![
+            Point3::new(0., 0., 0.),
+            Point3::new(1., 1., 0.),
+            Point3::new(2., 0., 0.),
+        ];
         let kv = KnotVector::uniform_clamped(2, 3).unwrap();
         let c = Curve::new(kv, pts.clone()).unwrap();
         let panels = vec![
-            Panel { title: "a<b".into(), subtitle: "ok".into(), points: &pts, curve: Some(&c) },
-            Panel { title: "b".into(), subtitle: "error".into(), points: &pts, curve: None },
+            Panel {
+                title: "a<b".into(),
+                subtitle: "ok".into(),
+                points: &pts,
+                curve: Some(&c),
+            },
+            Panel {
+                title: "b".into(),
+                subtitle: "error".into(),
+                points: &pts,
+                curve: None,
+            },
         ];
         let svg = curve_panels(&panels, 2, "t", PanelSize::GRID);
         assert!(svg.starts_with("<svg") && svg.ends_with("</svg>\n"));

@@ -39,7 +39,10 @@ impl PointTable {
 
     /// The extra column named `name`, if any.
     pub fn column(&self, name: &str) -> Option<&[f64]> {
-        let i = self.columns.iter().position(|c| c.eq_ignore_ascii_case(name))?;
+        let i = self
+            .columns
+            .iter()
+            .position(|c| c.eq_ignore_ascii_case(name))?;
         if i < 3 {
             return None;
         }
@@ -121,7 +124,12 @@ pub fn parse_points(path: &Path, text: &str) -> Result<PointTable> {
         if let Some((k, f)) = bad {
             if points.is_empty() && columns.is_none() {
                 // the first non-numeric line before any data is the header
-                columns = Some(fields.iter().map(|s| s.trim_matches('"').to_string()).collect());
+                columns = Some(
+                    fields
+                        .iter()
+                        .map(|s| s.trim_matches('"').to_string())
+                        .collect(),
+                );
                 continue;
             }
             return Err(perr(
@@ -142,13 +150,20 @@ pub fn parse_points(path: &Path, text: &str) -> Result<PointTable> {
         if values.len() != width {
             return Err(perr(
                 line_no,
-                format!("{} values found, but the file has {width} columns", values.len()),
+                format!(
+                    "{} values found, but the file has {width} columns",
+                    values.len()
+                ),
             ));
         }
         if let Some(k) = values.iter().position(|v| !v.is_finite()) {
             return Err(perr(
                 line_no,
-                format!("value {} is {}; every coordinate must be a finite number", k + 1, values[k]),
+                format!(
+                    "value {} is {}; every coordinate must be a finite number",
+                    k + 1,
+                    values[k]
+                ),
             ));
         }
         points.push(Point3::new(values[0], values[1], values[2]));
@@ -188,7 +203,10 @@ mod tests {
     #[test]
     fn csv_with_header_and_extra_columns() {
         let t = parse("x,y,z,w\n1,2,3,0.5\n\n# c\n4,5,6,1.5\n").unwrap();
-        assert_eq!(t.points, vec![Point3::new(1., 2., 3.), Point3::new(4., 5., 6.)]);
+        assert_eq!(
+            t.points,
+            vec![Point3::new(1., 2., 3.), Point3::new(4., 5., 6.)]
+        );
         assert_eq!(t.lines, vec![2, 5]);
         assert_eq!(t.column("w").unwrap(), &[0.5, 1.5]);
         assert_eq!(t.locate(1), "t.csv:5");
@@ -222,7 +240,9 @@ mod tests {
 
     #[test]
     fn missing_file_and_unsupported_extension() {
-        let e = read_points(Path::new("/nonexistent/p.xyz")).unwrap_err().to_string();
+        let e = read_points(Path::new("/nonexistent/p.xyz"))
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("/nonexistent/p.xyz:"), "{e}");
         let e = read_points(Path::new("scan.e57")).unwrap_err().to_string();
         assert!(e.contains("not supported"), "{e}");

@@ -26,7 +26,11 @@ pub(crate) fn validate_distinct_consecutive(points: &[Point3], closed: bool) -> 
     let scale = bbox_diagonal(points).max(f64::MIN_POSITIVE);
     let tol = scale * 1e-14;
     let n = points.len();
-    let pairs = if closed && n > 1 { n } else { n.saturating_sub(1) };
+    let pairs = if closed && n > 1 {
+        n
+    } else {
+        n.saturating_sub(1)
+    };
     for i in 0..pairs {
         let j = (i + 1) % n;
         let d = (points[j] - points[i]).norm();

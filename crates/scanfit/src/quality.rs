@@ -57,12 +57,18 @@ pub struct CurveQuality {
 }
 
 /// Computes the quality report of `curve` fitted to `points` at `params`.
-pub fn curve_quality(curve: &Curve, points: &[Point3], params: &[f64], cfg: &QualityConfig) -> CurveQuality {
+pub fn curve_quality(
+    curve: &Curve,
+    points: &[Point3],
+    params: &[f64],
+    cfg: &QualityConfig,
+) -> CurveQuality {
     let p = curve.degree();
     let mut ws = BasisWorkspace::new(p, 2);
 
     // deviations at the fit parameters, and orthogonal distances by Newton
-    let (mut max_dev, mut max_idx, mut sum, mut sum2, mut max_dist) = (0.0f64, 0usize, 0.0, 0.0, 0.0f64);
+    let (mut max_dev, mut max_idx, mut sum, mut sum2, mut max_dist) =
+        (0.0f64, 0usize, 0.0, 0.0, 0.0f64);
     for (k, (q, &u)) in points.iter().zip(params).enumerate() {
         let d = (curve.point(u) - q).norm();
         if d > max_dev {
@@ -141,14 +147,23 @@ pub fn curve_quality(curve: &Curve, points: &[Point3], params: &[f64], cfg: &Qua
         self_intersections,
         length,
         polygon_length,
-        length_ratio: if polygon_length > 0.0 { length / polygon_length } else { f64::NAN },
+        length_ratio: if polygon_length > 0.0 {
+            length / polygon_length
+        } else {
+            f64::NAN
+        },
     }
 }
 
 /// Closest point on `curve` to `q` by Newton iteration on `(C(u) - q) . C'(u) = 0`
 /// started at `u0` (NURBS Book section 6.1), clamped (or wrapped) to the domain.
 /// Returns `(u, distance)`; if Newton does not improve on the start, the start.
-pub fn closest_point_near(curve: &Curve, q: &Point3, u0: f64, ws: &mut BasisWorkspace) -> (f64, f64) {
+pub fn closest_point_near(
+    curve: &Curve,
+    q: &Point3,
+    u0: f64,
+    ws: &mut BasisWorkspace,
+) -> (f64, f64) {
     let (a, b) = curve.domain();
     let mut d = [Vector3::zeros(); 3];
     let mut u = u0;
@@ -163,7 +178,11 @@ pub fn closest_point_near(curve: &Curve, q: &Point3, u0: f64, ws: &mut BasisWork
             break;
         }
         let mut next = u - f / fp;
-        next = if curve.is_periodic() { curve.wrap(next) } else { next.clamp(a, b) };
+        next = if curve.is_periodic() {
+            curve.wrap(next)
+        } else {
+            next.clamp(a, b)
+        };
         let dist = (curve.point(next) - q).norm();
         if dist < best.1 {
             best = (next, dist);
@@ -271,7 +290,11 @@ fn segment_distance(p0: &Point3, p1: &Point3, q0: &Point3, q1: &Point3) -> f64 {
         } else {
             let b = d1.dot(&d2);
             let denom = a * e - b * b;
-            let mut s0 = if denom > 0.0 { ((b * f - c * e) / denom).clamp(0.0, 1.0) } else { 0.0 };
+            let mut s0 = if denom > 0.0 {
+                ((b * f - c * e) / denom).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
             let mut t0 = (b * s0 + f) / e;
             if t0 < 0.0 {
                 t0 = 0.0;
@@ -328,7 +351,14 @@ mod tests {
     fn s_curve_has_one_inflection_and_circle_arc_curvature() {
         // an S: two opposite bends
         let kv = KnotVector::uniform_clamped(3, 6).unwrap();
-        let ctrl = vec![p(0., 0.), p(1., 1.), p(2., 1.), p(3., -1.), p(4., -1.), p(5., 0.)];
+        let ctrl = vec![
+            p(0., 0.),
+            p(1., 1.),
+            p(2., 1.),
+            p(3., -1.),
+            p(4., -1.),
+            p(5., 0.),
+        ];
         let c = Curve::new(kv, ctrl).unwrap();
         let q = curve_quality(&c, &[p(0., 0.)], &[0.0], &QualityConfig::default());
         assert_eq!(q.curvature_sign_changes, 1);

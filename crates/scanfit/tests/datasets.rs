@@ -1,6 +1,8 @@
 //! The six data sets of the curve paper (Table 2) through all seven
 //! parameterization methods, with the paper's crisp findings asserted.
 
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::path::Path;
 
 use scanfit::fit::{interpolate, InterpolationConfig};
@@ -9,7 +11,8 @@ use scanfit::quality::{curve_quality, QualityConfig};
 use scanfit::Point3;
 
 fn dataset(k: usize) -> Vec<Point3> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../examples/data/dataset{k}.csv"));
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../examples/data/dataset{k}.csv"));
     let text = std::fs::read_to_string(path).unwrap();
     text.lines()
         .skip(1)
@@ -21,9 +24,15 @@ fn dataset(k: usize) -> Vec<Point3> {
 }
 
 /// Interpolates data set `k` with `method` (cubic) and reports its quality.
-fn run(k: usize, method: Method) -> scanfit::Result<(scanfit::fit::CurveFit, scanfit::quality::CurveQuality)> {
+fn run(
+    k: usize,
+    method: Method,
+) -> scanfit::Result<(scanfit::fit::CurveFit, scanfit::quality::CurveQuality)> {
     let pts = dataset(k);
-    let cfg = InterpolationConfig { method, ..Default::default() };
+    let cfg = InterpolationConfig {
+        method,
+        ..Default::default()
+    };
     let fit = interpolate(&pts, &cfg)?;
     let q = curve_quality(&fit.curve, &pts, &fit.params, &QualityConfig::default());
     Ok((fit, q))
@@ -36,7 +45,11 @@ fn every_method_on_every_dataset_interpolates_or_reports_why() {
             match run(k, m) {
                 Ok((fit, q)) => {
                     // passes through every data point
-                    assert!(q.max_deviation < 1e-9, "ds{k} {m}: deviation {}", q.max_deviation);
+                    assert!(
+                        q.max_deviation < 1e-9,
+                        "ds{k} {m}: deviation {}",
+                        q.max_deviation
+                    );
                     assert!(fit.params.windows(2).all(|w| w[1] > w[0]));
                     assert_eq!((fit.params[0], *fit.params.last().unwrap()), (0.0, 1.0));
                 }
@@ -53,7 +66,13 @@ fn every_method_on_every_dataset_interpolates_or_reports_why() {
 fn hybrid_gives_coincident_parameters_on_dataset_3() {
     // paper section 4.1.3 and Figs. 14-15: "u3 = u4 = 0.5", singular system
     match run(3, Method::Hybrid) {
-        Err(scanfit::Error::CoincidentParameters { first, second, u_first, u_second, .. }) => {
+        Err(scanfit::Error::CoincidentParameters {
+            first,
+            second,
+            u_first,
+            u_second,
+            ..
+        }) => {
             assert_eq!((first, second), (3, 4));
             assert_eq!(u_first, 0.5);
             assert_eq!(u_second, 0.5);
@@ -67,7 +86,11 @@ fn new_method_succeeds_on_all_six_without_loops() {
     for k in 1..=6 {
         let (_, q) = run(k, Method::Proposed(0.8)).unwrap();
         assert_eq!(q.self_intersections, 0, "ds{k}");
-        assert!(q.length_ratio < 1.1, "ds{k}: length ratio {}", q.length_ratio);
+        assert!(
+            q.length_ratio < 1.1,
+            "ds{k}: length ratio {}",
+            q.length_ratio
+        );
     }
 }
 
@@ -107,7 +130,11 @@ fn hybrid_is_bulky_at_the_ends_of_dataset_1() {
     // section 4.1.1: "The only different result is given by hybrid ... bulky
     // curve at the start and end"
     let hybrid = run(1, Method::Hybrid).unwrap().1;
-    for m in [Method::Centripetal, Method::ChordLength, Method::Proposed(0.8)] {
+    for m in [
+        Method::Centripetal,
+        Method::ChordLength,
+        Method::Proposed(0.8),
+    ] {
         let other = run(1, m).unwrap().1;
         assert!(other.length_ratio < 1.02, "{m}");
         assert!(hybrid.length_ratio > 1.3 * other.length_ratio);

@@ -3,6 +3,8 @@
 //! `make_smoothing_spline`). The reference data were computed once by
 //! `python3 crates/scanfit/tests/data/golden/make_golden.py` and are committed.
 
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::path::{Path, PathBuf};
 
 use scanfit::bspline::KnotVector;
@@ -23,7 +25,11 @@ fn load(name: &str) -> Value {
 }
 
 fn floats(v: &Value) -> Vec<f64> {
-    v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
 }
 
 fn points(v: &Value) -> Vec<Point3> {
@@ -79,7 +85,12 @@ fn interpolation_matches_scipy() {
             assert!((a - b).abs() <= 1e-15, "{name}: knot {a} vs {b}");
         }
         let (curve, _) = interpolate_with(&pts, &par.params, kv, None).unwrap();
-        assert_close(&name, curve.control_points(), &points(&g["coefficients"]), 1e-9);
+        assert_close(
+            &name,
+            curve.control_points(),
+            &points(&g["coefficients"]),
+            1e-9,
+        );
         check_samples(&name, &g, |u| curve.point(u), 1e-9);
         // and the curve passes through every data point to 1e-9
         for (u, q) in par.params.iter().zip(&pts) {
@@ -101,9 +112,17 @@ fn interpolation_with_end_derivatives_matches_scipy() {
     }
     let d0 = floats(&g["d0"]);
     let dn = floats(&g["dn"]);
-    let ders = (Vector3::new(d0[0], d0[1], d0[2]), Vector3::new(dn[0], dn[1], dn[2]));
+    let ders = (
+        Vector3::new(d0[0], d0[1], d0[2]),
+        Vector3::new(dn[0], dn[1], dn[2]),
+    );
     let (curve, _) = interpolate_with(&pts, &u, kv, Some(ders)).unwrap();
-    assert_close("derivs", curve.control_points(), &points(&g["coefficients"]), 1e-9);
+    assert_close(
+        "derivs",
+        curve.control_points(),
+        &points(&g["coefficients"]),
+        1e-9,
+    );
     check_samples("derivs", &g, |u| curve.point(u), 1e-9);
 }
 
@@ -129,7 +148,12 @@ fn least_squares_matches_scipy() {
         };
         let (curve, cond) = least_squares_with(&pts, &u, kv, opts).unwrap();
         assert!(cond.is_finite() && cond > 1.0);
-        assert_close(file, curve.control_points(), &points(&g["coefficients"]), 1e-9);
+        assert_close(
+            file,
+            curve.control_points(),
+            &points(&g["coefficients"]),
+            1e-9,
+        );
         check_samples(file, &g, |u| curve.point(u), 1e-9);
     }
 }
@@ -191,11 +215,15 @@ fn periodic_interpolation_matches_scipy() {
         }
         let (curve, _) = interpolate_closed_with(pts, &par.params[..pts.len()], kv).unwrap();
         assert!(curve.is_periodic());
-        assert_close(&file, curve.control_points(), &points(&g["coefficients"]), 1e-9);
+        assert_close(
+            &file,
+            curve.control_points(),
+            &points(&g["coefficients"]),
+            1e-9,
+        );
         check_samples(&file, &g, |u| curve.point(u), 1e-9);
     }
 }
-
 
 /// Universal, hybrid and the new method against an independent Python/scipy
 /// implementation (maxima by dense sampling + brentq on N'):
@@ -219,15 +247,25 @@ fn basis_maxima_methods_match_independent_implementation() {
         };
         let want = floats(&c["params"]);
         for (i, (a, b)) in u.iter().zip(&want).enumerate() {
-            assert!((a - b).abs() < 1e-9, "ds{k} p{p} {method}: u[{i}] = {a} vs {b}");
+            assert!(
+                (a - b).abs() < 1e-9,
+                "ds{k} p{p} {method}: u[{i}] = {a} vs {b}"
+            );
         }
         if method != "hybrid" {
             for (a, b) in kv.as_slice().iter().zip(&floats(&c["knots"])) {
-                assert!((a - b).abs() < 1e-14, "ds{k} p{p} {method}: knot {a} vs {b}");
+                assert!(
+                    (a - b).abs() < 1e-14,
+                    "ds{k} p{p} {method}: knot {a} vs {b}"
+                );
             }
         }
         // the same verdict on strict monotonicity
         let increasing = u.windows(2).all(|w| w[1] > w[0]);
-        assert_eq!(increasing, c["strictly_increasing"].as_bool().unwrap(), "ds{k} p{p} {method}");
+        assert_eq!(
+            increasing,
+            c["strictly_increasing"].as_bool().unwrap(),
+            "ds{k} p{p} {method}"
+        );
     }
 }

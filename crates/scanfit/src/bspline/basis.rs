@@ -130,7 +130,11 @@ impl BasisWorkspace {
                     d = a[s2 * q] * ndu[rk * q + pk];
                 }
                 let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
-                let j2 = if (r as isize - 1) <= pk as isize { k - 1 } else { p - r };
+                let j2 = if (r as isize - 1) <= pk as isize {
+                    k - 1
+                } else {
+                    p - r
+                };
                 for j in j1..=j2 {
                     let idx = (rk + j as isize) as usize;
                     a[s2 * q + j] = (a[s1 * q + j] - a[s1 * q + j - 1]) / ndu[(pk + 1) * q + idx];
@@ -176,7 +180,11 @@ pub fn single_basis_ders(
     let j = i + p - span;
     let q = p + 1;
     let d = ws.ders(knots, span, u, order);
-    for (k, o) in out.iter_mut().enumerate().take(order.min(d.len() / q - 1) + 1) {
+    for (k, o) in out
+        .iter_mut()
+        .enumerate()
+        .take(order.min(d.len() / q - 1) + 1)
+    {
         *o = d[k * q + j];
     }
 }

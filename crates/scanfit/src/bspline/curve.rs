@@ -391,9 +391,7 @@ pub(crate) fn insert_homogeneous(
     uq.extend_from_slice(&t[k + 1..=mp]);
     let mut qw = vec![[0.0; 4]; np + 1 + r];
     qw[..=(k - p)].copy_from_slice(&pw[..=(k - p)]);
-    for i in (k - s)..=np {
-        qw[i + r] = pw[i];
-    }
+    qw[(k - s + r)..=(np + r)].copy_from_slice(&pw[(k - s)..=np]);
     let mut rw: Vec<[f64; 4]> = pw[(k - p)..=(k - s)].to_vec();
     let mut l = 0;
     for j in 1..=r {
@@ -407,8 +405,8 @@ pub(crate) fn insert_homogeneous(
         qw[l] = rw[0];
         qw[k + r - j - s] = rw[p - j - s];
     }
-    for i in (l + 1)..(k - s) {
-        qw[i] = rw[i - l];
+    if l + 1 < k - s {
+        qw[(l + 1)..(k - s)].copy_from_slice(&rw[1..(k - s - l)]);
     }
     (uq, qw)
 }
@@ -481,9 +479,14 @@ mod tests {
             c.derivatives_into(u, &mut ws, &mut d);
             assert!((Point3::from(d[0]) - c.point(u)).norm() < 1e-14);
             let fd = (c.point(u + h) - c.point(u - h)) / (2.0 * h);
-            assert!((d[1] - fd).norm() < 1e-7 * (1.0 + fd.norm()), "{} vs {}", d[1], fd);
-            let fd2 = (c.point(u + h).coords - 2.0 * c.point(u).coords + c.point(u - h).coords)
-                / (h * h);
+            assert!(
+                (d[1] - fd).norm() < 1e-7 * (1.0 + fd.norm()),
+                "{} vs {}",
+                d[1],
+                fd
+            );
+            let fd2 =
+                (c.point(u + h).coords - 2.0 * c.point(u).coords + c.point(u - h).coords) / (h * h);
             assert!((d[2] - fd2).norm() < 1e-3 * (1.0 + fd2.norm()));
         }
     }
@@ -502,8 +505,8 @@ mod tests {
             assert!((Point3::from(d[0]) - r.point(u)).norm() < 1e-13);
             let fd = (r.point(u + h) - r.point(u - h)) / (2.0 * h);
             assert!((d[1] - fd).norm() < 1e-6 * (1.0 + fd.norm()));
-            let fd2 = (r.point(u + h).coords - 2.0 * r.point(u).coords + r.point(u - h).coords)
-                / (h * h);
+            let fd2 =
+                (r.point(u + h).coords - 2.0 * r.point(u).coords + r.point(u - h).coords) / (h * h);
             assert!((d[2] - fd2).norm() < 1e-3 * (1.0 + fd2.norm()));
         }
     }

@@ -245,7 +245,15 @@ mod tests {
     fn span_search_matches_linear_scan() {
         let kv = KnotVector::new(vec![0., 0., 0., 1., 2., 2., 3., 4., 4., 4.], 2).unwrap();
         assert_eq!(kv.basis_count(), 7);
-        for (u, s) in [(0.0, 2), (0.5, 2), (1.0, 3), (1.9, 3), (2.0, 5), (3.5, 6), (4.0, 6)] {
+        for (u, s) in [
+            (0.0, 2),
+            (0.5, 2),
+            (1.0, 3),
+            (1.9, 3),
+            (2.0, 5),
+            (3.5, 6),
+            (4.0, 6),
+        ] {
             assert_eq!(kv.find_span(u), s, "u = {u}");
         }
         assert_eq!(kv.find_span(-1.0), 2);
@@ -257,7 +265,10 @@ mod tests {
     #[test]
     fn uniform_constructors() {
         let kv = KnotVector::uniform_clamped(3, 7).unwrap();
-        assert_eq!(kv.as_slice(), &[0., 0., 0., 0., 0.25, 0.5, 0.75, 1., 1., 1., 1.]);
+        assert_eq!(
+            kv.as_slice(),
+            &[0., 0., 0., 0., 0.25, 0.5, 0.75, 1., 1., 1., 1.]
+        );
         let kp = KnotVector::uniform_periodic(3, 5).unwrap();
         assert_eq!(kp.basis_count(), 8);
         assert_eq!(kp.domain(), (0.0, 1.0));

@@ -265,7 +265,13 @@ impl Surface {
     }
 
     /// Unit normal `S_u x S_v / |S_u x S_v|` at `(u, v)` (zero where degenerate).
-    pub fn normal(&self, u: f64, v: f64, wu: &mut BasisWorkspace, wv: &mut BasisWorkspace) -> Vector3 {
+    pub fn normal(
+        &self,
+        u: f64,
+        v: f64,
+        wu: &mut BasisWorkspace,
+        wv: &mut BasisWorkspace,
+    ) -> Vector3 {
         let mut d = [Vector3::zeros(); 4];
         self.derivatives_into(u, v, wu, wv, 1, &mut d);
         let n = d[2].cross(&d[1]);
@@ -336,7 +342,10 @@ impl Surface {
             .iter()
             .map(|h| Point3::new(h[0] / h[3], h[1] / h[3], h[2] / h[3]))
             .collect();
-        let weights = self.weights.as_ref().map(|_| out.iter().map(|h| h[3]).collect());
+        let weights = self
+            .weights
+            .as_ref()
+            .map(|_| out.iter().map(|h| h[3]).collect());
         let new_kv = KnotVector::new(new_knots, p)?;
         let (ku, kvv) = match dir {
             Direction::U => (new_kv, self.knots_v.clone()),
@@ -392,8 +401,14 @@ mod tests {
                 assert!((Point3::from(d[0]) - s.point(u, v)).norm() < 1e-13);
                 let fu = (s.point(u + h, v) - s.point(u - h, v)) / (2.0 * h);
                 let fv = (s.point(u, v + h) - s.point(u, v - h)) / (2.0 * h);
-                assert!((d[3] - fu).norm() < 1e-6 * (1.0 + fu.norm()), "rational={rational}");
-                assert!((d[1] - fv).norm() < 1e-6 * (1.0 + fv.norm()), "rational={rational}");
+                assert!(
+                    (d[3] - fu).norm() < 1e-6 * (1.0 + fu.norm()),
+                    "rational={rational}"
+                );
+                assert!(
+                    (d[1] - fv).norm() < 1e-6 * (1.0 + fv.norm()),
+                    "rational={rational}"
+                );
                 let fuv = (s.point(u + h, v + h).coords
                     - s.point(u + h, v - h).coords
                     - s.point(u - h, v + h).coords

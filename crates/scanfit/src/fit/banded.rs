@@ -37,7 +37,10 @@ impl BandMatrix {
 
     #[inline]
     fn idx(&self, i: usize, j: usize) -> usize {
-        debug_assert!(j + self.kl >= i && j <= i + self.ku, "({i},{j}) outside band");
+        debug_assert!(
+            j + self.kl >= i && j <= i + self.ku,
+            "({i},{j}) outside band"
+        );
         i * (self.kl + self.ku + 1) + j + self.kl - i
     }
 
@@ -94,7 +97,8 @@ impl BandMatrix {
         let tiny = f64::EPSILON * norm.max(f64::MIN_POSITIVE) * 16.0;
         for k in 0..n {
             let pivot = self.data[self.idx(k, k)];
-            if !(pivot.abs() > tiny) {
+            // written so that a NaN pivot also fails
+            if pivot.abs().partial_cmp(&tiny) != Some(std::cmp::Ordering::Greater) {
                 return Err(Error::Singular {
                     what: what.to_string(),
                     condition: f64::INFINITY,
@@ -149,7 +153,8 @@ impl BandLu {
 
     /// Errors when the condition estimate exceeds `limit`.
     pub fn check_condition(&self, what: &str, limit: f64, hint: &str) -> Result<()> {
-        if !(self.condition <= limit) {
+        // a NaN condition also fails
+        if self.condition.is_nan() || self.condition > limit {
             return Err(Error::Singular {
                 what: what.to_string(),
                 condition: self.condition,
@@ -221,12 +226,18 @@ impl BandLu {
             let mut y = x.clone();
             self.solve_in_place(&mut y, 1);
             est = y.iter().map(|v| v.abs()).sum::<f64>();
-            let mut z: Vec<f64> = y.iter().map(|&v| if v >= 0.0 { 1.0 } else { -1.0 }).collect();
-            self.solve_transposed(&mut z);
-            let (jmax, zmax) = z
+            let mut z: Vec<f64> = y
                 .iter()
-                .enumerate()
-                .fold((0, 0.0f64), |(bj, bv), (j, &v)| if v.abs() > bv { (j, v.abs()) } else { (bj, bv) });
+                .map(|&v| if v >= 0.0 { 1.0 } else { -1.0 })
+                .collect();
+            self.solve_transposed(&mut z);
+            let (jmax, zmax) = z.iter().enumerate().fold((0, 0.0f64), |(bj, bv), (j, &v)| {
+                if v.abs() > bv {
+                    (j, v.abs())
+                } else {
+                    (bj, bv)
+                }
+            });
             let ztx: f64 = z.iter().zip(&x).map(|(a, b)| a * b).sum();
             if zmax <= ztx {
                 break;
@@ -244,7 +255,10 @@ impl BandLu {
 /// Solves a small dense system `A x = b` (row-major `n x n`, `nrhs` columns) by
 /// LU with partial pivoting. Returns `None` when a pivot vanishes.
 pub(crate) fn dense_solve(a: &mut [f64], n: usize, b: &mut [f64], nrhs: usize) -> Option<()> {
-    let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(f64::MIN_POSITIVE);
+    let scale = a
+        .iter()
+        .fold(0.0f64, |m, v| m.max(v.abs()))
+        .max(f64::MIN_POSITIVE);
     for k in 0..n {
         let (piv, pmax) = (k..n).fold((k, 0.0f64), |(bi, bv), i| {
             let v = a[i * n + k].abs();
@@ -312,13 +326,23 @@ mod tests {
             assert!((u - v).abs() < 1e-14);
         }
         // exact cond_1 of this matrix is below 3 (diagonally dominant: ||A||=6, ||A^-1|| <= 1/2)
-        assert!(lu.condition() > 1.0 && lu.condition() <= 3.0, "{}", lu.condition());
+        assert!(
+            lu.condition() > 1.0 && lu.condition() <= 3.0,
+            "{}",
+            lu.condition()
+        );
     }
 
     #[test]
     fn singular_matrix_is_an_error() {
         let mut a = BandMatrix::zeros(3, 1, 1);
-        for (i, j, v) in [(0, 0, 1.0), (0, 1, 1.0), (1, 0, 1.0), (1, 1, 1.0), (2, 2, 1.0)] {
+        for (i, j, v) in [
+            (0, 0, 1.0),
+            (0, 1, 1.0),
+            (1, 0, 1.0),
+            (1, 1, 1.0),
+            (2, 2, 1.0),
+        ] {
             a.set(i, j, v);
         }
         let e = a.factor("demo").unwrap_err();

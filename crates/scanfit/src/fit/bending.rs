@@ -84,7 +84,11 @@ mod tests {
             let (x, w) = gauss_legendre(k);
             for deg in 0..2 * k {
                 let approx: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(deg as i32)).sum();
-                let exact = if deg % 2 == 1 { 0.0 } else { 2.0 / (deg as f64 + 1.0) };
+                let exact = if deg % 2 == 1 {
+                    0.0
+                } else {
+                    2.0 / (deg as f64 + 1.0)
+                };
                 assert!((approx - exact).abs() < 1e-14, "k={k} deg={deg}");
             }
         }

@@ -78,7 +78,8 @@ impl CyclicBandMatrix {
                     a[i * n + j] = self.get(i, j);
                 }
             }
-            dense_solve(&mut a, n, f, nrhs).ok_or_else(|| singular(f64::INFINITY, "a pivot vanishes"))?;
+            dense_solve(&mut a, n, f, nrhs)
+                .ok_or_else(|| singular(f64::INFINITY, "a pivot vanishes"))?;
             return Ok(f64::NAN);
         }
         let m = n - w;

@@ -146,14 +146,19 @@ pub fn interpolate_with(
         }
         rhs[i * 3..i * 3 + 3].copy_from_slice(r.as_slice());
     }
-    let lu = a.factor("curve interpolation").map_err(|e| with_hint(e, params))?;
+    let lu = a
+        .factor("curve interpolation")
+        .map_err(|e| with_hint(e, params))?;
     lu.check_condition(
         "curve interpolation",
         CONDITION_LIMIT,
         "the parameters crowd together; try centripetal or the proposed method",
     )?;
     lu.solve_in_place(&mut rhs, 3);
-    let ctrl = rhs.chunks(3).map(|c| Point3::new(c[0], c[1], c[2])).collect();
+    let ctrl = rhs
+        .chunks(3)
+        .map(|c| Point3::new(c[0], c[1], c[2]))
+        .collect();
     Ok((Curve::new(kv, ctrl)?, lu.condition()))
 }
 
@@ -161,7 +166,11 @@ pub fn interpolate_with(
 /// parameters in `[0, 1)` on a periodic knot vector (see
 /// [`param::knots::periodic`]). The result is a periodic curve with
 /// `points.len()` distinct control points.
-pub fn interpolate_closed_with(points: &[Point3], params: &[f64], kv: KnotVector) -> Result<(Curve, f64)> {
+pub fn interpolate_closed_with(
+    points: &[Point3],
+    params: &[f64],
+    kv: KnotVector,
+) -> Result<(Curve, f64)> {
     let n = points.len();
     let p = kv.degree();
     if kv.basis_count() != n + p || params.len() != n {
@@ -199,7 +208,10 @@ pub fn interpolate_closed_with(points: &[Point3], params: &[f64], kv: KnotVector
             hint: "the parameters crowd together; try centripetal".into(),
         });
     }
-    let mut ctrl: Vec<Point3> = rhs.chunks(3).map(|c| Point3::new(c[0], c[1], c[2])).collect();
+    let mut ctrl: Vec<Point3> = rhs
+        .chunks(3)
+        .map(|c| Point3::new(c[0], c[1], c[2]))
+        .collect();
     for j in 0..p {
         ctrl.push(ctrl[j]);
     }
@@ -210,7 +222,11 @@ pub fn interpolate_closed_with(points: &[Point3], params: &[f64], kv: KnotVector
 /// coincident parameters are its usual cause.
 fn with_hint(e: Error, params: &[f64]) -> Error {
     match e {
-        Error::Singular { what, condition, hint } => {
+        Error::Singular {
+            what,
+            condition,
+            hint,
+        } => {
             let closest = params
                 .windows(2)
                 .enumerate()

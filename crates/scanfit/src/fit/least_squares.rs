@@ -214,7 +214,12 @@ pub fn least_squares_with(
         (ctrl, cond)
     } else {
         let cond = solve_normal(m, &mut rhs, &kv, params)?;
-        (rhs.chunks(3).map(|c| Point3::new(c[0], c[1], c[2])).collect(), cond)
+        (
+            rhs.chunks(3)
+                .map(|c| Point3::new(c[0], c[1], c[2]))
+                .collect(),
+            cond,
+        )
     };
     Ok((Curve::new(kv, ctrl)?, cond))
 }
@@ -250,11 +255,13 @@ pub fn least_squares_closed_with(
         }
     }
     if opts.smoothing > 0.0 {
-        bending::for_each_entry(&kv, |i, j, g| m.add(i % count, j % count, opts.smoothing * g));
+        bending::for_each_entry(&kv, |i, j, g| {
+            m.add(i % count, j % count, opts.smoothing * g)
+        });
     }
-    let cond = m.solve(&mut rhs, 3, "closed least-squares curve").map_err(|e| {
-        empty_span_hint(e, &kv, params)
-    })?;
+    let cond = m
+        .solve(&mut rhs, 3, "closed least-squares curve")
+        .map_err(|e| empty_span_hint(e, &kv, params))?;
     if cond > CONDITION_LIMIT {
         return Err(empty_span_hint(
             Error::Singular {
@@ -266,7 +273,10 @@ pub fn least_squares_closed_with(
             params,
         ));
     }
-    let mut ctrl: Vec<Point3> = rhs.chunks(3).map(|c| Point3::new(c[0], c[1], c[2])).collect();
+    let mut ctrl: Vec<Point3> = rhs
+        .chunks(3)
+        .map(|c| Point3::new(c[0], c[1], c[2]))
+        .collect();
     for j in 0..p {
         ctrl.push(ctrl[j]);
     }
@@ -295,7 +305,10 @@ fn solve_normal(m: BandMatrix, rhs: &mut [f64], kv: &KnotVector, params: &[f64])
 /// Names the first knot span without data (the usual cause of a singular
 /// normal matrix) and what to change.
 fn empty_span_hint(e: Error, kv: &KnotVector, params: &[f64]) -> Error {
-    let Error::Singular { what, condition, .. } = e else {
+    let Error::Singular {
+        what, condition, ..
+    } = e
+    else {
         return e;
     };
     let bps = kv.breakpoints();

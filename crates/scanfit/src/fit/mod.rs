@@ -13,9 +13,12 @@ pub mod cyclic;
 mod interpolate;
 mod least_squares;
 
-pub use interpolate::{interpolate, interpolate_closed_with, interpolate_with, InterpolationConfig};
+pub use interpolate::{
+    interpolate, interpolate_closed_with, interpolate_with, InterpolationConfig,
+};
 pub use least_squares::{
-    approximate, least_squares_closed_with, least_squares_with, ApproximationConfig, LeastSquaresOptions,
+    approximate, least_squares_closed_with, least_squares_with, ApproximationConfig,
+    LeastSquaresOptions,
 };
 
 use crate::bspline::Curve;

@@ -27,7 +27,11 @@ pub fn basis_maximum(kv: &KnotVector, i: usize, ws: &mut BasisWorkspace) -> (f64
         }
         let d = ws.ders(t, s, u, order);
         let q = p + 1;
-        for (k, o) in out.iter_mut().enumerate().take(order.min(d.len() / q - 1) + 1) {
+        for (k, o) in out
+            .iter_mut()
+            .enumerate()
+            .take(order.min(d.len() / q - 1) + 1)
+        {
             *o = d[k * q + i + p - s];
         }
         out
@@ -67,7 +71,9 @@ pub fn basis_maximum(kv: &KnotVector, i: usize, ws: &mut BasisWorkspace) -> (f64
                 };
                 let step = (next - x).abs();
                 x = next;
-                if step <= 4.0 * f64::EPSILON * (b - a).max(x.abs()) || r - l <= f64::EPSILON * x.abs() {
+                if step <= 4.0 * f64::EPSILON * (b - a).max(x.abs())
+                    || r - l <= f64::EPSILON * x.abs()
+                {
                     break;
                 }
             }
@@ -99,8 +105,8 @@ mod tests {
 
     #[test]
     fn maximum_is_a_true_maximum() {
-        let kv = KnotVector::new(vec![0., 0., 0., 0., 0.1, 0.15, 0.6, 0.9, 1., 1., 1., 1.], 3)
-            .unwrap();
+        let kv =
+            KnotVector::new(vec![0., 0., 0., 0., 0.1, 0.15, 0.6, 0.9, 1., 1., 1., 1.], 3).unwrap();
         let mut ws = BasisWorkspace::new(3, 2);
         let mut ws2 = BasisWorkspace::new(3, 0);
         for i in 0..kv.basis_count() {
@@ -121,7 +127,9 @@ mod tests {
     fn support_ending_at_clamped_end() {
         // N_7 of a clamped cubic with 10 functions: N'(1) = 0 and N(1) = 0, the
         // maximum is inside the last span (regression: was reported at u = 1)
-        let t = vec![0., 0., 0., 0., 0.24, 0.356, 0.468, 0.5675, 0.6688, 0.7804, 1., 1., 1., 1.];
+        let t = vec![
+            0., 0., 0., 0., 0.24, 0.356, 0.468, 0.5675, 0.6688, 0.7804, 1., 1., 1., 1.,
+        ];
         let kv = KnotVector::new(t, 3).unwrap();
         let mut ws = BasisWorkspace::new(3, 2);
         let (theta, b) = basis_maximum(&kv, 7, &mut ws);

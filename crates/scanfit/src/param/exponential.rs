@@ -62,7 +62,10 @@ mod tests {
     #[test]
     fn known_values() {
         let p = pts();
-        assert_eq!(params(&p, 0.0, false).unwrap(), vec![0., 1. / 3., 2. / 3., 1.]);
+        assert_eq!(
+            params(&p, 0.0, false).unwrap(),
+            vec![0., 1. / 3., 2. / 3., 1.]
+        );
         let c = params(&p, 1.0, false).unwrap();
         assert!((c[1] - 0.125).abs() < 1e-15 && (c[2] - 0.375).abs() < 1e-15);
         let s = params(&p, 0.5, false).unwrap();

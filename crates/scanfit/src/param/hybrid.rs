@@ -30,7 +30,9 @@ pub fn params(points: &[Point3], p: usize) -> Result<(Vec<f64>, KnotVector)> {
     super::check_increasing(&chord, "chord-length (hybrid's first step)")?;
     let kv = averaging(&chord, p)?;
     let mut ws = BasisWorkspace::new(p, 2);
-    let b: Vec<f64> = (0..points.len()).map(|i| basis_maximum(&kv, i, &mut ws).1).collect();
+    let b: Vec<f64> = (0..points.len())
+        .map(|i| basis_maximum(&kv, i, &mut ws).1)
+        .collect();
     let bmax = b.iter().cloned().fold(0.0f64, f64::max);
     let inc: Vec<f64> = b
         .windows(2)

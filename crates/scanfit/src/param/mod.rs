@@ -190,7 +190,10 @@ pub fn parameterize(
 
 /// Errors unless `params` is strictly increasing, finite and in `[0, 1]`.
 pub fn check_increasing(params: &[f64], method: &str) -> Result<()> {
-    if let Some(i) = params.iter().position(|u| !u.is_finite() || !(0.0..=1.0).contains(u)) {
+    if let Some(i) = params
+        .iter()
+        .position(|u| !u.is_finite() || !(0.0..=1.0).contains(u))
+    {
         return Err(Error::InvalidInput(format!(
             "{method} parameterization gives parameter {} for point {i}, outside [0, 1]",
             params[i]

@@ -25,7 +25,9 @@ pub fn params(points: &[Point3], p: usize, a: f64) -> Result<(Vec<f64>, KnotVect
     super::check_increasing(&u, "exponential (the new method's first step)")?;
     let kv = averaging(&u, p)?;
     let mut ws = BasisWorkspace::new(p, 2);
-    let theta: Vec<f64> = (0..points.len()).map(|i| basis_maximum(&kv, i, &mut ws).0).collect();
+    let theta: Vec<f64> = (0..points.len())
+        .map(|i| basis_maximum(&kv, i, &mut ws).0)
+        .collect();
     let n = points.len() - 1;
     let pairs = if n % 2 == 0 { n / 2 } else { (n - 1) / 2 };
     for i in 1..=pairs {

@@ -12,7 +12,9 @@ use crate::Result;
 pub fn params(count: usize, p: usize) -> Result<(Vec<f64>, KnotVector)> {
     let kv = KnotVector::uniform_clamped(p, count)?;
     let mut ws = BasisWorkspace::new(p, 2);
-    let mut u: Vec<f64> = (0..count).map(|i| basis_maximum(&kv, i, &mut ws).0).collect();
+    let mut u: Vec<f64> = (0..count)
+        .map(|i| basis_maximum(&kv, i, &mut ws).0)
+        .collect();
     u[0] = 0.0;
     u[count - 1] = 1.0;
     Ok((u, kv))
