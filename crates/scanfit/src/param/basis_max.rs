@@ -37,7 +37,8 @@ pub fn basis_maximum(kv: &KnotVector, i: usize, ws: &mut BasisWorkspace) -> (f64
         out
     };
     let mut last = (lo, 0.0);
-    for s in p..=n {
+    // only the p + 1 spans of the support [t_i, t_{i+p+1}) (O(p) per function)
+    for s in i.max(p)..=(i + p).min(n) {
         let (a, b) = (t[s], t[s + 1]);
         if b <= a || a < lo || b > hi {
             continue;
