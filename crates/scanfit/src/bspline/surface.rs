@@ -221,8 +221,14 @@ impl Surface {
         let (ku, kv) = (du.len() / (p + 1) - 1, dv.len() / (q + 1) - 1);
         let cv = self.knots_v.basis_count();
         out.iter_mut().for_each(|o| *o = Vector3::zeros());
-        // homogeneous derivatives A^(k,l) and w^(k,l) (w = 1 when non-rational)
-        let mut wd = vec![0.0; d1 * d1];
+        // homogeneous derivatives A^(k,l) and w^(k,l) (w = 1 when non-rational);
+        // orders above 7 are not supported for rational surfaces (stack buffer)
+        let mut wd = [0.0f64; 64];
+        let order = if self.weights.is_some() {
+            order.min(7)
+        } else {
+            order
+        };
         for k in 0..=order.min(ku) {
             for l in 0..=(order - k).min(kv) {
                 let mut acc = Vector3::zeros();
@@ -238,7 +244,9 @@ impl Surface {
                     }
                 }
                 out[k * d1 + l] = acc;
-                wd[k * d1 + l] = wacc;
+                if k * d1 + l < wd.len() {
+                    wd[k * d1 + l] = wacc;
+                }
             }
         }
         if self.weights.is_none() {

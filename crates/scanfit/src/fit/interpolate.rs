@@ -181,6 +181,11 @@ pub fn interpolate_closed_with(
             params.len()
         )));
     }
+    if p > 31 {
+        return Err(Error::InvalidInput(format!(
+            "closed interpolation supports degrees up to 31, got {p}"
+        )));
+    }
     if n < 2 * p + 1 {
         return Err(Error::TooFewPoints {
             got: n,
@@ -190,17 +195,39 @@ pub fn interpolate_closed_with(
     }
     let t = kv.as_slice();
     let mut ws = BasisWorkspace::new(p, 0);
+    // Row k's largest entry belongs to control point k + shift (shift = p/2
+    // rounded down for the standard knots). Unknowns are rotated by `shift` so
+    // that it sits on the diagonal: otherwise the band block of the cyclic
+    // solver is nearly triangular with small pivots and grows exponentially
+    // ill-conditioned with n.
+    let rows: Vec<(usize, [f64; 32])> = params
+        .iter()
+        .map(|&u| {
+            let s = kv.find_span(u);
+            let mut vals = [0.0; 32];
+            vals[..=p].copy_from_slice(&ws.values(t, s, u)[..=p]);
+            (s, vals)
+        })
+        .collect();
+    let mut votes = vec![0usize; n];
+    for (k, (s, vals)) in rows.iter().enumerate() {
+        let jmax = (0..=p)
+            .max_by(|&a, &b| vals[a].total_cmp(&vals[b]))
+            .unwrap_or(0);
+        votes[(s - p + jmax + n - k) % n] += 1;
+    }
+    let shift = (0..n).max_by_key(|&d| votes[d]).unwrap_or(0);
     let mut a = CyclicBandMatrix::zeros(n, p)?;
     let mut rhs = vec![0.0; n * 3];
-    for (k, (&u, q)) in params.iter().zip(points).enumerate() {
-        let s = kv.find_span(u);
-        let vals = ws.values(t, s, u);
-        for (j, &v) in vals.iter().enumerate() {
-            a.add(k, (s - p + j) % n, v);
+    for (k, ((s, vals), q)) in rows.iter().zip(points).enumerate() {
+        for (j, &v) in vals[..=p].iter().enumerate() {
+            a.add(k, (s - p + j + n - shift) % n, v);
         }
         rhs[k * 3..k * 3 + 3].copy_from_slice(q.coords.as_slice());
     }
     let cond = a.solve(&mut rhs, 3, "closed curve interpolation")?;
+    // undo the rotation: unknown c is control point (c + shift) mod n
+    rhs.rotate_right(3 * shift);
     if cond > CONDITION_LIMIT {
         return Err(Error::Singular {
             what: "closed curve interpolation".into(),

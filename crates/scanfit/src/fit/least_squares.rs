@@ -93,6 +93,13 @@ pub fn approximate(points: &[Point3], cfg: &ApproximationConfig) -> Result<Curve
             pts.len()
         )));
     }
+    if cfg.closed && cfg.ctrl_count < 2 * p + 1 {
+        return Err(Error::InvalidInput(format!(
+            "a closed curve of degree {p} needs at least {} control points, {} requested",
+            2 * p + 1,
+            cfg.ctrl_count
+        )));
+    }
     validate_distinct_consecutive(pts, cfg.closed)?;
     let par = param::parameterize(pts, cfg.method, p, cfg.closed)?;
     let opts = LeastSquaresOptions {
