@@ -64,18 +64,7 @@ impl Curve {
         }
         crate::validate_points(&ctrl)?;
         if let Some(w) = &weights {
-            if w.len() != n {
-                return Err(Error::InvalidInput(format!(
-                    "{} weights given for {n} control points",
-                    w.len()
-                )));
-            }
-            if let Some(i) = w.iter().position(|&w| !(w.is_finite() && w > 0.0)) {
-                return Err(Error::InvalidInput(format!(
-                    "weight {i} is {} but weights must be positive and finite",
-                    w[i]
-                )));
-            }
+            validate_weights(w, n)?;
         }
         if periodic {
             check_periodic(&knots, &ctrl, weights.as_deref())?;
@@ -137,19 +126,7 @@ impl Curve {
     /// Maps `u` into the domain: wrapped for periodic curves, clamped otherwise.
     #[inline]
     pub fn wrap(&self, u: f64) -> f64 {
-        let (a, b) = self.domain();
-        if self.periodic && (u < a || u > b) {
-            let w = b - a;
-            let r = a + (u - a).rem_euclid(w);
-            // rem_euclid may round up to exactly w
-            if r >= b {
-                a
-            } else {
-                r
-            }
-        } else {
-            u.clamp(a, b)
-        }
+        self.knots.wrap(u, self.periodic)
     }
 
     /// Point at `u` (A3.1; rational by homogeneous coordinates). Allocation-free
@@ -366,6 +343,23 @@ impl Curve {
         }
         len
     }
+}
+
+/// Checks one positive finite weight per control point.
+pub(crate) fn validate_weights(w: &[f64], count: usize) -> Result<()> {
+    if w.len() != count {
+        return Err(Error::InvalidInput(format!(
+            "{} weights given for {count} control points",
+            w.len()
+        )));
+    }
+    if let Some(i) = w.iter().position(|&w| !(w.is_finite() && w > 0.0)) {
+        return Err(Error::InvalidInput(format!(
+            "weight {i} is {} but weights must be positive and finite",
+            w[i]
+        )));
+    }
+    Ok(())
 }
 
 /// Binomial coefficient as f64 (small arguments).

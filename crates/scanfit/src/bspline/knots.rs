@@ -186,6 +186,24 @@ impl KnotVector {
         out
     }
 
+    /// Maps `u` into the domain: wrapped by the period when `periodic`, clamped
+    /// otherwise (used by curve and surface evaluation alike).
+    #[inline]
+    pub fn wrap(&self, u: f64, periodic: bool) -> f64 {
+        let (a, b) = self.domain();
+        if periodic && (u < a || u > b) {
+            let r = a + (u - a).rem_euclid(b - a);
+            // rem_euclid may round up to exactly the period
+            if r >= b {
+                a
+            } else {
+                r
+            }
+        } else {
+            u.clamp(a, b)
+        }
+    }
+
     /// Consumes the vector, returning the knots.
     pub fn into_vec(self) -> Vec<f64> {
         self.knots

@@ -6,7 +6,7 @@
 //! every row or column of the control net).
 
 use super::basis::{basis_funs, BasisWorkspace};
-use super::curve::{binomial, insert_homogeneous, STACK_DEGREE};
+use super::curve::{binomial, insert_homogeneous, validate_weights, STACK_DEGREE};
 use super::knots::{find_span, KnotVector};
 use crate::{Error, Point3, Result, Vector3};
 
@@ -59,19 +59,7 @@ impl Surface {
         }
         crate::validate_points(&ctrl)?;
         if let Some(w) = &weights {
-            if w.len() != ctrl.len() {
-                return Err(Error::InvalidInput(format!(
-                    "{} weights given for {} control points",
-                    w.len(),
-                    ctrl.len()
-                )));
-            }
-            if let Some(i) = w.iter().position(|&w| !(w.is_finite() && w > 0.0)) {
-                return Err(Error::InvalidInput(format!(
-                    "weight {i} is {} but weights must be positive and finite",
-                    w[i]
-                )));
-            }
+            validate_weights(w, ctrl.len())?;
         }
         let s = Self {
             knots_u,
@@ -147,20 +135,6 @@ impl Surface {
         (self.knots_u.domain(), self.knots_v.domain())
     }
 
-    fn wrap(kv: &KnotVector, periodic: bool, u: f64) -> f64 {
-        let (a, b) = kv.domain();
-        if periodic && (u < a || u > b) {
-            let r = a + (u - a).rem_euclid(b - a);
-            if r >= b {
-                a
-            } else {
-                r
-            }
-        } else {
-            u.clamp(a, b)
-        }
-    }
-
     /// Point at `(u, v)` (A3.5, homogeneous for rational surfaces). Allocation-free
     /// for degrees <= 15.
     pub fn point(&self, u: f64, v: f64) -> Point3 {
@@ -172,8 +146,8 @@ impl Surface {
             self.derivatives_into(u, v, &mut wu, &mut wv, 0, &mut out);
             return Point3::from(out[0]);
         }
-        let u = Self::wrap(&self.knots_u, self.periodic_u, u);
-        let v = Self::wrap(&self.knots_v, self.periodic_v, v);
+        let u = self.knots_u.wrap(u, self.periodic_u);
+        let v = self.knots_v.wrap(v, self.periodic_v);
         let (tu, tv) = (self.knots_u.as_slice(), self.knots_v.as_slice());
         let (su, sv) = (find_span(tu, p, u), find_span(tv, q, v));
         let mut nu = [0.0; STACK_DEGREE + 1];
@@ -212,8 +186,8 @@ impl Surface {
     ) {
         let (p, q) = self.degrees();
         let d1 = order + 1;
-        let u = Self::wrap(&self.knots_u, self.periodic_u, u);
-        let v = Self::wrap(&self.knots_v, self.periodic_v, v);
+        let u = self.knots_u.wrap(u, self.periodic_u);
+        let v = self.knots_v.wrap(v, self.periodic_v);
         let (tu, tv) = (self.knots_u.as_slice(), self.knots_v.as_slice());
         let (su, sv) = (find_span(tu, p, u), find_span(tv, q, v));
         let du = wu.ders(tu, su, u, order);

@@ -5,6 +5,17 @@
 
 use crate::bspline::{BasisWorkspace, KnotVector};
 
+/// `(P_k(z), P_k'(z))` by the three-term recurrence (k >= 1, |z| < 1).
+fn legendre(k: usize, z: f64) -> (f64, f64) {
+    let (mut p0, mut p1) = (1.0, z);
+    for j in 2..=k {
+        let p2 = ((2 * j - 1) as f64 * z * p1 - (j - 1) as f64 * p0) / j as f64;
+        p0 = p1;
+        p1 = p2;
+    }
+    (p1, k as f64 * (z * p1 - p0) / (z * z - 1.0))
+}
+
 /// Gauss-Legendre nodes and weights on `[-1, 1]` (Newton on the Legendre
 /// polynomial from the Chebyshev-like initial guess; accurate to rounding).
 pub fn gauss_legendre(k: usize) -> (Vec<f64>, Vec<f64>) {
@@ -13,31 +24,16 @@ pub fn gauss_legendre(k: usize) -> (Vec<f64>, Vec<f64>) {
     for i in 0..k {
         let mut z = (std::f64::consts::PI * (i as f64 + 0.75) / (k as f64 + 0.5)).cos();
         for _ in 0..100 {
-            // P_k(z) and P_k'(z) by the three-term recurrence
-            let (mut p0, mut p1) = (1.0, z);
-            for j in 2..=k {
-                let p2 = ((2 * j - 1) as f64 * z * p1 - (j - 1) as f64 * p0) / j as f64;
-                p0 = p1;
-                p1 = p2;
-            }
-            let (pk, pkm1) = if k == 1 { (z, 1.0) } else { (p1, p0) };
-            let dp = k as f64 * (z * pk - pkm1) / (z * z - 1.0);
+            let (pk, dp) = legendre(k, z);
             let dz = pk / dp;
             z -= dz;
             if dz.abs() < 1e-16 {
-                let (mut q0, mut q1) = (1.0, z);
-                for j in 2..=k {
-                    let q2 = ((2 * j - 1) as f64 * z * q1 - (j - 1) as f64 * q0) / j as f64;
-                    q0 = q1;
-                    q1 = q2;
-                }
-                let (qk, qkm1) = if k == 1 { (z, 1.0) } else { (q1, q0) };
-                let dq = k as f64 * (z * qk - qkm1) / (z * z - 1.0);
-                x[i] = z;
-                w[i] = 2.0 / ((1.0 - z * z) * dq * dq);
                 break;
             }
         }
+        let (_, dp) = legendre(k, z);
+        x[i] = z;
+        w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
     }
     (x, w)
 }

@@ -5,7 +5,6 @@ use super::banded::BandMatrix;
 use super::cyclic::CyclicBandMatrix;
 use super::{CurveFit, CONDITION_LIMIT};
 use crate::bspline::{BasisWorkspace, Curve, KnotVector};
-use crate::geom::validate_distinct_consecutive;
 use crate::param::{self, Method};
 use crate::{Error, Point3, Result, Vector3};
 
@@ -36,26 +35,11 @@ impl Default for InterpolationConfig {
 /// Interpolates `points` with the configured degree and parameterization.
 pub fn interpolate(points: &[Point3], cfg: &InterpolationConfig) -> Result<CurveFit> {
     let p = cfg.degree;
-    if p == 0 {
-        return Err(Error::InvalidInput("degree must be at least 1".into()));
-    }
-    crate::validate_points(points)?;
-    let mut pts = points;
-    if cfg.closed && pts.len() > 2 && pts[0] == pts[pts.len() - 1] {
-        pts = &pts[..pts.len() - 1]; // the loop was given closed explicitly
-    }
-    let needed = p + 1;
-    if pts.len() < needed {
-        return Err(Error::TooFewPoints {
-            got: pts.len(),
-            needed,
-            what: format!(
-                "{}interpolation of degree {p}",
-                if cfg.closed { "closed " } else { "" }
-            ),
-        });
-    }
-    validate_distinct_consecutive(pts, cfg.closed)?;
+    let what = format!(
+        "{}interpolation of degree {p}",
+        if cfg.closed { "closed " } else { "" }
+    );
+    let pts = super::prepare_points(points, p, cfg.closed, &what)?;
     let par = param::parameterize(pts, cfg.method, p, cfg.closed)?;
     if cfg.closed {
         if cfg.end_derivatives.is_some() {

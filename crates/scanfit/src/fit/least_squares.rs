@@ -17,7 +17,6 @@ use super::bending;
 use super::cyclic::CyclicBandMatrix;
 use super::{CurveFit, CONDITION_LIMIT};
 use crate::bspline::{BasisWorkspace, Curve, KnotVector};
-use crate::geom::validate_distinct_consecutive;
 use crate::param::{self, Method};
 use crate::{Error, Point3, Result};
 
@@ -70,21 +69,12 @@ pub struct LeastSquaresOptions<'a> {
 /// Approximates `points` by a curve with `cfg.ctrl_count` control points.
 pub fn approximate(points: &[Point3], cfg: &ApproximationConfig) -> Result<CurveFit> {
     let p = cfg.degree;
-    if p == 0 {
-        return Err(Error::InvalidInput("degree must be at least 1".into()));
-    }
-    crate::validate_points(points)?;
-    let mut pts = points;
-    if cfg.closed && pts.len() > 2 && pts[0] == pts[pts.len() - 1] {
-        pts = &pts[..pts.len() - 1];
-    }
-    if pts.len() < p + 1 {
-        return Err(Error::TooFewPoints {
-            got: pts.len(),
-            needed: p + 1,
-            what: format!("least squares of degree {p}"),
-        });
-    }
+    let pts = super::prepare_points(
+        points,
+        p,
+        cfg.closed,
+        &format!("least squares of degree {p}"),
+    )?;
     if cfg.ctrl_count > pts.len() {
         return Err(Error::InvalidInput(format!(
             "{} control points requested but only {} data points; use --ctrl {} or fewer, or --interpolate",
@@ -100,7 +90,6 @@ pub fn approximate(points: &[Point3], cfg: &ApproximationConfig) -> Result<Curve
             cfg.ctrl_count
         )));
     }
-    validate_distinct_consecutive(pts, cfg.closed)?;
     let par = param::parameterize(pts, cfg.method, p, cfg.closed)?;
     let opts = LeastSquaresOptions {
         fix_ends: cfg.fix_ends,

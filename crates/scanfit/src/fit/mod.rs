@@ -22,7 +22,9 @@ pub use least_squares::{
 };
 
 use crate::bspline::Curve;
+use crate::geom::validate_distinct_consecutive;
 use crate::param::Method;
+use crate::{Error, Point3, Result};
 
 /// Condition estimates above this are reported as an error (about 1/(2^12 eps)):
 /// the solution would have fewer than 4 significant digits.
@@ -39,4 +41,33 @@ pub struct CurveFit {
     pub method: Method,
     /// 1-norm condition estimate of the solved system.
     pub condition: f64,
+}
+
+/// Validates fitting input and returns the points to fit: finite coordinates,
+/// degree >= 1, at least `p + 1` points, no two consecutive points equal. For a
+/// closed curve a last point repeating the first (a loop given closed
+/// explicitly) is dropped.
+fn prepare_points<'a>(
+    points: &'a [Point3],
+    p: usize,
+    closed: bool,
+    what: &str,
+) -> Result<&'a [Point3]> {
+    if p == 0 {
+        return Err(Error::InvalidInput("degree must be at least 1".into()));
+    }
+    crate::validate_points(points)?;
+    let mut pts = points;
+    if closed && pts.len() > 2 && pts[0] == pts[pts.len() - 1] {
+        pts = &pts[..pts.len() - 1];
+    }
+    if pts.len() < p + 1 {
+        return Err(Error::TooFewPoints {
+            got: pts.len(),
+            needed: p + 1,
+            what: what.to_string(),
+        });
+    }
+    validate_distinct_consecutive(pts, closed)?;
+    Ok(pts)
 }
