@@ -7,14 +7,14 @@
 //! ```
 //!
 //! The normal equations `(N^T W N + lambda G) P = N^T W Q` are assembled point by
-//! point into a band matrix (half-bandwidth `p`; `G` from [`super::bending`]) and
+//! point into a band matrix (half-bandwidth `p`; `G` from [`super::gram`]) and
 //! solved without pivoting (SPD). With `fix_ends` the first and last control
 //! points are the first and last data points and drop out of the system
 //! (eq. 9.63-9.67). Closed curves use periodic knots and the cyclic solver.
 
 use super::banded::BandMatrix;
-use super::bending;
 use super::cyclic::CyclicBandMatrix;
+use super::gram;
 use super::{CurveFit, CONDITION_LIMIT};
 use crate::bspline::{BasisWorkspace, Curve, KnotVector};
 use crate::param::{self, Method};
@@ -187,7 +187,7 @@ pub fn least_squares_with(
         }
     }
     if opts.smoothing > 0.0 {
-        bending::for_each_entry(&kv, |i, j, g| m.add(i, j, opts.smoothing * g));
+        gram::for_each_entry(&kv, 2, |i, j, g| m.add(i, j, opts.smoothing * g));
     }
     let (ctrl, cond) = if opts.fix_ends {
         let (q0, qn) = (points[0], points[points.len() - 1]);
@@ -251,7 +251,7 @@ pub fn least_squares_closed_with(
         }
     }
     if opts.smoothing > 0.0 {
-        bending::for_each_entry(&kv, |i, j, g| {
+        gram::for_each_entry(&kv, 2, |i, j, g| {
             m.add(i % count, j % count, opts.smoothing * g)
         });
     }

@@ -8,10 +8,11 @@
 //! matrix whose size grows with the data.
 
 pub mod banded;
-pub mod bending;
 pub mod cyclic;
+pub mod gram;
 mod interpolate;
 mod least_squares;
+pub mod surface;
 
 pub use interpolate::{
     interpolate, interpolate_closed_with, interpolate_with, InterpolationConfig,

@@ -40,17 +40,24 @@ pub fn least_squares(params: &[f64], p: usize, ctrl_count: usize) -> Result<Knot
             params.len()
         )));
     }
+    let interior = eq_9_69_interior(params, p, ctrl_count);
+    KnotVector::clamped(p, params[0], params[m], &interior)
+}
+
+/// The interior knots of eqs. 9.68-9.69 for `ctrl_count` control points over the
+/// sorted `params` (needs `p + 1 <= ctrl_count <= params.len()`).
+pub fn eq_9_69_interior(params: &[f64], p: usize, ctrl_count: usize) -> Vec<f64> {
+    let m = params.len() - 1;
     let n = ctrl_count - 1;
     let d = (m + 1) as f64 / (n - p + 1) as f64;
-    let interior: Vec<f64> = (1..=n - p)
+    (1..=n.saturating_sub(p))
         .map(|j| {
             let jd = j as f64 * d;
-            let i = jd.floor() as usize;
+            let i = (jd.floor() as usize).clamp(1, m);
             let alpha = jd - i as f64;
             (1.0 - alpha) * params[i - 1] + alpha * params[i]
         })
-        .collect();
-    KnotVector::clamped(p, params[0], params[m], &interior)
+        .collect()
 }
 
 /// Knots for interpolation with prescribed first derivatives at both ends

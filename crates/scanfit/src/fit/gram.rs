@@ -1,7 +1,12 @@
-//! Bending energy `∫ |C''(u)|^2 du` of a B-spline curve as a quadratic form in
-//! its control points: `G_ij = ∫ N_i''(u) N_j''(u) du`, integrated exactly by
-//! Gauss-Legendre quadrature on each knot span (`N''` has degree `p-2`, so
-//! `p - 1` nodes integrate the product of degree `2p-4` exactly).
+//! Gram matrices of B-spline basis derivatives, `G^(k)_ij = ∫ N_i^(k)(u) N_j^(k)(u) du`
+//! over the domain, integrated exactly by Gauss-Legendre quadrature on each
+//! knot span (`N^(k)` has degree `p-k`, so `p - k + 1` nodes integrate the
+//! product of degree `2(p-k)` exactly).
+//!
+//! They make the smoothing terms: the curve's bending energy `∫ |C''|^2 du` is
+//! `G^(2)` (NURBS Book / de Boor's smoothing spline), and the surface's
+//! thin-plate energy `∫∫ |S_uu|^2 + 2|S_uv|^2 + |S_vv|^2` is
+//! `G^(2)_u ⊗ G^(0)_v + 2 G^(1)_u ⊗ G^(1)_v + G^(0)_u ⊗ G^(2)_v`.
 
 use crate::bspline::{BasisWorkspace, KnotVector};
 
@@ -38,16 +43,17 @@ pub fn gauss_legendre(k: usize) -> (Vec<f64>, Vec<f64>) {
     (x, w)
 }
 
-/// Calls `add(i, j, G_ij)` for every non-zero entry of the bending-energy
-/// matrix (each pair within one span once per span; entries accumulate).
-pub fn for_each_entry(kv: &KnotVector, mut add: impl FnMut(usize, usize, f64)) {
+/// Calls `add(i, j, G^(order)_ij)` for every non-zero contribution (pairs within
+/// one knot span, once per span: entries accumulate). Orders above the degree
+/// give nothing (the derivative vanishes).
+pub fn for_each_entry(kv: &KnotVector, order: usize, mut add: impl FnMut(usize, usize, f64)) {
     let p = kv.degree();
-    if p < 2 {
-        return; // piecewise linear: C'' vanishes inside every span
+    if order > p {
+        return;
     }
     let t = kv.as_slice();
-    let (nodes, weights) = gauss_legendre(p - 1);
-    let mut ws = BasisWorkspace::new(p, 2);
+    let (nodes, weights) = gauss_legendre(p - order + 1);
+    let mut ws = BasisWorkspace::new(p, order);
     let q = p + 1;
     let (a, b) = kv.domain();
     for s in p..kv.basis_count() {
@@ -59,15 +65,25 @@ pub fn for_each_entry(kv: &KnotVector, mut add: impl FnMut(usize, usize, f64)) {
         let mid = 0.5 * (hi + lo);
         for (x, w) in nodes.iter().zip(&weights) {
             let u = mid + half * x;
-            let d = ws.ders(t, s, u, 2);
-            let d2 = &d[2 * q..3 * q];
+            let d = ws.ders(t, s, u, order);
+            let dk = &d[order * q..(order + 1) * q];
             for r in 0..q {
                 for c in 0..q {
-                    add(s - p + r, s - p + c, w * half * d2[r] * d2[c]);
+                    add(s - p + r, s - p + c, w * half * dk[r] * dk[c]);
                 }
             }
         }
     }
+}
+
+/// The Gram matrix `G^(order)` as a dense band: `g[i * (2p+1) + (j - i + p)]`
+/// (entries with `|i - j| > p` are zero). Used for the tensor-product energies.
+pub fn band(kv: &KnotVector, order: usize) -> Vec<f64> {
+    let p = kv.degree();
+    let w = 2 * p + 1;
+    let mut g = vec![0.0; kv.basis_count() * w];
+    for_each_entry(kv, order, |i, j, v| g[i * w + j + p - i] += v);
+    g
 }
 
 #[cfg(test)]
@@ -98,7 +114,21 @@ mod tests {
         let cx = [0.0, 0.25, 0.75, 1.0];
         let cy = [0.0, 0.0, 0.5, 1.0];
         let mut e = 0.0;
-        for_each_entry(&kv, |i, j, g| e += g * (cx[i] * cx[j] + cy[i] * cy[j]));
+        for_each_entry(&kv, 2, |i, j, g| e += g * (cx[i] * cx[j] + cy[i] * cy[j]));
         assert!((e - 4.0).abs() < 1e-13, "{e}");
+    }
+
+    #[test]
+    fn order_zero_gram_integrates_partition_of_unity() {
+        // sum_ij G0_ij = ∫ (sum_i N_i)^2 = domain length; order 1 sums to 0
+        let kv = KnotVector::new(vec![0., 0., 0., 0., 0.3, 0.45, 1., 1., 1., 1.], 3).unwrap();
+        for (order, want) in [(0, 1.0), (1, 0.0), (2, 0.0)] {
+            let mut total = 0.0;
+            for_each_entry(&kv, order, |_, _, g| total += g);
+            assert!((total - want).abs() < 1e-13, "order {order}: {total}");
+        }
+        // and the band layout holds the same entries
+        let g = band(&kv, 0);
+        assert!((g.iter().sum::<f64>() - 1.0).abs() < 1e-13);
     }
 }
