@@ -14,6 +14,7 @@
 //! * [`fit`]: curve interpolation (open, with end tangents, closed/periodic) and
 //!   least-squares approximation with optional bending-energy smoothing, on banded
 //!   solvers.
+//! * [`project`]: point inversion (orthogonal projection onto surfaces).
 //! * [`quality`]: per-curve quality report (deviation, curvature, loops, length).
 
 pub mod bspline;
@@ -21,6 +22,7 @@ mod error;
 pub mod fit;
 mod geom;
 pub mod param;
+pub mod project;
 pub mod quality;
 
 pub use error::{Error, Result};

@@ -1,0 +1,308 @@
+//! Point inversion: the orthogonal projection of points onto a B-spline surface
+//! (*The NURBS Book* section 6.1, eqs. 6.5-6.8).
+//!
+//! Start: the nearest vertex of a parameter grid sampled on the surface, found
+//! with a KD-tree (kiddo). Iteration: Newton on `f = r.S_u = 0`, `g = r.S_v = 0`
+//! (`r = S - P`) with the full Jacobian; when it is not positive definite (far
+//! from a minimum) a Gauss-Newton step is taken instead, and a step that does
+//! not reduce the distance is halved. Parameters are clamped to the domain, or
+//! wrapped in a periodic direction. If the iteration does not converge, it is
+//! restarted from the next nearest grid vertices and the closest result wins.
+//! Convergence (eq. 6.8): the point is on the surface, or `r` is orthogonal to
+//! both tangents, or the parameter step is negligible (also at the boundary,
+//! where the constrained minimum is not orthogonal).
+
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use rayon::prelude::*;
+
+use crate::bspline::{BasisWorkspace, Surface};
+use crate::{Error, Point3, Result, Vector3};
+
+/// Settings of [`SurfaceInverter`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InversionConfig {
+    /// Grid samples per knot span in each direction for the initial guess
+    /// (default 4; at least 16 and at most 1024 per direction).
+    pub samples_per_span: usize,
+    /// Newton iterations per start (default 30).
+    pub max_iterations: usize,
+    /// Zero-cosine and point-coincidence tolerance, relative (default 1e-12).
+    pub tolerance: f64,
+    /// Grid vertices to start from when an iteration does not converge (default 3).
+    pub starts: usize,
+}
+
+impl Default for InversionConfig {
+    fn default() -> Self {
+        Self {
+            samples_per_span: 4,
+            max_iterations: 30,
+            tolerance: 1e-12,
+            starts: 3,
+        }
+    }
+}
+
+/// The projection of one point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Inversion {
+    /// Parameters of the foot point.
+    pub uv: [f64; 2],
+    /// The foot point `S(u, v)`.
+    pub point: Point3,
+    /// Distance from the input point to the foot point.
+    pub distance: f64,
+    /// Newton iterations used (summed over restarts).
+    pub iterations: usize,
+    /// Whether a convergence criterion was met.
+    pub converged: bool,
+}
+
+/// Reusable evaluation memory for one thread.
+#[derive(Debug, Clone)]
+pub struct InversionWorkspace {
+    wu: BasisWorkspace,
+    wv: BasisWorkspace,
+}
+
+impl InversionWorkspace {
+    /// Workspace for `surface`.
+    pub fn new(surface: &Surface) -> Self {
+        let (p, q) = surface.degrees();
+        Self {
+            wu: BasisWorkspace::new(p, 2),
+            wv: BasisWorkspace::new(q, 2),
+        }
+    }
+}
+
+/// Projects points onto one surface; build once, query many times.
+pub struct SurfaceInverter<'s> {
+    surface: &'s Surface,
+    tree: ImmutableKdTree<f64, 3>,
+    grid: Vec<[f64; 2]>,
+    cfg: InversionConfig,
+    scale: f64,
+}
+
+impl<'s> SurfaceInverter<'s> {
+    /// Samples `surface` on a parameter grid and builds the KD-tree.
+    pub fn new(surface: &'s Surface, cfg: InversionConfig) -> Result<Self> {
+        let ((u0, u1), (v0, v1)) = surface.domain();
+        let count = |kv: &crate::bspline::KnotVector| {
+            ((kv.breakpoints().len() - 1) * cfg.samples_per_span.max(1)).clamp(16, 1024)
+        };
+        let (nu, nv) = (count(surface.knots_u()), count(surface.knots_v()));
+        let mut grid = Vec::with_capacity((nu + 1) * (nv + 1));
+        for i in 0..=nu {
+            for j in 0..=nv {
+                grid.push([
+                    u0 + (u1 - u0) * i as f64 / nu as f64,
+                    v0 + (v1 - v0) * j as f64 / nv as f64,
+                ]);
+            }
+        }
+        let pts: Vec<[f64; 3]> = grid
+            .par_iter()
+            .map(|t| {
+                let p = surface.point(t[0], t[1]);
+                [p.x, p.y, p.z]
+            })
+            .collect();
+        let scale = crate::geom::bbox_diagonal(surface.control_points()).max(f64::MIN_POSITIVE);
+        let tree = ImmutableKdTree::new_from_slice(&pts).map_err(|e| {
+            Error::InvalidInput(format!("could not index the surface samples: {e:?}"))
+        })?;
+        Ok(Self {
+            surface,
+            tree,
+            grid,
+            cfg,
+            scale,
+        })
+    }
+
+    /// The surface.
+    pub fn surface(&self) -> &Surface {
+        self.surface
+    }
+
+    /// Projects `p` (KD-tree start, restarts if needed).
+    pub fn invert(&self, p: &Point3, ws: &mut InversionWorkspace) -> Inversion {
+        let q = [p.x, p.y, p.z];
+        let first = self
+            .tree
+            .query(&q)
+            .nearest_one::<SquaredEuclidean<f64>>()
+            .execute();
+        let mut best = self.invert_from(p, self.grid[first.item as usize], ws);
+        if best.converged || self.cfg.starts <= 1 {
+            return best;
+        }
+        let n = std::num::NonZeroUsize::new(self.cfg.starts.max(2))
+            .unwrap_or(std::num::NonZeroUsize::MIN);
+        let more = self
+            .tree
+            .query(&q)
+            .nearest_n::<SquaredEuclidean<f64>>(n)
+            .execute();
+        let mut iterations = best.iterations;
+        for item in more.iter().skip(1) {
+            let r = self.invert_from(p, self.grid[item.item as usize], ws);
+            iterations += r.iterations;
+            if (r.converged && !best.converged) || r.distance < best.distance {
+                best = r;
+            }
+        }
+        best.iterations = iterations;
+        best
+    }
+
+    /// Projects every point, in parallel (results in input order).
+    pub fn invert_all(&self, points: &[Point3]) -> Vec<Inversion> {
+        points
+            .par_iter()
+            .map_init(
+                || InversionWorkspace::new(self.surface),
+                |ws, p| self.invert(p, ws),
+            )
+            .collect()
+    }
+
+    /// Projects every point starting from its given parameters (no KD-tree: for
+    /// re-projection after a small change of the surface, as in parameter
+    /// correction), in parallel.
+    pub fn invert_all_from(&self, points: &[Point3], start: &[[f64; 2]]) -> Vec<Inversion> {
+        points
+            .par_iter()
+            .zip(start.par_iter())
+            .map_init(
+                || InversionWorkspace::new(self.surface),
+                |ws, (p, uv)| {
+                    let r = self.invert_from(p, *uv, ws);
+                    if r.converged {
+                        r
+                    } else {
+                        self.invert(p, ws)
+                    }
+                },
+            )
+            .collect()
+    }
+
+    /// Newton iteration from `uv0`.
+    pub fn invert_from(&self, p: &Point3, uv0: [f64; 2], ws: &mut InversionWorkspace) -> Inversion {
+        let s = self.surface;
+        let ((u0, u1), (v0, v1)) = s.domain();
+        let (pu, pv) = s.periodic();
+        let wrap = |x: f64, lo: f64, hi: f64, periodic: bool| {
+            if periodic {
+                lo + (x - lo).rem_euclid(hi - lo)
+            } else {
+                x.clamp(lo, hi)
+            }
+        };
+        let eps1 = self.cfg.tolerance * self.scale;
+        let eps2 = self.cfg.tolerance; // zero-cosine tolerance (eq. 6.8)
+        let mut d = [Vector3::zeros(); 9];
+        let (mut u, mut v) = (uv0[0], uv0[1]);
+        s.derivatives_into(u, v, &mut ws.wu, &mut ws.wv, 2, &mut d);
+        let mut r = d[0] - p.coords;
+        let mut dist = r.norm();
+        let mut converged = false;
+        let mut it = 0;
+        while it < self.cfg.max_iterations {
+            it += 1;
+            let (su, sv) = (d[3], d[1]);
+            let (suu, suv, svv) = (d[6], d[4], d[2]);
+            if dist <= eps1 {
+                converged = true;
+                break;
+            }
+            let f = r.dot(&su);
+            let g = r.dot(&sv);
+            let (nsu, nsv) = (su.norm(), sv.norm());
+            let interior_u = pu || (u > u0 && u < u1);
+            let interior_v = pv || (v > v0 && v < v1);
+            let cos_u = f.abs() / (nsu * dist).max(f64::MIN_POSITIVE);
+            let cos_v = g.abs() / (nsv * dist).max(f64::MIN_POSITIVE);
+            if (cos_u <= eps2 || !interior_u && f * if u <= u0 { 1.0 } else { -1.0 } >= 0.0)
+                && (cos_v <= eps2 || !interior_v && g * if v <= v0 { 1.0 } else { -1.0 } >= 0.0)
+            {
+                converged = true;
+                break;
+            }
+            // Newton (eq. 6.6) or, if J is not positive definite, Gauss-Newton
+            let (mut a, mut b, mut c) = (
+                nsu * nsu + r.dot(&suu),
+                su.dot(&sv) + r.dot(&suv),
+                nsv * nsv + r.dot(&svv),
+            );
+            if !(a > 0.0 && a * c - b * b > 0.0) {
+                a = nsu * nsu;
+                b = su.dot(&sv);
+                c = nsv * nsv;
+            }
+            let det = a * c - b * b;
+            if !(det.abs() > f64::MIN_POSITIVE) {
+                break;
+            }
+            let mut du = -(c * f - b * g) / det;
+            let mut dv = -(a * g - b * f) / det;
+            // active set: a parameter on its bound whose step points outward stays
+            // there, and the other one takes the one-dimensional Newton step
+            let out_u = !pu && ((u <= u0 && du < 0.0) || (u >= u1 && du > 0.0));
+            let out_v = !pv && ((v <= v0 && dv < 0.0) || (v >= v1 && dv > 0.0));
+            if out_u && out_v {
+                converged = true;
+                break;
+            } else if out_u {
+                du = 0.0;
+                dv = if c > 0.0 { -g / c } else { -g / (nsv * nsv) };
+            } else if out_v {
+                dv = 0.0;
+                du = if a > 0.0 { -f / a } else { -f / (nsu * nsu) };
+            }
+            // halve the step until the distance decreases
+            let mut t = 1.0;
+            let mut accepted = false;
+            let (mut nu_, mut nv_) = (u, v);
+            for _ in 0..30 {
+                nu_ = wrap(u + t * du, u0, u1, pu);
+                nv_ = wrap(v + t * dv, v0, v1, pv);
+                s.derivatives_into(nu_, nv_, &mut ws.wu, &mut ws.wv, 2, &mut d);
+                let nr = d[0] - p.coords;
+                let nd = nr.norm();
+                // accept unless the distance grows beyond rounding: near the
+                // minimum it is flat to rounding while the parameters still improve
+                if nd <= dist + 4.0 * f64::EPSILON * (dist + p.coords.amax()) {
+                    r = nr;
+                    dist = nd;
+                    accepted = true;
+                    break;
+                }
+                t *= 0.5;
+            }
+            let step = ((nu_ - u) * nsu).hypot((nv_ - v) * nsv);
+            if !accepted {
+                // no decrease along the step: at a (constrained) minimum up to rounding
+                s.derivatives_into(u, v, &mut ws.wu, &mut ws.wv, 2, &mut d);
+                converged = step <= 1e3 * eps1.max(dist * 1e-12);
+                break;
+            }
+            u = nu_;
+            v = nv_;
+            if step <= eps1 {
+                converged = true;
+                break;
+            }
+        }
+        Inversion {
+            uv: [u, v],
+            point: Point3::from(d[0]),
+            distance: dist,
+            iterations: it,
+            converged,
+        }
+    }
+}
