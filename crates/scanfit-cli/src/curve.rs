@@ -10,7 +10,7 @@ use scanfit::quality::{curve_quality, CurveQuality, QualityConfig};
 use scanfit::Vector3;
 use scanfit_io::json::{CurveDoc, Provenance, QualityDoc};
 use scanfit_io::svg::{curve_panels, Panel, PanelSize};
-use scanfit_io::{read_points, write_atomic, PointTable};
+use scanfit_io::{read_points, write_all_atomic, write_atomic, PointTable};
 use serde::Serialize;
 
 use crate::progress::Progress;
@@ -45,14 +45,10 @@ const COMPARE_EXAMPLES: &str = "Examples:
 pub struct FitArgs {
     /// Input point file (XYZ, CSV or TXT; points in curve order).
     pub input: PathBuf,
-    /// Parameterization method.
-    #[arg(
-        short,
-        long = "param",
-        default_value = "proposed",
-        value_name = "METHOD"
-    )]
-    pub param: String,
+    /// Parameterization method [default: proposed; centripetal with --closed,
+    /// as the basis-maxima methods are defined for open curves only].
+    #[arg(short, long = "param", value_name = "METHOD")]
+    pub param: Option<String>,
     /// Degree of the curve.
     #[arg(short, long, default_value_t = 3)]
     pub degree: usize,
@@ -68,13 +64,26 @@ pub struct FitArgs {
     /// Smoothing weight λ (least squares only): minimises Σ|Q_k − C(u_k)|² + λ ∫₀¹|C''(u)|² du.
     /// Both terms scale alike with the data's size, so λ is scale-free; it grows with
     /// the number of points (try 1e-6 … 1e-2 times the point count).
-    #[arg(long, value_name = "W", default_value_t = 0.0, requires = "ctrl")]
+    #[arg(
+        long,
+        value_name = "W",
+        default_value_t = 0.0,
+        requires = "ctrl",
+        allow_negative_numbers = true
+    )]
     pub smooth: f64,
     /// Let the curve's ends move (least squares only; default: pinned to the first and last points).
     #[arg(long, requires = "ctrl")]
     pub free_ends: bool,
-    /// End derivatives for interpolation, "dx,dy,dz;dx,dy,dz" (start; end).
-    #[arg(long, value_name = "D0;D1", conflicts_with_all = ["ctrl", "closed"])]
+    /// End derivatives for interpolation, "dx,dy,dz;dx,dy,dz" (start; end): dC/du
+    /// with u running over [0, 1], so a length about that of the data polygon
+    /// gives a natural speed (e.g. the first chord's direction times the polygon length).
+    #[arg(
+        long,
+        value_name = "D0;D1",
+        conflicts_with_all = ["ctrl", "closed"],
+        allow_negative_numbers = true
+    )]
     pub end_tangents: Option<String>,
     /// Write the curve as JSON (schema scanfit/1) to this file.
     #[arg(short, long, value_name = "OUT.json")]
@@ -170,7 +179,8 @@ struct FitReport<'a> {
 }
 
 fn fit_cmd(a: FitArgs) -> Result<()> {
-    let method = Method::parse(&a.param)?;
+    let default = if a.closed { "centripetal" } else { "proposed" };
+    let method = Method::parse(a.param.as_deref().unwrap_or(default))?;
     let progress = Progress::spinner(a.quiet);
     progress.stage(format!("reading {}", a.input.display()));
     let table = load(&a.input)?;
@@ -233,9 +243,11 @@ fn fit_cmd(a: FitArgs) -> Result<()> {
     });
     doc.params = Some(fit.params.clone());
     doc.quality = Some(QualityDoc::from(&q));
-    // outputs are written only after everything succeeded, each atomically
+    // outputs are built first and written together, atomically, only after
+    // everything succeeded: a failed run leaves no file behind
+    let mut files: Vec<(&Path, Vec<u8>)> = Vec::new();
     if let Some(out) = &a.output {
-        write_atomic(out, doc.to_json().as_bytes())?;
+        files.push((out, doc.to_json().into_bytes()));
     }
     if let Some(svg) = &a.svg {
         let panel = Panel {
@@ -244,11 +256,13 @@ fn fit_cmd(a: FitArgs) -> Result<()> {
             points: used,
             curve: Some(&fit.curve),
         };
-        write_atomic(
+        files.push((
             svg,
-            curve_panels(&[panel], 1, "", PanelSize::SINGLE).as_bytes(),
-        )?;
+            curve_panels(&[panel], 1, "", PanelSize::SINGLE).into_bytes(),
+        ));
     }
+    let refs: Vec<(&Path, &[u8])> = files.iter().map(|(p, b)| (*p, b.as_slice())).collect();
+    write_all_atomic(&refs)?;
     if a.json {
         let report = FitReport {
             input: a.input.display().to_string(),

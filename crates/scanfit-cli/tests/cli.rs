@@ -266,3 +266,67 @@ fn help_has_examples() {
         );
     }
 }
+
+#[test]
+fn review_regressions() {
+    // a good JSON target plus an unwritable SVG target: neither is written
+    let d = tmpdir("group");
+    let good = d.join("good.json");
+    let input = examples().join("dataset1.csv");
+    let o = run(&[
+        "curve",
+        "fit",
+        input.to_str().unwrap(),
+        "-o",
+        good.to_str().unwrap(),
+        "--svg",
+        d.join("missing/f.svg").to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(!good.exists(), "half of a failed run was written");
+    assert_eq!(
+        stderr(&o).matches("No such file").count(),
+        1,
+        "{}",
+        stderr(&o)
+    );
+
+    expect_error(
+        "typo",
+        Some("0,O,0\n1,1,1\n2,0,0\n3,1,0\n"),
+        &[],
+        "typo.csv:1: value 2 ('O') is not a number",
+    );
+    expect_error(
+        "huge",
+        Some("0,0,0\n1,1,1e300\n2,0,0\n3,1,0\n"),
+        &[],
+        "magnitude 1e300",
+    );
+    expect_error(
+        "negsmooth",
+        Some("0,0,0\n1,1,0\n2,0,0\n3,1,0\n4,0,0\n"),
+        &["--ctrl", "4", "--smooth", "-1"],
+        "smoothing weight -1 must be finite and non-negative",
+    );
+    expect_error(
+        "closedfew",
+        Some("0,0,0\n1,0,0\n1,1,0\n0,1,0\n"),
+        &["--closed"],
+        "closed interpolation of degree 3 needs at least 7",
+    );
+
+    // --closed works with the default method (centripetal then)
+    let sq = d.join("sq.csv");
+    std::fs::write(&sq, "0,0,0\n1,0,0\n1,1,0\n0,1,0\n").unwrap();
+    let o = run(&[
+        "curve",
+        "fit",
+        sq.to_str().unwrap(),
+        "--closed",
+        "--degree",
+        "1",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("centripetal"));
+}

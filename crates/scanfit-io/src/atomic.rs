@@ -9,9 +9,9 @@ use crate::{Error, Result};
 /// file in the same directory, which is renamed over `path` only when fully
 /// written and flushed. On error the temporary file is removed.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let io = |source| Error::Io {
+    let io = |error| Error::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     };
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
@@ -35,6 +35,53 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     Ok(())
 }
 
+/// Writes several files as a group: every content goes to its temporary file
+/// first, and only when all of them are written are they renamed into place.
+/// If any write fails, no target is touched and the temporaries are removed.
+pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<()> {
+    let mut staged: Vec<(std::path::PathBuf, &Path)> = Vec::new();
+    let cleanup = |staged: &[(std::path::PathBuf, &Path)]| {
+        for (tmp, _) in staged {
+            let _ = std::fs::remove_file(tmp);
+        }
+    };
+    for (path, bytes) in files {
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+            _ => std::path::PathBuf::from("."),
+        };
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "out".into());
+        let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
+        let r = (|| {
+            let mut f = std::fs::File::create(&tmp)?;
+            f.write_all(bytes)?;
+            f.sync_all()
+        })();
+        if let Err(error) = r {
+            let _ = std::fs::remove_file(&tmp);
+            cleanup(&staged);
+            return Err(Error::Io {
+                path: path.to_path_buf(),
+                error,
+            });
+        }
+        staged.push((tmp, path));
+    }
+    for (k, (tmp, path)) in staged.iter().enumerate() {
+        if let Err(error) = std::fs::rename(tmp, path) {
+            cleanup(&staged[k..]);
+            return Err(Error::Io {
+                path: path.to_path_buf(),
+                error,
+            });
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -53,6 +100,12 @@ mod tests {
         let bad = dir.join("missing/b.txt");
         let e = write_atomic(&bad, b"x").unwrap_err();
         assert!(e.to_string().contains("missing/b.txt"), "{e}");
+        // a group with one unwritable target writes nothing
+        let ok = dir.join("c.txt");
+        let e = write_all_atomic(&[(&ok, b"c"), (&bad, b"x")]).unwrap_err();
+        assert!(e.to_string().contains("missing/b.txt"));
+        assert!(!ok.exists());
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

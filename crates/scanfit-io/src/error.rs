@@ -6,12 +6,12 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// The file could not be opened, read or written.
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     Io {
         /// the file
         path: PathBuf,
-        /// the OS error
-        source: std::io::Error,
+        /// the OS error (in the message, not chained, so it prints once)
+        error: std::io::Error,
     },
     /// The file's content is malformed at a given line.
     #[error("{path}:{line}: {message}")]
@@ -32,12 +32,12 @@ pub enum Error {
         message: String,
     },
     /// The geometry read from a file is invalid.
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     Geometry {
         /// the file
         path: PathBuf,
         /// the library's error
-        source: scanfit::Error,
+        error: scanfit::Error,
     },
 }
 

@@ -11,6 +11,6 @@ pub mod json;
 pub mod svg;
 pub mod xyz;
 
-pub use atomic::write_atomic;
+pub use atomic::{write_all_atomic, write_atomic};
 pub use error::{Error, Result};
 pub use xyz::{read_points, PointTable};

@@ -68,9 +68,9 @@ pub fn read_points(path: &Path) -> Result<PointTable> {
             ),
         });
     }
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
+    let bytes = std::fs::read(path).map_err(|error| Error::Io {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     let text = String::from_utf8(bytes).map_err(|e| {
         let line = 1 + e.as_bytes()[..e.utf8_error().valid_up_to()]
@@ -122,7 +122,13 @@ pub fn parse_points(path: &Path, text: &str) -> Result<PointTable> {
             }
         }
         if let Some((k, f)) = bad {
-            if points.is_empty() && columns.is_none() {
+            // the header: before any data, and no field a number (a data line
+            // with a typo such as `0,O,0` is an error, not a header)
+            if points.is_empty()
+                && columns.is_none()
+                && values.is_empty()
+                && fields.iter().all(|f| f.parse::<f64>().is_err())
+            {
                 // the first non-numeric line before any data is the header
                 columns = Some(
                     fields
@@ -210,6 +216,12 @@ mod tests {
         assert_eq!(t.lines, vec![2, 5]);
         assert_eq!(t.column("w").unwrap(), &[0.5, 1.5]);
         assert_eq!(t.locate(1), "t.csv:5");
+    }
+
+    #[test]
+    fn a_typo_in_the_first_line_is_not_a_header() {
+        let e = parse("0,O,0\n1,1,1\n").unwrap_err().to_string();
+        assert_eq!(e, "t.csv:1: value 2 ('O') is not a number");
     }
 
     #[test]

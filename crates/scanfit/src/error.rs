@@ -36,7 +36,7 @@ pub enum Error {
         distance: f64,
     },
     /// A parameterization produced non-increasing parameters.
-    #[error("{method} parameterization gives coincident parameters at points {first} and {second} (u = {u_first} and {u_second}); the interpolation matrix would be singular, choose another method")]
+    #[error("{method} parameterization gives {} parameters at points {first} and {second} (u = {u_first} then {u_second}); the interpolation matrix would be singular, choose another method (e.g. centripetal)", if u_first == u_second { "coincident" } else { "decreasing" })]
     CoincidentParameters {
         /// method name
         method: String,

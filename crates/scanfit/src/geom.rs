@@ -7,7 +7,12 @@ pub type Point3 = nalgebra::Point3<f64>;
 /// A vector in 3D space (f64).
 pub type Vector3 = nalgebra::Vector3<f64>;
 
-/// Checks that every coordinate is finite; the error names the first bad point.
+/// Largest coordinate magnitude the library accepts: squared distances of
+/// larger values overflow f64.
+pub const MAX_COORDINATE: f64 = 1e150;
+
+/// Checks that every coordinate is finite and of a magnitude whose squared
+/// distances stay representable; the error names the first bad point.
 pub fn validate_points(points: &[Point3]) -> Result<()> {
     for (index, p) in points.iter().enumerate() {
         if let Some(v) = p.coords.iter().find(|v| !v.is_finite()) {
@@ -16,6 +21,18 @@ pub fn validate_points(points: &[Point3]) -> Result<()> {
                 value: v.to_string(),
             });
         }
+        if let Some(v) = p.coords.iter().find(|v| v.abs() > MAX_COORDINATE) {
+            return Err(Error::InvalidInput(format!(
+                "point {index} has a coordinate of magnitude {v:e}; values beyond {MAX_COORDINATE:e} overflow squared distances, rescale the data"
+            )));
+        }
+    }
+    // tiny data: distances would underflow (points that differ would coincide)
+    let extent = bbox_diagonal(points);
+    if points.len() > 1 && extent > 0.0 && extent < 1e-140 {
+        return Err(Error::InvalidInput(format!(
+            "the points span only {extent:e}; distances this small underflow, rescale the data"
+        )));
     }
     Ok(())
 }

@@ -11,9 +11,10 @@ use crate::{Point3, Vector3};
 pub struct QualityConfig {
     /// Samples per knot span for curvature, length and loop detection (default 64).
     pub samples_per_span: usize,
-    /// Curvature values below this fraction of the maximum count as zero when
-    /// counting sign changes, so straight runs do not flip on rounding noise
-    /// (default 1e-6).
+    /// A curvature lobe (a run of one sign) counts towards the inflections only
+    /// if its peak exceeds this fraction of the maximum curvature (default 0.01),
+    /// so the faint ringing of an interpolant along collinear data does not
+    /// count as an inflection.
     pub curvature_zero: f64,
 }
 
@@ -21,7 +22,7 @@ impl Default for QualityConfig {
     fn default() -> Self {
         Self {
             samples_per_span: 64,
-            curvature_zero: 1e-6,
+            curvature_zero: 0.01,
         }
     }
 }
@@ -43,8 +44,8 @@ pub struct CurveQuality {
     pub max_curvature: f64,
     /// Parameter where the curvature is largest.
     pub max_curvature_at: f64,
-    /// Number of sign changes of the curvature signed about the best-fit plane's
-    /// normal (inflections; for a planar curve exactly its inflection count).
+    /// Number of sign changes between significant curvature lobes, the curvature
+    /// signed about the best-fit plane's normal (inflections of a planar curve).
     pub curvature_sign_changes: usize,
     /// Number of self-intersections (loops) of the curve.
     pub self_intersections: usize,
@@ -115,19 +116,7 @@ pub fn curve_quality(
         }
         signed.push(k);
     }
-    let zero = kmax * cfg.curvature_zero;
-    let mut changes = 0;
-    let mut last_sign = 0.0;
-    for &k in &signed {
-        if k.abs() <= zero {
-            continue;
-        }
-        let s = k.signum();
-        if last_sign != 0.0 && s != last_sign {
-            changes += 1;
-        }
-        last_sign = s;
-    }
+    let changes = count_inflections(&signed, kmax * cfg.curvature_zero);
 
     let closed = curve.is_closed();
     let mut polygon_length: f64 = points.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
@@ -153,6 +142,30 @@ pub fn curve_quality(
             f64::NAN
         },
     }
+}
+
+/// Sign changes between lobes of `signed` curvature whose peak exceeds `threshold`.
+fn count_inflections(signed: &[f64], threshold: f64) -> usize {
+    let mut lobes: Vec<f64> = Vec::new(); // signs of significant lobes
+    let (mut sign, mut peak) = (0.0f64, 0.0f64);
+    let close = |sign: f64, peak: f64, lobes: &mut Vec<f64>| {
+        if sign != 0.0 && peak > threshold && lobes.last() != Some(&sign) {
+            lobes.push(sign);
+        }
+    };
+    for &k in signed {
+        if k == 0.0 {
+            continue;
+        }
+        if k.signum() != sign {
+            close(sign, peak, &mut lobes);
+            sign = k.signum();
+            peak = 0.0;
+        }
+        peak = peak.max(k.abs());
+    }
+    close(sign, peak, &mut lobes);
+    lobes.len().saturating_sub(1)
 }
 
 /// Closest point on `curve` to `q` by Newton iteration on `(C(u) - q) . C'(u) = 0`
@@ -363,6 +376,13 @@ mod tests {
         let q = curve_quality(&c, &[p(0., 0.)], &[0.0], &QualityConfig::default());
         assert_eq!(q.curvature_sign_changes, 1);
         assert_eq!(q.self_intersections, 0);
+    }
+
+    #[test]
+    fn faint_lobes_do_not_count() {
+        let k = [1.0, 2.0, -0.001, 0.5, 1.0, -1.0, -2.0, 0.0, -1.0];
+        assert_eq!(count_inflections(&k, 0.02), 1);
+        assert_eq!(count_inflections(&k, 0.0), 3);
     }
 
     #[test]

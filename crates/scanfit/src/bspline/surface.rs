@@ -197,12 +197,14 @@ impl Surface {
         out.iter_mut().for_each(|o| *o = Vector3::zeros());
         // homogeneous derivatives A^(k,l) and w^(k,l) (w = 1 when non-rational);
         // orders above 7 are not supported for rational surfaces (stack buffer)
+        // (stride 8 in `wd`: orders up to 7)
         let mut wd = [0.0f64; 64];
         let order = if self.weights.is_some() {
             order.min(7)
         } else {
             order
         };
+        let wi = |k: usize, l: usize| k * 8 + l;
         for k in 0..=order.min(ku) {
             for l in 0..=(order - k).min(kv) {
                 let mut acc = Vector3::zeros();
@@ -218,8 +220,8 @@ impl Surface {
                     }
                 }
                 out[k * d1 + l] = acc;
-                if k * d1 + l < wd.len() {
-                    wd[k * d1 + l] = wacc;
+                if k < 8 && l < 8 {
+                    wd[wi(k, l)] = wacc;
                 }
             }
         }
@@ -231,17 +233,17 @@ impl Surface {
             for l in 0..=(order - k) {
                 let mut v = out[k * d1 + l];
                 for j in 1..=l {
-                    v -= out[k * d1 + l - j] * (binomial(l, j) * wd[j]);
+                    v -= out[k * d1 + l - j] * (binomial(l, j) * wd[wi(0, j)]);
                 }
                 for i in 1..=k {
-                    v -= out[(k - i) * d1 + l] * (binomial(k, i) * wd[i * d1]);
+                    v -= out[(k - i) * d1 + l] * (binomial(k, i) * wd[wi(i, 0)]);
                     let mut v2 = Vector3::zeros();
                     for j in 1..=l {
-                        v2 += out[(k - i) * d1 + l - j] * (binomial(l, j) * wd[i * d1 + j]);
+                        v2 += out[(k - i) * d1 + l - j] * (binomial(l, j) * wd[wi(i, j)]);
                     }
                     v -= v2 * binomial(k, i);
                 }
-                out[k * d1 + l] = v / wd[0];
+                out[k * d1 + l] = v / wd[wi(0, 0)];
             }
         }
     }

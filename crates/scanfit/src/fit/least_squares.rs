@@ -97,7 +97,7 @@ pub fn approximate(points: &[Point3], cfg: &ApproximationConfig) -> Result<Curve
         weights: cfg.weights.as_deref(),
     };
     let (curve, condition, params) = if cfg.closed {
-        let kv = KnotVector::uniform_periodic(p, cfg.ctrl_count)?;
+        let kv = param::knots::periodic_least_squares(&par.params, p, cfg.ctrl_count)?;
         let u = &par.params[..pts.len()];
         let (c, k) = least_squares_closed_with(pts, u, kv, opts)?;
         (c, k, u.to_vec())

@@ -62,10 +62,13 @@ fn prepare_points<'a>(
     if closed && pts.len() > 2 && pts[0] == pts[pts.len() - 1] {
         pts = &pts[..pts.len() - 1];
     }
-    if pts.len() < p + 1 {
+    // a closed curve of degree p needs 2p + 1 points (p + 1 distinct spans and
+    // its p wrapped control points must not overlap)
+    let needed = if closed { 2 * p + 1 } else { p + 1 };
+    if pts.len() < needed {
         return Err(Error::TooFewPoints {
             got: pts.len(),
-            needed: p + 1,
+            needed,
             what: what.to_string(),
         });
     }

@@ -66,17 +66,23 @@ pub fn eq_9_69_interior(params: &[f64], p: usize, ctrl_count: usize) -> Vec<f64>
 /// `t_{j+p+1} = (1/p) sum_{i=j}^{j+p-1} u_i`, `j = 0..n-p+1`.
 pub fn with_end_derivatives(params: &[f64], p: usize) -> Result<KnotVector> {
     let n = params.len() - 1;
-    if n + 2 < p {
+    if p < 2 {
+        return Err(Error::InvalidInput(format!(
+            "end derivatives need degree 2 or more (a degree-{p} curve has fixed end tangents)"
+        )));
+    }
+    // n + 3 control points must be at least p + 1
+    if n + 2 < p || n < 1 {
         return Err(Error::TooFewPoints {
             got: params.len(),
-            needed: p.saturating_sub(1),
+            needed: p.max(2),
             what: format!("degree {p} interpolation with end derivatives"),
         });
     }
     let interior: Vec<f64> = if p == 3 {
         params[1..n].to_vec()
     } else {
-        (0..=(n + 1 - p))
+        (0..(n + 2 - p))
             .map(|j| params[j..j + p].iter().sum::<f64>() / p as f64)
             .collect()
     };
@@ -113,6 +119,41 @@ pub fn periodic(params: &[f64], p: usize) -> Result<KnotVector> {
     KnotVector::new(t, p)
 }
 
+/// Periodic knots for closed least squares with `count` distinct control
+/// points: the periodic analogue of eqs. 9.68-9.69. `params` holds the closed
+/// parameters (`u_0 = 0, ..., u_n = 1`, the last for the repeated first point);
+/// the domain knot `k_j` (`j = 0..=count`) is the parameter found a fraction
+/// `j / count` of the way along the point sequence, interpolated linearly, so
+/// every span holds about the same number of points. `p` knots continue the
+/// spacing at each end with period 1.
+pub fn periodic_least_squares(params: &[f64], p: usize, count: usize) -> Result<KnotVector> {
+    let n = params.len() - 1; // number of distinct points
+    if count < p + 1 || count > n {
+        return Err(Error::InvalidInput(format!(
+            "a closed curve of degree {p} through {n} points takes {} to {n} control points, {count} requested",
+            p + 1
+        )));
+    }
+    let inner: Vec<f64> = (0..=count)
+        .map(|j| {
+            let x = j as f64 * n as f64 / count as f64;
+            let i = (x.floor() as usize).min(n - 1);
+            let a = x - i as f64;
+            (1.0 - a) * params[i] + a * params[i + 1]
+        })
+        .collect();
+    let period = inner[count] - inner[0];
+    let mut t = Vec::with_capacity(count + 1 + 2 * p);
+    for j in (1..=p).rev() {
+        t.push(inner[count - j] - period);
+    }
+    t.extend_from_slice(&inner);
+    for j in 1..=p {
+        t.push(inner[j] + period);
+    }
+    KnotVector::new(t, p)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -136,6 +177,27 @@ mod tests {
         assert!((t[4] - (u[2] / 3.0 + 2.0 * u[3] / 3.0)).abs() < 1e-15);
         assert_eq!(kv.basis_count(), 6);
         assert!(least_squares(&u, 3, 12).is_err());
+    }
+
+    #[test]
+    fn periodic_least_squares_knots_follow_the_points() {
+        // 8 points crowded at the start: the knots follow them
+        let u = [0.0, 0.01, 0.02, 0.03, 0.04, 0.05, 0.5, 0.9, 1.0];
+        let kv = periodic_least_squares(&u, 3, 4).unwrap();
+        assert_eq!(kv.domain(), (0.0, 1.0));
+        let t = kv.as_slice();
+        assert!(
+            (t[4] - 0.02).abs() < 1e-15 && (t[5] - 0.04).abs() < 1e-15,
+            "{t:?}"
+        );
+        assert!(periodic_least_squares(&u, 3, 9).is_err());
+    }
+
+    #[test]
+    fn end_derivative_knots_reject_bad_degrees() {
+        assert!(with_end_derivatives(&[0.0, 0.5, 1.0], 1).is_err());
+        assert!(with_end_derivatives(&[0.0, 0.5, 1.0], 4).is_ok());
+        assert!(with_end_derivatives(&[0.0, 1.0], 5).is_err());
     }
 
     #[test]

@@ -51,7 +51,8 @@ pub fn grid_iteration(
     points: &[Point3],
     cfg: &GridIterationConfig,
 ) -> Result<Vec<Inversion>> {
-    if !(cfg.h > 0.0 && cfg.h <= 0.5) || !(cfg.epsilon > 0.0) {
+    let valid = cfg.h > 0.0 && cfg.h <= 0.5 && cfg.epsilon > 0.0; // false for NaN too
+    if !valid {
         return Err(Error::InvalidInput(format!(
             "grid step h = {} must be in (0, 0.5] and epsilon = {} positive",
             cfg.h, cfg.epsilon

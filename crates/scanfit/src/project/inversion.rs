@@ -244,7 +244,7 @@ impl<'s> SurfaceInverter<'s> {
                 c = nsv * nsv;
             }
             let det = a * c - b * b;
-            if !(det.abs() > f64::MIN_POSITIVE) {
+            if det.is_nan() || det.abs() <= f64::MIN_POSITIVE {
                 break;
             }
             let mut du = -(c * f - b * g) / det;
