@@ -11,7 +11,12 @@
 //!    the pair move by `s_i` (eqs. 3.3-3.4); then `u_0 = 0`, `u_n = 1`;
 //! 5. the shifted `u_i` and the knot vector `U` of step 2 are the result.
 //!
-//! Points are `P_0..P_n` (n + 1 points). The pseudocode's `mu_i <- (u_{2i} +
+//! Points are `P_0..P_n` (n + 1 points), as section 3.2 states ("Assume P_i
+//! are n + 1 number of given data points"); Algorithm 1's "n: Number of data
+//! points" would shift the pairing by one, and we follow the section's text.
+//! The shift does not guarantee increasing parameters (it fails on some
+//! random data and on data set 6 at degree >= 16); that is reported as an
+//! error naming the points, never returned. The pseudocode's `mu_i <- (u_{2i} +
 //! u_{2i})/2` is a typo for `(u_{2i-1} + u_{2i})/2`, as eqs. 3.3-3.4 and the
 //! symmetric role of the pair show.
 
