@@ -83,10 +83,9 @@ pub fn interpolate_with(
     end_derivatives: Option<(Vector3, Vector3)>,
 ) -> Result<(Curve, f64)> {
     let n = points.len();
-    let p = kv.degree();
     let extra = if end_derivatives.is_some() { 2 } else { 0 };
     let count = kv.basis_count();
-    if count != n + extra || params.len() != n {
+    if count != n + extra || params.len() != n || n < 2 {
         return Err(Error::InvalidInput(format!(
             "interpolation of {n} points{} needs {} basis functions and {n} parameters; got {count} and {}",
             if extra > 0 { " with end derivatives" } else { "" },
@@ -94,26 +93,45 @@ pub fn interpolate_with(
             params.len()
         )));
     }
-    let t = kv.as_slice();
-    let mut ws = BasisWorkspace::new(p, 1);
-    // rows: (parameter, derivative order, right-hand side)
-    let mut rows: Vec<(f64, usize, Vector3)> = Vec::with_capacity(count);
+    // rows: (parameter, derivative order) and their right-hand sides
+    let mut rows: Vec<(f64, usize)> = Vec::with_capacity(count);
+    let mut values: Vec<f64> = Vec::with_capacity(count * 3);
     for (k, (&u, q)) in params.iter().zip(points).enumerate() {
         if let (Some((d0, _)), 1) = (end_derivatives, k) {
-            rows.push((params[0], 1, d0));
+            rows.push((params[0], 1));
+            values.extend_from_slice(d0.as_slice());
         }
         if let (Some((_, dn)), true) = (end_derivatives, k + 1 == n) {
-            rows.push((params[n - 1], 1, dn));
+            rows.push((params[n - 1], 1));
+            values.extend_from_slice(dn.as_slice());
         }
-        rows.push((u, 0, q.coords));
+        rows.push((u, 0));
+        values.extend_from_slice(q.coords.as_slice());
     }
-    if n == 1 {
-        return Err(Error::TooFewPoints {
-            got: 1,
-            needed: p + 1,
-            what: "interpolation".into(),
-        });
-    }
+    let (ctrl, cond) = collocate(&rows, &values, 3, &kv, params)?;
+    let ctrl = ctrl
+        .chunks(3)
+        .map(|c| Point3::new(c[0], c[1], c[2]))
+        .collect();
+    Ok((Curve::new(kv, ctrl)?, cond))
+}
+
+/// Solves the collocation system `sum_j N_j^(order_i)(u_i) X_j = V_i` for
+/// `ncols` value columns (row-major, one row per collocation row) on a clamped
+/// knot vector: banded LU without pivoting, condition check, iterative
+/// refinement and a residual check (an accepted result reproduces the values to
+/// 1e-9 relative). Returns the control values (row-major) and the condition.
+pub(crate) fn collocate(
+    rows: &[(f64, usize)],
+    values: &[f64],
+    ncols: usize,
+    kv: &KnotVector,
+    params: &[f64],
+) -> Result<(Vec<f64>, f64)> {
+    let p = kv.degree();
+    let count = kv.basis_count();
+    let t = kv.as_slice();
+    let mut ws = BasisWorkspace::new(p, 1);
     // band widths from the actual structure
     let spans: Vec<usize> = rows.iter().map(|r| kv.find_span(r.0)).collect();
     let (mut kl, mut ku) = (0usize, 0usize);
@@ -122,13 +140,11 @@ pub fn interpolate_with(
         ku = ku.max(s.saturating_sub(i));
     }
     let mut a = BandMatrix::zeros(count, kl, ku);
-    let mut rhs = vec![0.0; count * 3];
-    for (i, ((u, order, r), &s)) in rows.iter().zip(&spans).enumerate() {
+    for (i, ((u, order), &s)) in rows.iter().zip(&spans).enumerate() {
         let d = ws.ders(t, s, *u, *order);
         for j in 0..=p {
             a.set(i, s - p + j, d[order * (p + 1) + j]);
         }
-        rhs[i * 3..i * 3 + 3].copy_from_slice(r.as_slice());
     }
     let a0 = a.clone();
     let lu = a
@@ -139,20 +155,20 @@ pub fn interpolate_with(
         CONDITION_LIMIT,
         "the parameters crowd together; try centripetal or the proposed method",
     )?;
-    let b = rhs.clone();
-    lu.solve_in_place(&mut rhs, 3);
+    let mut x = values.to_vec();
+    lu.solve_in_place(&mut x, ncols);
     // Iterative refinement: on ill-conditioned (but accepted) systems the first
     // solution can miss the data by more than 1e-9; correcting with the residual
     // of the kept matrix restores a small residual, i.e. an exact interpolant.
-    let scale = points.iter().map(|q| q.coords.amax()).fold(1.0, f64::max);
+    let scale = values.iter().fold(1.0f64, |m, v| m.max(v.abs()));
     let mut residual = f64::INFINITY;
     for _ in 0..3 {
-        let mut r = b.clone();
+        let mut r = values.to_vec();
         for i in 0..count {
             for j in i.saturating_sub(kl)..(i + ku + 1).min(count) {
                 let v = a0.get(i, j);
-                for c in 0..3 {
-                    r[i * 3 + c] -= v * rhs[j * 3 + c];
+                for c in 0..ncols {
+                    r[i * ncols + c] -= v * x[j * ncols + c];
                 }
             }
         }
@@ -160,8 +176,8 @@ pub fn interpolate_with(
         if residual <= 1e-14 * scale {
             break;
         }
-        lu.solve_in_place(&mut r, 3);
-        rhs.iter_mut().zip(&r).for_each(|(x, d)| *x += d);
+        lu.solve_in_place(&mut r, ncols);
+        x.iter_mut().zip(&r).for_each(|(x, d)| *x += d);
     }
     if residual > 1e-9 * scale {
         return Err(Error::Singular {
@@ -172,11 +188,7 @@ pub fn interpolate_with(
             ),
         });
     }
-    let ctrl = rhs
-        .chunks(3)
-        .map(|c| Point3::new(c[0], c[1], c[2]))
-        .collect();
-    Ok((Curve::new(kv, ctrl)?, lu.condition()))
+    Ok((x, lu.condition()))
 }
 
 /// Closed (periodic) interpolation: `points.len()` distinct points with
@@ -190,12 +202,38 @@ pub fn interpolate_closed_with(
 ) -> Result<(Curve, f64)> {
     let n = points.len();
     let p = kv.degree();
-    if kv.basis_count() != n + p || params.len() != n {
+    if params.len() != n {
         return Err(Error::InvalidInput(format!(
-            "closed interpolation of {n} points needs {} basis functions and {n} parameters; got {} and {}",
-            n + p,
-            kv.basis_count(),
+            "{} parameters for {n} points",
             params.len()
+        )));
+    }
+    let values: Vec<f64> = points.iter().flat_map(|q| [q.x, q.y, q.z]).collect();
+    let (x, cond) = collocate_closed(params, &values, 3, &kv)?;
+    let mut ctrl: Vec<Point3> = x.chunks(3).map(|c| Point3::new(c[0], c[1], c[2])).collect();
+    for j in 0..p {
+        ctrl.push(ctrl[j]);
+    }
+    Ok((Curve::new_periodic(kv, ctrl, None)?, cond))
+}
+
+/// Periodic collocation for `ncols` value columns: `params.len()` rows in
+/// `[0, 1)`, a periodic knot vector with `params.len() + p` basis functions.
+/// Returns the `params.len()` distinct control values (row-major) and the
+/// condition estimate.
+pub(crate) fn collocate_closed(
+    params: &[f64],
+    values: &[f64],
+    ncols: usize,
+    kv: &KnotVector,
+) -> Result<(Vec<f64>, f64)> {
+    let n = params.len();
+    let p = kv.degree();
+    if kv.basis_count() != n + p {
+        return Err(Error::InvalidInput(format!(
+            "closed interpolation of {n} points needs {} basis functions; got {}",
+            n + p,
+            kv.basis_count()
         )));
     }
     if p > 31 {
@@ -235,16 +273,13 @@ pub fn interpolate_closed_with(
     }
     let shift = (0..n).max_by_key(|&d| votes[d]).unwrap_or(0);
     let mut a = CyclicBandMatrix::zeros(n, p)?;
-    let mut rhs = vec![0.0; n * 3];
-    for (k, ((s, vals), q)) in rows.iter().zip(points).enumerate() {
+    for (k, (s, vals)) in rows.iter().enumerate() {
         for (j, &v) in vals[..=p].iter().enumerate() {
             a.add(k, (s - p + j + n - shift) % n, v);
         }
-        rhs[k * 3..k * 3 + 3].copy_from_slice(q.coords.as_slice());
     }
-    let cond = a.solve(&mut rhs, 3, "closed curve interpolation")?;
-    // undo the rotation: unknown c is control point (c + shift) mod n
-    rhs.rotate_right(3 * shift);
+    let mut x = values.to_vec();
+    let cond = a.solve(&mut x, ncols, "closed curve interpolation")?;
     if cond > CONDITION_LIMIT {
         return Err(Error::Singular {
             what: "closed curve interpolation".into(),
@@ -252,14 +287,9 @@ pub fn interpolate_closed_with(
             hint: "the parameters crowd together; try centripetal".into(),
         });
     }
-    let mut ctrl: Vec<Point3> = rhs
-        .chunks(3)
-        .map(|c| Point3::new(c[0], c[1], c[2]))
-        .collect();
-    for j in 0..p {
-        ctrl.push(ctrl[j]);
-    }
-    Ok((Curve::new_periodic(kv, ctrl, None)?, cond))
+    // undo the rotation: unknown c is control point (c + shift) mod n
+    x.rotate_right(ncols * shift);
+    Ok((x, cond))
 }
 
 /// Adds the parameter values to a singular-system error, since crowded or

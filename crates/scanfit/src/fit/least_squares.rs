@@ -155,68 +155,9 @@ pub fn least_squares_with(
     opts: LeastSquaresOptions,
 ) -> Result<(Curve, f64)> {
     check_inputs(points, params, &opts)?;
-    let p = kv.degree();
-    let count = kv.basis_count();
-    let fixed = if opts.fix_ends { 2 } else { 0 };
-    if count < fixed + 1 {
-        return Err(Error::InvalidInput(format!(
-            "{count} control points leave nothing to fit with fixed ends"
-        )));
-    }
-    let t = kv.as_slice();
-    let mut m = BandMatrix::zeros(count, p, p);
-    let mut rhs = vec![0.0; count * 3];
-    let mut ws = BasisWorkspace::new(p, 0);
-    let mut s = p;
-    let last = count - 1;
-    for (k, (&u, q)) in params.iter().zip(points).enumerate() {
-        if !(t[s] <= u && (u < t[s + 1] || (s == last && u <= t[s + 1]))) {
-            s = kv.find_span(u);
-        }
-        let w = opts.weights.map_or(1.0, |w| w[k]);
-        let n = ws.values(t, s, u);
-        for a in 0..=p {
-            let wa = w * n[a];
-            let row = s - p + a;
-            for b in 0..=p {
-                m.add(row, s - p + b, wa * n[b]);
-            }
-            rhs[row * 3] += wa * q.x;
-            rhs[row * 3 + 1] += wa * q.y;
-            rhs[row * 3 + 2] += wa * q.z;
-        }
-    }
-    if opts.smoothing > 0.0 {
-        gram::for_each_entry(&kv, 2, |i, j, g| m.add(i, j, opts.smoothing * g));
-    }
-    let (ctrl, cond) = if opts.fix_ends {
-        let (q0, qn) = (points[0], points[points.len() - 1]);
-        let r = count - 2;
-        let mut red = BandMatrix::zeros(r, p, p);
-        let mut f = vec![0.0; r * 3];
-        for i in 1..=r {
-            for j in i.saturating_sub(p).max(1)..=(i + p).min(r) {
-                red.set(i - 1, j - 1, m.get(i, j));
-            }
-            let (a0, an) = (m.get(i, 0), m.get(i, count - 1));
-            for c in 0..3 {
-                f[(i - 1) * 3 + c] = rhs[i * 3 + c] - a0 * q0[c] - an * qn[c];
-            }
-        }
-        let cond = solve_normal(red, &mut f, &kv, params)?;
-        let mut ctrl = vec![q0];
-        ctrl.extend(f.chunks(3).map(|c| Point3::new(c[0], c[1], c[2])));
-        ctrl.push(qn);
-        (ctrl, cond)
-    } else {
-        let cond = solve_normal(m, &mut rhs, &kv, params)?;
-        (
-            rhs.chunks(3)
-                .map(|c| Point3::new(c[0], c[1], c[2]))
-                .collect(),
-            cond,
-        )
-    };
+    let values: Vec<f64> = points.iter().flat_map(|q| [q.x, q.y, q.z]).collect();
+    let (x, cond) = lsq_values(params, &values, 3, &kv, &opts, false)?;
+    let ctrl = x.chunks(3).map(|c| Point3::new(c[0], c[1], c[2])).collect();
     Ok((Curve::new(kv, ctrl)?, cond))
 }
 
@@ -231,55 +172,147 @@ pub fn least_squares_closed_with(
 ) -> Result<(Curve, f64)> {
     check_inputs(points, params, &opts)?;
     let p = kv.degree();
-    let count = kv.basis_count() - p;
-    let t = kv.as_slice();
-    let mut m = CyclicBandMatrix::zeros(count, p)?;
-    let mut rhs = vec![0.0; count * 3];
-    let mut ws = BasisWorkspace::new(p, 0);
-    for (k, (&u, q)) in params.iter().zip(points).enumerate() {
-        let s = kv.find_span(u);
-        let w = opts.weights.map_or(1.0, |w| w[k]);
-        let n = ws.values(t, s, u);
-        for a in 0..=p {
-            let row = (s - p + a) % count;
-            for b in 0..=p {
-                m.add(row, (s - p + b) % count, w * n[a] * n[b]);
-            }
-            for c in 0..3 {
-                rhs[row * 3 + c] += w * n[a] * q[c];
-            }
-        }
-    }
-    if opts.smoothing > 0.0 {
-        gram::for_each_entry(&kv, 2, |i, j, g| {
-            m.add(i % count, j % count, opts.smoothing * g)
-        });
-    }
-    let cond = m
-        .solve(&mut rhs, 3, "closed least-squares curve")
-        .map_err(|e| empty_span_hint(e, &kv, params))?;
-    if cond > CONDITION_LIMIT {
-        return Err(empty_span_hint(
-            Error::Singular {
-                what: "closed least-squares curve".into(),
-                condition: cond,
-                hint: String::new(),
-            },
-            &kv,
-            params,
-        ));
-    }
-    let mut ctrl: Vec<Point3> = rhs
-        .chunks(3)
-        .map(|c| Point3::new(c[0], c[1], c[2]))
-        .collect();
+    let values: Vec<f64> = points.iter().flat_map(|q| [q.x, q.y, q.z]).collect();
+    let (x, cond) = lsq_values(params, &values, 3, &kv, &opts, true)?;
+    let mut ctrl: Vec<Point3> = x.chunks(3).map(|c| Point3::new(c[0], c[1], c[2])).collect();
     for j in 0..p {
         ctrl.push(ctrl[j]);
     }
     Ok((Curve::new_periodic(kv, ctrl, None)?, cond))
 }
 
-fn solve_normal(m: BandMatrix, rhs: &mut [f64], kv: &KnotVector, params: &[f64]) -> Result<f64> {
+/// The least-squares kernel for `ncols` value columns (row-major, one row per
+/// parameter): normal equations assembled per row into a band (or, periodic, a
+/// cyclic band) matrix, optional weights and bending-energy smoothing, fixed
+/// ends (open only: the first and last control rows equal the first and last
+/// value rows). Returns the control values (distinct ones when periodic) and
+/// the condition estimate.
+pub(crate) fn lsq_values(
+    params: &[f64],
+    values: &[f64],
+    ncols: usize,
+    kv: &KnotVector,
+    opts: &LeastSquaresOptions,
+    periodic: bool,
+) -> Result<(Vec<f64>, f64)> {
+    let p = kv.degree();
+    let count = if periodic {
+        kv.basis_count() - p
+    } else {
+        kv.basis_count()
+    };
+    let fix = opts.fix_ends && !periodic;
+    if fix && count < 3 {
+        return Err(Error::InvalidInput(format!(
+            "{count} control points leave nothing to fit with fixed ends"
+        )));
+    }
+    let t = kv.as_slice();
+    // band storage: entry (i, j) with j = i + d, d in -p..=p (cyclic when periodic)
+    let w = 2 * p + 1;
+    let mut m = vec![0.0; count * w];
+    let mut rhs = vec![0.0; count * ncols];
+    let fold = |i: usize| if periodic { i % count } else { i };
+    let mut ws = BasisWorkspace::new(p, 0);
+    let mut s = p;
+    let last = kv.basis_count() - 1;
+    for (k, &u) in params.iter().enumerate() {
+        if !(t[s] <= u && (u < t[s + 1] || (s == last && u <= t[s + 1]))) {
+            s = kv.find_span(u);
+        }
+        let wk = opts.weights.map_or(1.0, |w| w[k]);
+        let n = ws.values(t, s, u);
+        for a in 0..=p {
+            let wa = wk * n[a];
+            let row = fold(s - p + a);
+            for b in 0..=p {
+                m[row * w + b + p - a] += wa * n[b];
+            }
+            for c in 0..ncols {
+                rhs[row * ncols + c] += wa * values[k * ncols + c];
+            }
+        }
+    }
+    if opts.smoothing > 0.0 {
+        gram::for_each_entry(kv, 2, |i, j, g| {
+            m[fold(i) * w + j + p - i] += opts.smoothing * g
+        });
+    }
+    let what = if periodic {
+        "closed least-squares curve"
+    } else {
+        "least-squares curve"
+    };
+    if periodic {
+        let mut a = CyclicBandMatrix::zeros(count, p)?;
+        for i in 0..count {
+            for d in 0..w {
+                let v = m[i * w + d];
+                if v != 0.0 {
+                    a.add(i, (i + count + d - p) % count, v);
+                }
+            }
+        }
+        let cond = a
+            .solve(&mut rhs, ncols, what)
+            .map_err(|e| empty_span_hint(e, kv, params))?;
+        if cond > CONDITION_LIMIT {
+            return Err(empty_span_hint(
+                Error::Singular {
+                    what: what.into(),
+                    condition: cond,
+                    hint: String::new(),
+                },
+                kv,
+                params,
+            ));
+        }
+        return Ok((rhs, cond));
+    }
+    let get = |i: usize, j: usize| {
+        if j + p < i || j > i + p {
+            0.0
+        } else {
+            m[i * w + j + p - i]
+        }
+    };
+    if fix {
+        let (first, lastrow) = (&values[..ncols], &values[values.len() - ncols..]);
+        let r = count - 2;
+        let mut red = BandMatrix::zeros(r, p, p);
+        let mut f = vec![0.0; r * ncols];
+        for i in 1..=r {
+            for j in i.saturating_sub(p).max(1)..=(i + p).min(r) {
+                red.set(i - 1, j - 1, get(i, j));
+            }
+            let (a0, an) = (get(i, 0), get(i, count - 1));
+            for c in 0..ncols {
+                f[(i - 1) * ncols + c] = rhs[i * ncols + c] - a0 * first[c] - an * lastrow[c];
+            }
+        }
+        let cond = solve_normal(red, &mut f, ncols, kv, params)?;
+        let mut x = first.to_vec();
+        x.extend_from_slice(&f);
+        x.extend_from_slice(lastrow);
+        return Ok((x, cond));
+    }
+    let mut band = BandMatrix::zeros(count, p, p);
+    for i in 0..count {
+        for j in i.saturating_sub(p)..(i + p + 1).min(count) {
+            band.set(i, j, get(i, j));
+        }
+    }
+    let cond = solve_normal(band, &mut rhs, ncols, kv, params)?;
+    Ok((rhs, cond))
+}
+
+fn solve_normal(
+    m: BandMatrix,
+    rhs: &mut [f64],
+    ncols: usize,
+    kv: &KnotVector,
+    params: &[f64],
+) -> Result<f64> {
     let lu = m
         .factor("least-squares curve")
         .map_err(|e| empty_span_hint(e, kv, params))?;
@@ -294,7 +327,7 @@ fn solve_normal(m: BandMatrix, rhs: &mut [f64], kv: &KnotVector, params: &[f64])
             params,
         ));
     }
-    lu.solve_in_place(rhs, 3);
+    lu.solve_in_place(rhs, ncols);
     Ok(lu.condition())
 }
 
