@@ -238,3 +238,66 @@ fn bad_input_is_reported() {
     let e = fit_surface(&bad, &uv, &cfg).unwrap_err().to_string();
     assert!(e.contains("point 3"), "{e}");
 }
+
+#[test]
+fn grid_interpolation_matches_the_nurbs_book_algorithm() {
+    use scanfit::fit::grid::{fit_grid, GridFitConfig};
+    let g = load("surface_grid_interp.json");
+    let grid: Vec<Point3> = g["grid"].as_array().unwrap().iter().flat_map(|row| pts(row)).collect();
+    let (rows, cols) = (g["grid"].as_array().unwrap().len(), g["grid"][0].as_array().unwrap().len());
+    let fit = fit_grid(&grid, rows, cols, &GridFitConfig::default()).unwrap();
+    for (a, b) in fit.params_u.iter().zip(floats(&g["params_u"])) {
+        assert!((a - b).abs() < 1e-15);
+    }
+    for (a, b) in fit.params_v.iter().zip(floats(&g["params_v"])) {
+        assert!((a - b).abs() < 1e-15);
+    }
+    let want = pts(&g["coefficients"]);
+    for (k, (a, b)) in fit.surface.control_points().iter().zip(&want).enumerate() {
+        assert!((a - b).norm() < 1e-9, "coefficient {k}: {a} vs {b}");
+    }
+    for k in 0..rows {
+        for l in 0..cols {
+            let s = fit.surface.point(fit.params_u[k], fit.params_v[l]);
+            assert!((s - grid[k * cols + l]).norm() < 1e-9);
+        }
+    }
+}
+
+#[test]
+fn periodic_grid_interpolation_and_approximation() {
+    use scanfit::fit::grid::{fit_grid, GridFitConfig};
+    // 12 layers x 9 samples around a wobbly cylinder: closed in u
+    let (rows, cols) = (9, 12);
+    let mut grid = Vec::new();
+    for k in 0..rows {
+        let a = k as f64 / rows as f64 * std::f64::consts::TAU;
+        for l in 0..cols {
+            let r = 2.0 + 0.3 * (3.0 * a).sin() + 0.1 * l as f64;
+            grid.push(Point3::new(r * a.cos(), r * a.sin(), l as f64 * 0.5));
+        }
+    }
+    let cfg = GridFitConfig { periodic_u: true, ..Default::default() };
+    let fit = fit_grid(&grid, rows, cols, &cfg).unwrap();
+    assert!(fit.surface.periodic().0);
+    for k in 0..rows {
+        for l in 0..cols {
+            let s = fit.surface.point(fit.params_u[k], fit.params_v[l]);
+            assert!((s - grid[k * cols + l]).norm() < 1e-9, "({k},{l})");
+        }
+    }
+    // seam: smooth and closed
+    for &v in &[0.0, 0.5, 1.0] {
+        assert!((fit.surface.point(0.0, v) - fit.surface.point(1.0 - 1e-15, v)).norm() < 1e-9);
+    }
+    // least squares on the same grid: fewer control points, still close
+    let cfg = GridFitConfig { periodic_u: true, ctrl: Some((7, 6)), ..Default::default() };
+    let fit = fit_grid(&grid, rows, cols, &cfg).unwrap();
+    assert_eq!(fit.surface.counts(), (7 + 3, 6));
+    let err = (0..rows * cols)
+        .map(|i| (fit.surface.point(fit.params_u[i / cols], fit.params_v[i % cols]) - grid[i]).norm())
+        .fold(0.0, f64::max);
+    assert!(err < 0.2, "{err}");
+    // wrong sizes are errors
+    assert!(fit_grid(&grid, 10, 12, &GridFitConfig::default()).is_err());
+}

@@ -10,6 +10,7 @@
 pub mod banded;
 pub mod cyclic;
 pub mod gram;
+pub mod grid;
 mod interpolate;
 mod least_squares;
 pub mod surface;
