@@ -9,18 +9,22 @@
 //!
 //! * [`bspline`]: knot vectors, basis functions and derivatives, curves and
 //!   tensor-product surfaces (rational weights carried), knot insertion/refinement.
+//! * [`base`]: base surfaces that give points their parameters (best-fit plane).
 //! * [`param`]: the seven curve parameterization methods of the curve paper and
 //!   knot placement.
 //! * [`fit`]: curve interpolation (open, with end tangents, closed/periodic) and
 //!   least-squares approximation with optional bending-energy smoothing, on banded
 //!   solvers.
+//! * [`metrics`]: surface error measures and parameterization quality.
 //! * [`project`]: point inversion (orthogonal projection onto surfaces).
 //! * [`quality`]: per-curve quality report (deviation, curvature, loops, length).
 
+pub mod base;
 pub mod bspline;
 mod error;
 pub mod fit;
 mod geom;
+pub mod metrics;
 pub mod param;
 pub mod project;
 pub mod quality;

@@ -243,8 +243,16 @@ fn bad_input_is_reported() {
 fn grid_interpolation_matches_the_nurbs_book_algorithm() {
     use scanfit::fit::grid::{fit_grid, GridFitConfig};
     let g = load("surface_grid_interp.json");
-    let grid: Vec<Point3> = g["grid"].as_array().unwrap().iter().flat_map(|row| pts(row)).collect();
-    let (rows, cols) = (g["grid"].as_array().unwrap().len(), g["grid"][0].as_array().unwrap().len());
+    let grid: Vec<Point3> = g["grid"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|row| pts(row))
+        .collect();
+    let (rows, cols) = (
+        g["grid"].as_array().unwrap().len(),
+        g["grid"][0].as_array().unwrap().len(),
+    );
     let fit = fit_grid(&grid, rows, cols, &GridFitConfig::default()).unwrap();
     for (a, b) in fit.params_u.iter().zip(floats(&g["params_u"])) {
         assert!((a - b).abs() < 1e-15);
@@ -277,7 +285,10 @@ fn periodic_grid_interpolation_and_approximation() {
             grid.push(Point3::new(r * a.cos(), r * a.sin(), l as f64 * 0.5));
         }
     }
-    let cfg = GridFitConfig { periodic_u: true, ..Default::default() };
+    let cfg = GridFitConfig {
+        periodic_u: true,
+        ..Default::default()
+    };
     let fit = fit_grid(&grid, rows, cols, &cfg).unwrap();
     assert!(fit.surface.periodic().0);
     for k in 0..rows {
@@ -291,13 +302,67 @@ fn periodic_grid_interpolation_and_approximation() {
         assert!((fit.surface.point(0.0, v) - fit.surface.point(1.0 - 1e-15, v)).norm() < 1e-9);
     }
     // least squares on the same grid: fewer control points, still close
-    let cfg = GridFitConfig { periodic_u: true, ctrl: Some((7, 6)), ..Default::default() };
+    let cfg = GridFitConfig {
+        periodic_u: true,
+        ctrl: Some((7, 6)),
+        ..Default::default()
+    };
     let fit = fit_grid(&grid, rows, cols, &cfg).unwrap();
     assert_eq!(fit.surface.counts(), (7 + 3, 6));
     let err = (0..rows * cols)
-        .map(|i| (fit.surface.point(fit.params_u[i / cols], fit.params_v[i % cols]) - grid[i]).norm())
+        .map(|i| {
+            (fit.surface
+                .point(fit.params_u[i / cols], fit.params_v[i % cols])
+                - grid[i])
+                .norm()
+        })
         .fold(0.0, f64::max);
     assert!(err < 0.2, "{err}");
     // wrong sizes are errors
     assert!(fit_grid(&grid, 10, 12, &GridFitConfig::default()).is_err());
+}
+
+#[test]
+fn parameter_correction_reduces_the_error_every_round() {
+    use scanfit::base::plane_parameters;
+    use scanfit::fit::correction::{correct_parameters, CorrectionConfig};
+    // a dome: plane parameters distort towards the rim, correction fixes it
+    let mut pts = Vec::new();
+    for i in 0..60 {
+        for j in 0..60 {
+            let (x, y) = (i as f64 / 59.0 * 2.0 - 1.0, j as f64 / 59.0 * 2.0 - 1.0);
+            // a steep spherical cap: not representable by 8 x 8 bicubics, and
+            // its plane parameters are far from orthogonal near the rim
+            pts.push(Point3::new(x, y, (2.1 - x * x - y * y).sqrt()));
+        }
+    }
+    let mut uv = plane_parameters(&pts).unwrap().uv;
+    let cfg = SurfaceFitConfig {
+        ctrl: (8, 8),
+        ..Default::default()
+    };
+    let (s, rounds) = correct_parameters(
+        &pts,
+        &mut uv,
+        |t| fit_surface(&pts, t, &cfg),
+        &CorrectionConfig {
+            max_rounds: 6,
+            min_improvement: 1e-3,
+        },
+    )
+    .unwrap();
+    assert!(rounds.len() >= 3, "{rounds:?}");
+    for w in rounds.windows(2).take(rounds.len() - 2) {
+        assert!(w[1].errors.rmse < w[0].errors.rmse, "{rounds:?}");
+    }
+    let first = rounds[0].errors.rmse;
+    let best = rounds
+        .iter()
+        .map(|r| r.errors.rmse)
+        .fold(f64::INFINITY, f64::min);
+    assert!(best < 0.7 * first, "{first} -> {best}");
+    // the returned surface and parameters are the best round's
+    let e =
+        scanfit::metrics::ErrorStats::of(&scanfit::metrics::parametric_distances(&s, &pts, &uv));
+    assert!((e.rmse - best).abs() < 1e-12);
 }

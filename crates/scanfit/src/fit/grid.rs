@@ -51,7 +51,12 @@ pub struct GridFit {
 
 /// Fits a surface to `points` on a `rows x cols` grid, `Q_kl = points[k * cols + l]`
 /// (`k` along `u`, `l` along `v`).
-pub fn fit_grid(points: &[Point3], rows: usize, cols: usize, cfg: &GridFitConfig) -> Result<GridFit> {
+pub fn fit_grid(
+    points: &[Point3],
+    rows: usize,
+    cols: usize,
+    cfg: &GridFitConfig,
+) -> Result<GridFit> {
     let (p, q) = cfg.degree;
     if points.len() != rows * cols {
         return Err(Error::InvalidInput(format!(
@@ -91,14 +96,21 @@ pub fn fit_grid(points: &[Point3], rows: usize, cols: usize, cfg: &GridFitConfig
         ),
     };
     let us = &params_u[..rows]; // without the closing parameter
-    // pass 1 along u: one row per grid row k, columns (l, xyz)
+                                // pass 1 along u: one row per grid row k, columns (l, xyz)
     let mut values = Vec::with_capacity(rows * cols * 3);
     for k in 0..rows {
         for l in 0..cols {
             values.extend_from_slice(at(k, l).coords.as_slice());
         }
     }
-    let r = solve_dir(us, &values, 3 * cols, &ku, cfg.ctrl.is_some(), cfg.periodic_u)?;
+    let r = solve_dir(
+        us,
+        &values,
+        3 * cols,
+        &ku,
+        cfg.ctrl.is_some(),
+        cfg.periodic_u,
+    )?;
     let nu = r.len() / (3 * cols);
     // pass 2 along v: transpose to one row per grid column l, columns (i, xyz)
     let mut t = vec![0.0; cols * nu * 3];
@@ -130,7 +142,14 @@ pub fn fit_grid(points: &[Point3], rows: usize, cols: usize, cfg: &GridFitConfig
 }
 
 /// Interpolates (`lsq == false`) or approximates the value rows at `params`.
-fn solve_dir(params: &[f64], values: &[f64], ncols: usize, kv: &KnotVector, lsq: bool, periodic: bool) -> Result<Vec<f64>> {
+fn solve_dir(
+    params: &[f64],
+    values: &[f64],
+    ncols: usize,
+    kv: &KnotVector,
+    lsq: bool,
+    periodic: bool,
+) -> Result<Vec<f64>> {
     let out = match (lsq, periodic) {
         (false, false) => {
             let rows: Vec<(f64, usize)> = params.iter().map(|&u| (u, 0)).collect();
@@ -152,12 +171,19 @@ fn solve_dir(params: &[f64], values: &[f64], ncols: usize, kv: &KnotVector, lsq:
 /// over the lines (NURBS Book eqs. 9.10-9.11); a line of zero length is left
 /// out of the average. With `closed`, the chord back to the first sample is
 /// included and `n + 1` parameters are returned (the last is 1).
-fn averaged(n: usize, m: usize, closed: bool, at: impl Fn(usize, usize) -> Point3) -> Result<Vec<f64>> {
+fn averaged(
+    n: usize,
+    m: usize,
+    closed: bool,
+    at: impl Fn(usize, usize) -> Point3,
+) -> Result<Vec<f64>> {
     let segs = if closed { n } else { n - 1 };
     let mut acc = vec![0.0; segs + 1];
     let mut used = 0usize;
     for l in 0..m {
-        let d: Vec<f64> = (0..segs).map(|k| (at((k + 1) % n, l) - at(k, l)).norm()).collect();
+        let d: Vec<f64> = (0..segs)
+            .map(|k| (at((k + 1) % n, l) - at(k, l)).norm())
+            .collect();
         let total: f64 = d.iter().sum();
         if total <= 0.0 {
             continue;
@@ -170,7 +196,9 @@ fn averaged(n: usize, m: usize, closed: bool, at: impl Fn(usize, usize) -> Point
         }
     }
     if used == 0 {
-        return Err(Error::InvalidInput("every grid line has zero length".into()));
+        return Err(Error::InvalidInput(
+            "every grid line has zero length".into(),
+        ));
     }
     for v in acc.iter_mut() {
         *v /= used as f64;

@@ -8,6 +8,7 @@
 //! matrix whose size grows with the data.
 
 pub mod banded;
+pub mod correction;
 pub mod cyclic;
 pub mod gram;
 pub mod grid;

@@ -1,0 +1,335 @@
+//! Error and parameterization measures of fitted surfaces.
+//!
+//! * [`ErrorStats`] of `|P_i - S(u_i, v_i)|` at the points' parameters: mean and
+//!   maximum are the PDE paper's eq. 15, plus RMSE;
+//! * true orthogonal distances through point inversion ([`orthogonal_errors`]);
+//! * the MBA paper's eq. 17 ([`grid_rmse`]): RMSE over surface grid points of
+//!   the distance to the nearest input point;
+//! * parameterization quality ([`parameterization_quality`]): fold-overs
+//!   (triangles of the Delaunay triangulation of the parameters whose
+//!   orientation flips on the surface) and stretch (Sander et al. 2001).
+
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use rayon::prelude::*;
+use spade::{DelaunayTriangulation, HasPosition, Triangulation};
+
+use crate::bspline::{BasisWorkspace, Surface};
+use crate::project::{Inversion, SurfaceInverter};
+use crate::{Error, Point3, Result};
+
+/// Mean, maximum and RMSE of a set of distances.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ErrorStats {
+    /// Number of distances.
+    pub count: usize,
+    /// Mean (eq. 15, `Err_Mean`).
+    pub mean: f64,
+    /// Maximum (eq. 15, `Err_Max`).
+    pub max: f64,
+    /// Index of the maximum.
+    pub max_index: usize,
+    /// Root mean square.
+    pub rmse: f64,
+}
+
+impl ErrorStats {
+    /// Statistics of `d`.
+    pub fn of(d: &[f64]) -> Self {
+        let (mut sum, mut sum2, mut max, mut max_index) = (0.0, 0.0, 0.0f64, 0);
+        for (i, &x) in d.iter().enumerate() {
+            sum += x;
+            sum2 += x * x;
+            if x > max {
+                max = x;
+                max_index = i;
+            }
+        }
+        let n = d.len().max(1) as f64;
+        Self {
+            count: d.len(),
+            mean: sum / n,
+            max,
+            max_index,
+            rmse: (sum2 / n).sqrt(),
+        }
+    }
+}
+
+/// `|P_i - S(u_i, v_i)|` for every point (in parallel).
+pub fn parametric_distances(surface: &Surface, points: &[Point3], uv: &[[f64; 2]]) -> Vec<f64> {
+    points
+        .par_iter()
+        .zip(uv.par_iter())
+        .map(|(p, t)| (surface.point(t[0], t[1]) - p).norm())
+        .collect()
+}
+
+/// Orthogonal distances by point inversion, with the projections.
+pub fn orthogonal_errors(
+    inverter: &SurfaceInverter,
+    points: &[Point3],
+) -> (ErrorStats, Vec<Inversion>) {
+    let inv = inverter.invert_all(points);
+    let d: Vec<f64> = inv.iter().map(|r| r.distance).collect();
+    (ErrorStats::of(&d), inv)
+}
+
+/// The MBA paper's eq. 17: `sqrt(sum_i min_j |G_i - P_j|^2 / n_g)` over the
+/// surface points `G_i` on a parameter grid; by default (`grid = None`) the grid
+/// of the surface's knot lines, as in the paper (`u_i = s_{i+3}`), otherwise
+/// `(nu + 1) x (nv + 1)` equally spaced parameters.
+pub fn grid_rmse(
+    surface: &Surface,
+    points: &[Point3],
+    grid: Option<(usize, usize)>,
+) -> Result<f64> {
+    if points.is_empty() {
+        return Err(Error::InvalidInput(
+            "no input points for the grid RMSE".into(),
+        ));
+    }
+    let ((u0, u1), (v0, v1)) = surface.domain();
+    let (us, vs): (Vec<f64>, Vec<f64>) = match grid {
+        None => (
+            surface.knots_u().breakpoints(),
+            surface.knots_v().breakpoints(),
+        ),
+        Some((nu, nv)) => (
+            (0..=nu.max(1))
+                .map(|i| u0 + (u1 - u0) * i as f64 / nu.max(1) as f64)
+                .collect(),
+            (0..=nv.max(1))
+                .map(|j| v0 + (v1 - v0) * j as f64 / nv.max(1) as f64)
+                .collect(),
+        ),
+    };
+    let coords: Vec<[f64; 3]> = points.iter().map(|p| [p.x, p.y, p.z]).collect();
+    let tree: ImmutableKdTree<f64, 3> = ImmutableKdTree::new_from_slice(&coords)
+        .map_err(|e| Error::InvalidInput(format!("could not index the points: {e:?}")))?;
+    let g: Vec<[f64; 2]> = us
+        .iter()
+        .flat_map(|&u| vs.iter().map(move |&v| [u, v]))
+        .collect();
+    let sum: f64 = g
+        .par_iter()
+        .map(|t| {
+            let s = surface.point(t[0], t[1]);
+            tree.query(&[s.x, s.y, s.z])
+                .nearest_one::<SquaredEuclidean<f64>>()
+                .execute()
+                .distance
+        })
+        .sum();
+    Ok((sum / g.len() as f64).sqrt())
+}
+
+/// Quality of a parameterization of scattered points on a surface.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ParamQuality {
+    /// Triangles of the Delaunay triangulation of the parameters.
+    pub triangles: usize,
+    /// Triangles whose orientation on the surface (data points, signed by the
+    /// surface normal) is opposite to their orientation in `(u, v)`.
+    pub fold_overs: usize,
+    /// Area-weighted L2 stretch of the map `(u, v) -> P` (Sander et al. 2001),
+    /// normalised so that a map uniform up to scale gives 1.
+    pub l2_stretch: f64,
+    /// Largest ratio of the singular values of a triangle's map (anisotropy).
+    pub max_anisotropy: f64,
+    /// 5th, 50th and 95th percentile of the triangles' area ratio
+    /// (surface area / parameter area, normalised by the global ratio).
+    pub area_ratio_percentiles: [f64; 3],
+}
+
+#[derive(Clone, Copy)]
+struct Vertex {
+    pos: spade::Point2<f64>,
+    index: usize,
+}
+
+impl HasPosition for Vertex {
+    type Scalar = f64;
+    fn position(&self) -> spade::Point2<f64> {
+        self.pos
+    }
+}
+
+/// Fold-overs and stretch of the parameterization `uv` of `points` on `surface`.
+pub fn parameterization_quality(
+    surface: &Surface,
+    points: &[Point3],
+    uv: &[[f64; 2]],
+) -> Result<ParamQuality> {
+    if points.len() != uv.len() {
+        return Err(Error::InvalidInput(format!(
+            "{} points but {} parameter pairs",
+            points.len(),
+            uv.len()
+        )));
+    }
+    let verts: Vec<Vertex> = uv
+        .iter()
+        .enumerate()
+        .map(|(index, t)| Vertex {
+            pos: spade::Point2::new(t[0], t[1]),
+            index,
+        })
+        .collect();
+    let tri: DelaunayTriangulation<Vertex> = DelaunayTriangulation::bulk_load(verts)
+        .map_err(|e| Error::InvalidInput(format!("cannot triangulate the parameters: {e:?}")))?;
+    let faces: Vec<[usize; 3]> = tri
+        .inner_faces()
+        .map(|f| f.vertices().map(|v| v.data().index))
+        .collect();
+    let (p, q) = surface.degrees();
+    // per triangle: (folded, 3D area, uv area, L2^2, anisotropy)
+    let per: Vec<(bool, f64, f64, f64, f64)> = faces
+        .par_iter()
+        .map_init(
+            || (BasisWorkspace::new(p, 1), BasisWorkspace::new(q, 1)),
+            |(wu, wv), f| {
+                let [a, b, c] = *f;
+                let (ta, tb, tc) = (uv[a], uv[b], uv[c]);
+                let area_uv =
+                    0.5 * ((tb[0] - ta[0]) * (tc[1] - ta[1]) - (tc[0] - ta[0]) * (tb[1] - ta[1]));
+                let cross = (points[b] - points[a]).cross(&(points[c] - points[a]));
+                let area3 = 0.5 * cross.norm();
+                let cu = (ta[0] + tb[0] + tc[0]) / 3.0;
+                let cv = (ta[1] + tb[1] + tc[1]) / 3.0;
+                let n = surface.normal(cu, cv, wu, wv);
+                let folded = area_uv > 0.0 && cross.dot(&n) < 0.0;
+                // Sander et al.: partial derivatives of the affine map (s, t) -> q
+                if area_uv <= 0.0 || area3 <= 0.0 {
+                    return (folded, area3, area_uv.max(0.0), 0.0, 1.0);
+                }
+                let ss = (points[a].coords * (tb[1] - tc[1])
+                    + points[b].coords * (tc[1] - ta[1])
+                    + points[c].coords * (ta[1] - tb[1]))
+                    / (2.0 * area_uv);
+                let st = (points[a].coords * (tc[0] - tb[0])
+                    + points[b].coords * (ta[0] - tc[0])
+                    + points[c].coords * (tb[0] - ta[0]))
+                    / (2.0 * area_uv);
+                let (aa, bb, cc) = (ss.dot(&ss), ss.dot(&st), st.dot(&st));
+                let root = ((aa - cc) * (aa - cc) + 4.0 * bb * bb).sqrt();
+                let smax = (0.5 * (aa + cc + root)).sqrt();
+                let smin = (0.5 * (aa + cc - root)).max(0.0).sqrt();
+                let aniso = if smin > 0.0 {
+                    smax / smin
+                } else {
+                    f64::INFINITY
+                };
+                (folded, area3, area_uv, 0.5 * (aa + cc), aniso)
+            },
+        )
+        .collect();
+    let total3: f64 = per.iter().map(|t| t.1).sum();
+    let total_uv: f64 = per.iter().map(|t| t.2).sum();
+    let mut q = ParamQuality {
+        triangles: faces.len(),
+        ..Default::default()
+    };
+    q.fold_overs = per.iter().filter(|t| t.0).count();
+    if total3 > 0.0 && total_uv > 0.0 {
+        let l2: f64 = per.iter().map(|t| t.3 * t.1).sum::<f64>() / total3;
+        q.l2_stretch = (l2 * total_uv / total3).sqrt();
+        q.max_anisotropy = per
+            .iter()
+            .filter(|t| t.2 > 0.0)
+            .map(|t| t.4)
+            .fold(1.0, f64::max);
+        let global = total3 / total_uv;
+        let mut ratios: Vec<f64> = per
+            .iter()
+            .filter(|t| t.2 > 0.0)
+            .map(|t| t.1 / t.2 / global)
+            .collect();
+        ratios.sort_by(f64::total_cmp);
+        if !ratios.is_empty() {
+            let pick = |f: f64| ratios[((ratios.len() - 1) as f64 * f).round() as usize];
+            q.area_ratio_percentiles = [pick(0.05), pick(0.5), pick(0.95)];
+        }
+    }
+    Ok(q)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bspline::KnotVector;
+
+    fn plane() -> Surface {
+        let ku = KnotVector::uniform_clamped(1, 2).unwrap();
+        let kv = KnotVector::uniform_clamped(1, 2).unwrap();
+        let c = vec![
+            Point3::new(0., 0., 0.),
+            Point3::new(0., 2., 0.),
+            Point3::new(4., 0., 0.),
+            Point3::new(4., 2., 0.),
+        ];
+        Surface::new(ku, kv, c).unwrap()
+    }
+
+    fn grid_uv(n: usize) -> Vec<[f64; 2]> {
+        (0..n * n)
+            .map(|k| {
+                [
+                    ((k % n) as f64 + 0.3 * ((k * 7) % 5) as f64 / 5.0) / n as f64,
+                    ((k / n) as f64 + 0.5) / n as f64,
+                ]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn exact_parameterization_has_no_fold_and_unit_stretch() {
+        let s = plane();
+        let uv = grid_uv(20);
+        let pts: Vec<Point3> = uv.iter().map(|t| s.point(t[0], t[1])).collect();
+        let q = parameterization_quality(&s, &pts, &uv).unwrap();
+        assert_eq!(q.fold_overs, 0);
+        assert!(q.triangles > 600);
+        // an affine map with singular values 4 and 2: normalised L2 stretch = sqrt(10/8)
+        assert!(
+            (q.l2_stretch - (10.0f64 / 8.0).sqrt()).abs() < 1e-9,
+            "{}",
+            q.l2_stretch
+        );
+        assert!((q.max_anisotropy - 2.0).abs() < 1e-9);
+        for r in q.area_ratio_percentiles {
+            assert!((r - 1.0).abs() < 1e-9);
+        }
+        let e = ErrorStats::of(&parametric_distances(&s, &pts, &uv));
+        assert!(e.max < 1e-15);
+    }
+
+    #[test]
+    fn swapped_parameters_fold_over() {
+        let s = plane();
+        let mut uv = grid_uv(10);
+        let pts: Vec<Point3> = uv.iter().map(|t| s.point(t[0], t[1])).collect();
+        // swap the parameters of two neighbouring points: their triangles flip
+        uv.swap(44, 45);
+        let q = parameterization_quality(&s, &pts, &uv).unwrap();
+        assert!(q.fold_overs >= 2, "{}", q.fold_overs);
+    }
+
+    #[test]
+    fn grid_rmse_of_points_on_the_grid_is_zero() {
+        let s = plane();
+        let mut pts = Vec::new();
+        for i in 0..=10 {
+            for j in 0..=10 {
+                pts.push(s.point(i as f64 / 10.0, j as f64 / 10.0));
+            }
+        }
+        assert!(grid_rmse(&s, &pts, Some((10, 10))).unwrap() < 1e-15);
+        // a finer grid sees the gaps: the midpoint of a cell is 0.5*sqrt(0.4^2+0.2^2) away
+        let r = grid_rmse(&s, &pts, Some((20, 20))).unwrap();
+        assert!(r > 0.05 && r < 0.2, "{r}");
+        // stats
+        let e = ErrorStats::of(&[3.0, 4.0]);
+        assert_eq!((e.mean, e.max, e.max_index), (3.5, 4.0, 1));
+        assert!((e.rmse - 12.5f64.sqrt()).abs() < 1e-15);
+    }
+}
