@@ -17,6 +17,11 @@
 //! }
 //! ```
 //!
+//! Surfaces (`"type": "bspline_surface"`) carry `degree_u`, `degree_v`,
+//! `periodic_u`, `periodic_v`, `knots_u`, `knots_v`, `count_u`, `count_v` and
+//! `control_points` row-major with `u` slow (`P_ij` at `i * count_v + j`), the
+//! same `weights`, `provenance`, and a `quality` section ([`SurfaceQualityDoc`]).
+//!
 //! A periodic curve lists all `n + p` control points (the last `p` repeat the
 //! first `p`) and its unclamped knots. Numbers are written in the shortest form
 //! that reads back to the same `f64`, so a write/read round trip is exact.
@@ -24,7 +29,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use scanfit::bspline::{Curve, KnotVector};
+use scanfit::bspline::{Curve, KnotVector, Surface};
 use scanfit::quality::CurveQuality;
 use scanfit::Point3;
 use serde::{Deserialize, Serialize};
@@ -204,6 +209,147 @@ pub fn parse_curve(path: &Path, text: &str) -> Result<(CurveDoc, Curve)> {
     Ok((doc, curve))
 }
 
+/// Error and parameterization measures of a fitted surface, as stored in JSON.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct SurfaceQualityDoc {
+    /// Number of points measured.
+    pub points: usize,
+    /// Mean of `|P_i - S(u_i, v_i)|` (PDE paper eq. 15).
+    pub mean_error: f64,
+    /// Maximum of `|P_i - S(u_i, v_i)|` (PDE paper eq. 15).
+    pub max_error: f64,
+    /// RMSE of `|P_i - S(u_i, v_i)|`.
+    pub rmse: f64,
+    /// Mean orthogonal distance (point inversion).
+    pub mean_distance: f64,
+    /// Maximum orthogonal distance.
+    pub max_distance: f64,
+    /// RMSE of the orthogonal distances.
+    pub rmse_distance: f64,
+    /// Points whose inversion did not converge.
+    pub unconverged: usize,
+    /// MBA paper eq. 17: grid points to nearest input point.
+    pub grid_rmse: f64,
+    /// Delaunay triangles of the parameters.
+    pub triangles: usize,
+    /// Triangles folded over on the surface.
+    pub fold_overs: usize,
+    /// Normalised L2 stretch (1 = uniform up to scale).
+    pub l2_stretch: f64,
+    /// Largest triangle anisotropy.
+    pub max_anisotropy: f64,
+    /// RMSE after each parameter-correction round (round 0 = first fit).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub correction_rmse: Vec<f64>,
+}
+
+/// A surface document as written to and read from JSON.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SurfaceDoc {
+    /// Always [`SCHEMA`].
+    pub schema: String,
+    /// Always `bspline_surface`.
+    #[serde(rename = "type")]
+    pub kind: String,
+    /// Degree in `u`.
+    pub degree_u: usize,
+    /// Degree in `v`.
+    pub degree_v: usize,
+    /// Periodic in `u`.
+    pub periodic_u: bool,
+    /// Periodic in `v`.
+    pub periodic_v: bool,
+    /// Knot vector in `u`.
+    pub knots_u: Vec<f64>,
+    /// Knot vector in `v`.
+    pub knots_v: Vec<f64>,
+    /// Control points in `u`.
+    pub count_u: usize,
+    /// Control points in `v`.
+    pub count_v: usize,
+    /// Control points, row-major with `u` slow.
+    pub control_points: Vec<[f64; 3]>,
+    /// Weights (rational surfaces only), same order.
+    pub weights: Option<Vec<f64>>,
+    /// Where the surface came from.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<Provenance>,
+    /// Error and parameterization measures.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quality: Option<SurfaceQualityDoc>,
+}
+
+impl SurfaceDoc {
+    /// A document for `surface` without provenance or quality.
+    pub fn new(surface: &Surface) -> Self {
+        let (p, q) = surface.degrees();
+        let (cu, cv) = surface.counts();
+        let (pu, pv) = surface.periodic();
+        Self {
+            schema: SCHEMA.into(),
+            kind: "bspline_surface".into(),
+            degree_u: p,
+            degree_v: q,
+            periodic_u: pu,
+            periodic_v: pv,
+            knots_u: surface.knots_u().as_slice().to_vec(),
+            knots_v: surface.knots_v().as_slice().to_vec(),
+            count_u: cu,
+            count_v: cv,
+            control_points: surface.control_points().iter().map(|p| [p.x, p.y, p.z]).collect(),
+            weights: surface.weights().map(|w| w.to_vec()),
+            provenance: None,
+            quality: None,
+        }
+    }
+
+    /// Pretty JSON text.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).unwrap_or_default() + "\n"
+    }
+
+    /// The surface this document describes (validated).
+    pub fn surface(&self) -> scanfit::Result<Surface> {
+        let ku = KnotVector::new(self.knots_u.clone(), self.degree_u)?;
+        let kv = KnotVector::new(self.knots_v.clone(), self.degree_v)?;
+        if ku.basis_count() != self.count_u || kv.basis_count() != self.count_v {
+            return Err(scanfit::Error::InvalidInput(format!(
+                "count_u x count_v = {} x {} does not match the knot vectors ({} x {})",
+                self.count_u,
+                self.count_v,
+                ku.basis_count(),
+                kv.basis_count()
+            )));
+        }
+        let ctrl = self.control_points.iter().map(|c| Point3::new(c[0], c[1], c[2])).collect();
+        Surface::with_options(ku, kv, ctrl, self.weights.clone(), self.periodic_u, self.periodic_v)
+    }
+}
+
+/// Reads a surface document from `path` and builds its surface.
+pub fn read_surface(path: &Path) -> Result<(SurfaceDoc, Surface)> {
+    let text = std::fs::read_to_string(path).map_err(|error| Error::Io {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    let doc: SurfaceDoc = serde_json::from_str(&text).map_err(|e| Error::Parse {
+        path: path.to_path_buf(),
+        line: e.line(),
+        message: format!("not a scanfit surface document: {e}"),
+    })?;
+    if doc.kind != "bspline_surface" {
+        return Err(Error::Invalid {
+            path: path.to_path_buf(),
+            message: format!("type is '{}', expected 'bspline_surface'", doc.kind),
+        });
+    }
+    let surface = doc.surface().map_err(|error| Error::Geometry {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    Ok((doc, surface))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -229,6 +375,23 @@ mod tests {
         for (a, b) in c.control_points().iter().zip(c2.control_points()) {
             assert_eq!(a.x.to_bits(), b.x.to_bits());
         }
+    }
+
+    #[test]
+    fn surface_round_trip_is_exact() {
+        let ku = KnotVector::new(vec![0., 0., 0., 0.3, 1., 1., 1.], 2).unwrap();
+        let kv = KnotVector::uniform_clamped(1, 3).unwrap();
+        let c: Vec<Point3> = (0..12).map(|k| Point3::new(k as f64 / 7.0, (k * k) as f64 * 0.1, -3.47e-15 * k as f64)).collect();
+        let s = Surface::new(ku, kv, c).unwrap();
+        let doc = SurfaceDoc::new(&s);
+        let dir = std::env::temp_dir().join(format!("scanfit-json-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("s.json");
+        std::fs::write(&path, doc.to_json()).unwrap();
+        let (back, s2) = read_surface(&path).unwrap();
+        assert_eq!(back, doc);
+        assert_eq!(s2, s);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -1,13 +1,16 @@
 //! # scanfit-io
 //!
-//! File formats for scanfit: point files in (XYZ/CSV/TXT), curves out and back
-//! (JSON), pictures out (SVG). Every writer is atomic: it writes a temporary
+//! File formats for scanfit: point files in (XYZ/CSV/TXT), curves and surfaces
+//! out and back (JSON), points and meshes out (PLY, OBJ, XYZ), pictures out
+//! (SVG, PNG). Every writer is atomic: it writes a temporary
 //! file next to the target and renames it on success, so a failed run never
 //! leaves a half-written file.
 
 mod atomic;
 mod error;
 pub mod json;
+pub mod ply;
+pub mod render;
 pub mod svg;
 pub mod xyz;
 

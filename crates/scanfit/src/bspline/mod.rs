@@ -4,8 +4,10 @@ mod basis;
 mod curve;
 mod knots;
 mod surface;
+mod tessellate;
 
 pub use basis::{basis_funs, single_basis_ders, BasisWorkspace};
 pub use curve::Curve;
 pub use knots::KnotVector;
 pub use surface::{Direction, Surface};
+pub use tessellate::{tessellate, Mesh};

@@ -1,0 +1,237 @@
+//! Software rendering of surfaces to PNG: no GPU, no window, no system fonts.
+//!
+//! An orthographic camera looks at the object from an azimuth and elevation
+//! (z up) and fits it into the image; triangles are rasterised with a depth
+//! buffer, shaded (two-sided Lambert plus ambient) and coloured by height or
+//! by a per-vertex scalar (viridis), with darker iso-parameter lines; input
+//! points can be drawn on top where they are not hidden by the surface.
+
+use scanfit::bspline::Mesh;
+use scanfit::{Point3, Vector3};
+
+use crate::{Error, Result};
+
+/// What the surface colour shows.
+#[derive(Debug, Clone, Copy)]
+pub enum Colouring<'a> {
+    /// The height (world z), low = dark blue, high = yellow.
+    Height,
+    /// One value per mesh vertex over `range` (e.g. deviation).
+    Scalar {
+        /// values per vertex
+        values: &'a [f64],
+        /// value range mapped onto the colour map
+        range: (f64, f64),
+    },
+}
+
+/// Camera and image settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RenderOptions {
+    /// Image width in pixels (default 1200).
+    pub width: u32,
+    /// Image height in pixels (default 900).
+    pub height: u32,
+    /// Camera azimuth around z, degrees (default -60).
+    pub azimuth: f64,
+    /// Camera elevation above the xy plane, degrees (default 35).
+    pub elevation: f64,
+    /// Iso-parameter lines per direction (default 10; 0 = none).
+    pub iso_lines: usize,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        Self {
+            width: 1200,
+            height: 900,
+            azimuth: -60.0,
+            elevation: 35.0,
+            iso_lines: 10,
+        }
+    }
+}
+
+/// Renders `mesh` (and `points` on top) and returns the PNG bytes.
+pub fn render_png(mesh: &Mesh, points: Option<&[Point3]>, colouring: Colouring, opts: &RenderOptions) -> Result<Vec<u8>> {
+    let img = render_rgb(mesh, points, colouring, opts);
+    encode_png(&img, opts.width, opts.height)
+}
+
+/// Encodes an RGB8 image.
+pub fn encode_png(rgb: &[u8], width: u32, height: u32) -> Result<Vec<u8>> {
+    let mut out = Vec::new();
+    let err = |e: png::EncodingError| Error::Invalid {
+        path: "<png>".into(),
+        message: format!("PNG encoding failed: {e}"),
+    };
+    {
+        let mut enc = png::Encoder::new(&mut out, width, height);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        let mut w = enc.write_header().map_err(err)?;
+        w.write_image_data(rgb).map_err(err)?;
+    }
+    Ok(out)
+}
+
+/// Renders into an RGB8 buffer of `width x height` (row-major, top row first).
+pub fn render_rgb(mesh: &Mesh, points: Option<&[Point3]>, colouring: Colouring, opts: &RenderOptions) -> Vec<u8> {
+    let (w, h) = (opts.width.max(16) as usize, opts.height.max(16) as usize);
+    let (az, el) = (opts.azimuth.to_radians(), opts.elevation.to_radians());
+    // towards the camera, right, up
+    let d = Vector3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
+    let right = Vector3::new(-az.sin(), az.cos(), 0.0);
+    let up = d.cross(&right);
+    let light = (d + 0.4 * up - 0.3 * right).normalize();
+    let proj = |p: &Point3| (p.coords.dot(&right), p.coords.dot(&up), p.coords.dot(&d));
+    let sv: Vec<(f64, f64, f64)> = mesh.vertices.iter().map(proj).collect();
+    let sp: Vec<(f64, f64, f64)> = points.unwrap_or(&[]).iter().map(proj).collect();
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+    let (mut z0, mut z1) = (f64::INFINITY, f64::NEG_INFINITY);
+    for &(x, y, z) in sv.iter().chain(&sp) {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+        z0 = z0.min(z);
+        z1 = z1.max(z);
+    }
+    let mut img = vec![255u8; w * h * 3];
+    if !(x1 > x0 || y1 > y0) {
+        return img;
+    }
+    let margin = 0.05;
+    let scale = ((w as f64) * (1.0 - 2.0 * margin) / (x1 - x0).max(1e-300)).min((h as f64) * (1.0 - 2.0 * margin) / (y1 - y0).max(1e-300));
+    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+    let to_px = |x: f64, y: f64| (w as f64 / 2.0 + (x - cx) * scale, h as f64 / 2.0 - (y - cy) * scale);
+    let heights: Vec<f64> = mesh.vertices.iter().map(|p| p.z).collect();
+    let (vals, (lo, hi)) = match colouring {
+        Colouring::Height => {
+            let lo = heights.iter().cloned().fold(f64::INFINITY, f64::min);
+            let hi = heights.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+            (heights.as_slice(), (lo, hi))
+        }
+        Colouring::Scalar { values, range } => (values, range),
+    };
+    let span = if hi > lo { hi - lo } else { 1.0 };
+    let ((u0, u1), (v0, v1)) = mesh.uv.iter().fold(
+        ((f64::INFINITY, f64::NEG_INFINITY), (f64::INFINITY, f64::NEG_INFINITY)),
+        |((a, b), (c, e)), t| ((a.min(t[0]), b.max(t[0])), (c.min(t[1]), e.max(t[1]))),
+    );
+    let mut depth = vec![f64::NEG_INFINITY; w * h];
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|k| k as usize);
+        let (pa, pb, pc) = (to_px(sv[a].0, sv[a].1), to_px(sv[b].0, sv[b].1), to_px(sv[c].0, sv[c].1));
+        let area = (pb.0 - pa.0) * (pc.1 - pa.1) - (pc.0 - pa.0) * (pb.1 - pa.1);
+        if area.abs() < 1e-12 {
+            continue;
+        }
+        let xmin = pa.0.min(pb.0).min(pc.0).floor().max(0.0) as usize;
+        let xmax = (pa.0.max(pb.0).max(pc.0).ceil() as usize).min(w - 1);
+        let ymin = pa.1.min(pb.1).min(pc.1).floor().max(0.0) as usize;
+        let ymax = (pa.1.max(pb.1).max(pc.1).ceil() as usize).min(h - 1);
+        for py in ymin..=ymax {
+            for px in xmin..=xmax {
+                let (x, y) = (px as f64 + 0.5, py as f64 + 0.5);
+                let w0 = ((pb.0 - x) * (pc.1 - y) - (pc.0 - x) * (pb.1 - y)) / area;
+                let w1 = ((pc.0 - x) * (pa.1 - y) - (pa.0 - x) * (pc.1 - y)) / area;
+                let w2 = 1.0 - w0 - w1;
+                if w0 < -1e-9 || w1 < -1e-9 || w2 < -1e-9 {
+                    continue;
+                }
+                let z = w0 * sv[a].2 + w1 * sv[b].2 + w2 * sv[c].2;
+                let k = py * w + px;
+                if z <= depth[k] {
+                    continue;
+                }
+                depth[k] = z;
+                let n = mesh.normals[a] * w0 + mesh.normals[b] * w1 + mesh.normals[c] * w2;
+                let nn = n.norm();
+                let lambert = if nn > 0.0 { (n.dot(&light) / nn).abs() } else { 0.5 };
+                let shade = 0.3 + 0.7 * lambert;
+                let value = w0 * vals[a] + w1 * vals[b] + w2 * vals[c];
+                let mut col = viridis(((value - lo) / span).clamp(0.0, 1.0));
+                if opts.iso_lines > 0 {
+                    let u = w0 * mesh.uv[a][0] + w1 * mesh.uv[b][0] + w2 * mesh.uv[c][0];
+                    let v = w0 * mesh.uv[a][1] + w1 * mesh.uv[b][1] + w2 * mesh.uv[c][1];
+                    let fu = (u - u0) / (u1 - u0).max(1e-300) * opts.iso_lines as f64;
+                    let fv = (v - v0) / (v1 - v0).max(1e-300) * opts.iso_lines as f64;
+                    let near = |f: f64| (f - f.round()).abs() < 0.012 * opts.iso_lines as f64 / 10.0;
+                    if near(fu) || near(fv) {
+                        col = col.map(|c| c * 0.45);
+                    }
+                }
+                for ch in 0..3 {
+                    img[k * 3 + ch] = (col[ch] * shade * 255.0).round().clamp(0.0, 255.0) as u8;
+                }
+            }
+        }
+    }
+    // points: dark dots where not hidden (1% of the depth range of tolerance)
+    let tol = 0.01 * (z1 - z0).max(1e-300);
+    for &(x, y, z) in &sp {
+        let (px, py) = to_px(x, y);
+        let (px, py) = (px as isize, py as isize);
+        for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+            let (qx, qy) = (px + dx, py + dy);
+            if qx < 0 || qy < 0 || qx >= w as isize || qy >= h as isize {
+                continue;
+            }
+            let k = qy as usize * w + qx as usize;
+            if z + tol >= depth[k] {
+                img[k * 3..k * 3 + 3].copy_from_slice(&[200, 30, 30]);
+            }
+        }
+    }
+    img
+}
+
+/// The viridis colour map (matplotlib), linear between 9 stops.
+pub fn viridis(t: f64) -> [f64; 3] {
+    const STOPS: [[f64; 3]; 9] = [
+        [0.267, 0.005, 0.329],
+        [0.283, 0.141, 0.458],
+        [0.254, 0.265, 0.530],
+        [0.207, 0.372, 0.553],
+        [0.164, 0.471, 0.558],
+        [0.128, 0.567, 0.551],
+        [0.135, 0.659, 0.518],
+        [0.478, 0.821, 0.318],
+        [0.993, 0.906, 0.144],
+    ];
+    let x = t.clamp(0.0, 1.0) * 8.0;
+    let i = (x.floor() as usize).min(7);
+    let f = x - i as f64;
+    [0, 1, 2].map(|c| STOPS[i][c] * (1.0 - f) + STOPS[i + 1][c] * f)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use scanfit::bspline::{tessellate, KnotVector, Surface};
+
+    #[test]
+    fn a_rendered_surface_fills_the_frame_and_is_not_blank() {
+        let ku = KnotVector::uniform_clamped(3, 5).unwrap();
+        let kv = KnotVector::uniform_clamped(3, 5).unwrap();
+        let mut c = Vec::new();
+        for i in 0..5 {
+            for j in 0..5 {
+                c.push(Point3::new(i as f64, j as f64, ((i + j) as f64 * 0.8).sin()));
+            }
+        }
+        let s = Surface::new(ku, kv, c).unwrap();
+        let mesh = tessellate(&s, 40, 40);
+        let opts = RenderOptions { width: 200, height: 150, ..Default::default() };
+        let img = render_rgb(&mesh, None, Colouring::Height, &opts);
+        let painted = img.chunks(3).filter(|p| p != &[255, 255, 255]).count();
+        assert!(painted > 200 * 150 / 4, "{painted}");
+        // nothing drawn in the 2-pixel border (object inside the frame)
+        for x in 0..200 {
+            assert_eq!(&img[x * 3..x * 3 + 3], &[255, 255, 255]);
+        }
+        let png = encode_png(&img, 200, 150).unwrap();
+        assert_eq!(&png[1..4], b"PNG");
+    }
+}
