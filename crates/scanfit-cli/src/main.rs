@@ -5,6 +5,7 @@
 
 mod curve;
 mod progress;
+mod surface;
 mod table;
 
 use clap::{Parser, Subcommand};
@@ -25,12 +26,15 @@ enum Command {
     /// B-spline curves through or near a sequence of points.
     #[command(subcommand)]
     Curve(curve::CurveCommand),
+    /// Least-squares B-spline surface through scattered points, with an error table.
+    Fit(surface::FitArgs),
 }
 
 fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Curve(c) => curve::run(c),
+        Command::Fit(a) => surface::run(a),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

@@ -296,7 +296,11 @@ impl SurfaceDoc {
             knots_v: surface.knots_v().as_slice().to_vec(),
             count_u: cu,
             count_v: cv,
-            control_points: surface.control_points().iter().map(|p| [p.x, p.y, p.z]).collect(),
+            control_points: surface
+                .control_points()
+                .iter()
+                .map(|p| [p.x, p.y, p.z])
+                .collect(),
             weights: surface.weights().map(|w| w.to_vec()),
             provenance: None,
             quality: None,
@@ -321,8 +325,19 @@ impl SurfaceDoc {
                 kv.basis_count()
             )));
         }
-        let ctrl = self.control_points.iter().map(|c| Point3::new(c[0], c[1], c[2])).collect();
-        Surface::with_options(ku, kv, ctrl, self.weights.clone(), self.periodic_u, self.periodic_v)
+        let ctrl = self
+            .control_points
+            .iter()
+            .map(|c| Point3::new(c[0], c[1], c[2]))
+            .collect();
+        Surface::with_options(
+            ku,
+            kv,
+            ctrl,
+            self.weights.clone(),
+            self.periodic_u,
+            self.periodic_v,
+        )
     }
 }
 
@@ -381,7 +396,9 @@ mod tests {
     fn surface_round_trip_is_exact() {
         let ku = KnotVector::new(vec![0., 0., 0., 0.3, 1., 1., 1.], 2).unwrap();
         let kv = KnotVector::uniform_clamped(1, 3).unwrap();
-        let c: Vec<Point3> = (0..12).map(|k| Point3::new(k as f64 / 7.0, (k * k) as f64 * 0.1, -3.47e-15 * k as f64)).collect();
+        let c: Vec<Point3> = (0..12)
+            .map(|k| Point3::new(k as f64 / 7.0, (k * k) as f64 * 0.1, -3.47e-15 * k as f64))
+            .collect();
         let s = Surface::new(ku, kv, c).unwrap();
         let doc = SurfaceDoc::new(&s);
         let dir = std::env::temp_dir().join(format!("scanfit-json-{}", std::process::id()));

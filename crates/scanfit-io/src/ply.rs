@@ -21,13 +21,18 @@ pub enum PlyFormat {
 pub fn points_ply(points: &[Point3], attributes: &[(&str, &[f64])], format: PlyFormat) -> Vec<u8> {
     let mut header = header_start(format);
     let _ = writeln!(header, "element vertex {}", points.len());
-    for name in ["x", "y", "z"].iter().chain(attributes.iter().map(|(n, _)| n)) {
+    for name in ["x", "y", "z"]
+        .iter()
+        .chain(attributes.iter().map(|(n, _)| n))
+    {
         let _ = writeln!(header, "property double {name}");
     }
     header.push_str("end_header\n");
     let mut out = header.into_bytes();
     for (i, p) in points.iter().enumerate() {
-        let vals = [p.x, p.y, p.z].into_iter().chain(attributes.iter().map(|(_, v)| v[i]));
+        let vals = [p.x, p.y, p.z]
+            .into_iter()
+            .chain(attributes.iter().map(|(_, v)| v[i]));
         push_values(&mut out, vals, format);
     }
     out
@@ -35,7 +40,12 @@ pub fn points_ply(points: &[Point3], attributes: &[(&str, &[f64])], format: PlyF
 
 /// A PLY triangle mesh: vertices (double x, y, z, float nx, ny, nz), an optional
 /// per-vertex scalar property `name` and RGB colour, and the faces.
-pub fn mesh_ply(mesh: &Mesh, scalar: Option<(&str, &[f64])>, colours: Option<&[[u8; 3]]>, format: PlyFormat) -> Vec<u8> {
+pub fn mesh_ply(
+    mesh: &Mesh,
+    scalar: Option<(&str, &[f64])>,
+    colours: Option<&[[u8; 3]]>,
+    format: PlyFormat,
+) -> Vec<u8> {
     let mut h = header_start(format);
     let _ = writeln!(h, "element vertex {}", mesh.vertices.len());
     h.push_str("property double x\nproperty double y\nproperty double z\n");
@@ -66,7 +76,10 @@ pub fn mesh_ply(mesh: &Mesh, scalar: Option<(&str, &[f64])>, colours: Option<&[[
                 }
             }
             PlyFormat::Ascii => {
-                let mut line = format!("{:?} {:?} {:?} {:?} {:?} {:?}", p.x, p.y, p.z, n.x as f32, n.y as f32, n.z as f32);
+                let mut line = format!(
+                    "{:?} {:?} {:?} {:?} {:?} {:?}",
+                    p.x, p.y, p.z, n.x as f32, n.y as f32, n.z as f32
+                );
                 if let Some((_, s)) = scalar {
                     let _ = write!(line, " {:?}", s[i]);
                 }
@@ -86,7 +99,9 @@ pub fn mesh_ply(mesh: &Mesh, scalar: Option<(&str, &[f64])>, colours: Option<&[[
                     out.extend_from_slice(&(k as i32).to_le_bytes());
                 }
             }
-            PlyFormat::Ascii => out.extend_from_slice(format!("3 {} {} {}\n", t[0], t[1], t[2]).as_bytes()),
+            PlyFormat::Ascii => {
+                out.extend_from_slice(format!("3 {} {} {}\n", t[0], t[1], t[2]).as_bytes())
+            }
         }
     }
     out
@@ -139,7 +154,10 @@ fn header_start(format: PlyFormat) -> String {
         PlyFormat::Binary => "binary_little_endian",
         PlyFormat::Ascii => "ascii",
     };
-    format!("ply\nformat {f} 1.0\ncomment written by scanfit {}\n", env!("CARGO_PKG_VERSION"))
+    format!(
+        "ply\nformat {f} 1.0\ncomment written by scanfit {}\n",
+        env!("CARGO_PKG_VERSION")
+    )
 }
 
 fn push_values(out: &mut Vec<u8>, vals: impl Iterator<Item = f64>, format: PlyFormat) {

@@ -38,6 +38,30 @@ pub struct RenderOptions {
     pub elevation: f64,
     /// Iso-parameter lines per direction (default 10; 0 = none).
     pub iso_lines: usize,
+    /// Vertical exaggeration: z is multiplied by this before drawing (default 1;
+    /// see [`auto_exaggeration`] for flat data such as terrain).
+    pub z_scale: f64,
+}
+
+/// A vertical exaggeration that makes the relief of flat data visible: the
+/// factor that brings the z range to 20% of the larger horizontal extent,
+/// rounded to one significant digit; 1 when the data are not flat.
+pub fn auto_exaggeration(points: &[Point3]) -> f64 {
+    let (lo, hi) = points.iter().fold(
+        (
+            Vector3::repeat(f64::INFINITY),
+            Vector3::repeat(f64::NEG_INFINITY),
+        ),
+        |(lo, hi), p| (lo.inf(&p.coords), hi.sup(&p.coords)),
+    );
+    let ext = hi - lo;
+    let horizontal = ext.x.max(ext.y);
+    if !(ext.z > 0.0) || ext.z >= 0.1 * horizontal {
+        return 1.0;
+    }
+    let f = 0.2 * horizontal / ext.z;
+    let mag = 10f64.powf(f.log10().floor());
+    (f / mag).round() * mag
 }
 
 impl Default for RenderOptions {
@@ -48,12 +72,18 @@ impl Default for RenderOptions {
             azimuth: -60.0,
             elevation: 35.0,
             iso_lines: 10,
+            z_scale: 1.0,
         }
     }
 }
 
 /// Renders `mesh` (and `points` on top) and returns the PNG bytes.
-pub fn render_png(mesh: &Mesh, points: Option<&[Point3]>, colouring: Colouring, opts: &RenderOptions) -> Result<Vec<u8>> {
+pub fn render_png(
+    mesh: &Mesh,
+    points: Option<&[Point3]>,
+    colouring: Colouring,
+    opts: &RenderOptions,
+) -> Result<Vec<u8>> {
     let img = render_rgb(mesh, points, colouring, opts);
     encode_png(&img, opts.width, opts.height)
 }
@@ -76,7 +106,12 @@ pub fn encode_png(rgb: &[u8], width: u32, height: u32) -> Result<Vec<u8>> {
 }
 
 /// Renders into an RGB8 buffer of `width x height` (row-major, top row first).
-pub fn render_rgb(mesh: &Mesh, points: Option<&[Point3]>, colouring: Colouring, opts: &RenderOptions) -> Vec<u8> {
+pub fn render_rgb(
+    mesh: &Mesh,
+    points: Option<&[Point3]>,
+    colouring: Colouring,
+    opts: &RenderOptions,
+) -> Vec<u8> {
     let (w, h) = (opts.width.max(16) as usize, opts.height.max(16) as usize);
     let (az, el) = (opts.azimuth.to_radians(), opts.elevation.to_radians());
     // towards the camera, right, up
@@ -84,10 +119,23 @@ pub fn render_rgb(mesh: &Mesh, points: Option<&[Point3]>, colouring: Colouring, 
     let right = Vector3::new(-az.sin(), az.cos(), 0.0);
     let up = d.cross(&right);
     let light = (d + 0.4 * up - 0.3 * right).normalize();
-    let proj = |p: &Point3| (p.coords.dot(&right), p.coords.dot(&up), p.coords.dot(&d));
+    let zs = if opts.z_scale > 0.0 && opts.z_scale.is_finite() {
+        opts.z_scale
+    } else {
+        1.0
+    };
+    let proj = |p: &Point3| {
+        let c = Vector3::new(p.x, p.y, p.z * zs);
+        (c.dot(&right), c.dot(&up), c.dot(&d))
+    };
     let sv: Vec<(f64, f64, f64)> = mesh.vertices.iter().map(proj).collect();
     let sp: Vec<(f64, f64, f64)> = points.unwrap_or(&[]).iter().map(proj).collect();
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
     let (mut z0, mut z1) = (f64::INFINITY, f64::NEG_INFINITY);
     for &(x, y, z) in sv.iter().chain(&sp) {
         x0 = x0.min(x);
@@ -102,9 +150,15 @@ pub fn render_rgb(mesh: &Mesh, points: Option<&[Point3]>, colouring: Colouring, 
         return img;
     }
     let margin = 0.05;
-    let scale = ((w as f64) * (1.0 - 2.0 * margin) / (x1 - x0).max(1e-300)).min((h as f64) * (1.0 - 2.0 * margin) / (y1 - y0).max(1e-300));
+    let scale = ((w as f64) * (1.0 - 2.0 * margin) / (x1 - x0).max(1e-300))
+        .min((h as f64) * (1.0 - 2.0 * margin) / (y1 - y0).max(1e-300));
     let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-    let to_px = |x: f64, y: f64| (w as f64 / 2.0 + (x - cx) * scale, h as f64 / 2.0 - (y - cy) * scale);
+    let to_px = |x: f64, y: f64| {
+        (
+            w as f64 / 2.0 + (x - cx) * scale,
+            h as f64 / 2.0 - (y - cy) * scale,
+        )
+    };
     let heights: Vec<f64> = mesh.vertices.iter().map(|p| p.z).collect();
     let (vals, (lo, hi)) = match colouring {
         Colouring::Height => {
@@ -116,13 +170,20 @@ pub fn render_rgb(mesh: &Mesh, points: Option<&[Point3]>, colouring: Colouring, 
     };
     let span = if hi > lo { hi - lo } else { 1.0 };
     let ((u0, u1), (v0, v1)) = mesh.uv.iter().fold(
-        ((f64::INFINITY, f64::NEG_INFINITY), (f64::INFINITY, f64::NEG_INFINITY)),
+        (
+            (f64::INFINITY, f64::NEG_INFINITY),
+            (f64::INFINITY, f64::NEG_INFINITY),
+        ),
         |((a, b), (c, e)), t| ((a.min(t[0]), b.max(t[0])), (c.min(t[1]), e.max(t[1]))),
     );
     let mut depth = vec![f64::NEG_INFINITY; w * h];
     for t in &mesh.triangles {
         let [a, b, c] = t.map(|k| k as usize);
-        let (pa, pb, pc) = (to_px(sv[a].0, sv[a].1), to_px(sv[b].0, sv[b].1), to_px(sv[c].0, sv[c].1));
+        let (pa, pb, pc) = (
+            to_px(sv[a].0, sv[a].1),
+            to_px(sv[b].0, sv[b].1),
+            to_px(sv[c].0, sv[c].1),
+        );
         let area = (pb.0 - pa.0) * (pc.1 - pa.1) - (pc.0 - pa.0) * (pb.1 - pa.1);
         if area.abs() < 1e-12 {
             continue;
@@ -146,9 +207,14 @@ pub fn render_rgb(mesh: &Mesh, points: Option<&[Point3]>, colouring: Colouring, 
                     continue;
                 }
                 depth[k] = z;
-                let n = mesh.normals[a] * w0 + mesh.normals[b] * w1 + mesh.normals[c] * w2;
+                let mut n = mesh.normals[a] * w0 + mesh.normals[b] * w1 + mesh.normals[c] * w2;
+                n.z /= zs; // normals transform with the inverse transpose of the scaling
                 let nn = n.norm();
-                let lambert = if nn > 0.0 { (n.dot(&light) / nn).abs() } else { 0.5 };
+                let lambert = if nn > 0.0 {
+                    (n.dot(&light) / nn).abs()
+                } else {
+                    0.5
+                };
                 let shade = 0.3 + 0.7 * lambert;
                 let value = w0 * vals[a] + w1 * vals[b] + w2 * vals[c];
                 let mut col = viridis(((value - lo) / span).clamp(0.0, 1.0));
@@ -157,7 +223,8 @@ pub fn render_rgb(mesh: &Mesh, points: Option<&[Point3]>, colouring: Colouring, 
                     let v = w0 * mesh.uv[a][1] + w1 * mesh.uv[b][1] + w2 * mesh.uv[c][1];
                     let fu = (u - u0) / (u1 - u0).max(1e-300) * opts.iso_lines as f64;
                     let fv = (v - v0) / (v1 - v0).max(1e-300) * opts.iso_lines as f64;
-                    let near = |f: f64| (f - f.round()).abs() < 0.012 * opts.iso_lines as f64 / 10.0;
+                    let near =
+                        |f: f64| (f - f.round()).abs() < 0.012 * opts.iso_lines as f64 / 10.0;
                     if near(fu) || near(fv) {
                         col = col.map(|c| c * 0.45);
                     }
@@ -168,12 +235,17 @@ pub fn render_rgb(mesh: &Mesh, points: Option<&[Point3]>, colouring: Colouring, 
             }
         }
     }
-    // points: dark dots where not hidden (1% of the depth range of tolerance)
+    // points: small red dots where not hidden (1% of the depth range of tolerance)
     let tol = 0.01 * (z1 - z0).max(1e-300);
+    let dot: &[(isize, isize)] = if sp.len() > 2000 {
+        &[(0, 0)]
+    } else {
+        &[(0, 0), (1, 0), (0, 1), (1, 1)]
+    };
     for &(x, y, z) in &sp {
         let (px, py) = to_px(x, y);
         let (px, py) = (px as isize, py as isize);
-        for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+        for &(dx, dy) in dot {
             let (qx, qy) = (px + dx, py + dy);
             if qx < 0 || qy < 0 || qx >= w as isize || qy >= h as isize {
                 continue;
@@ -218,12 +290,20 @@ mod tests {
         let mut c = Vec::new();
         for i in 0..5 {
             for j in 0..5 {
-                c.push(Point3::new(i as f64, j as f64, ((i + j) as f64 * 0.8).sin()));
+                c.push(Point3::new(
+                    i as f64,
+                    j as f64,
+                    ((i + j) as f64 * 0.8).sin(),
+                ));
             }
         }
         let s = Surface::new(ku, kv, c).unwrap();
         let mesh = tessellate(&s, 40, 40);
-        let opts = RenderOptions { width: 200, height: 150, ..Default::default() };
+        let opts = RenderOptions {
+            width: 200,
+            height: 150,
+            ..Default::default()
+        };
         let img = render_rgb(&mesh, None, Colouring::Height, &opts);
         let painted = img.chunks(3).filter(|p| p != &[255, 255, 255]).count();
         assert!(painted > 200 * 150 / 4, "{painted}");

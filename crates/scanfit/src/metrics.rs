@@ -126,7 +126,8 @@ pub fn grid_rmse(
 /// Quality of a parameterization of scattered points on a surface.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ParamQuality {
-    /// Triangles of the Delaunay triangulation of the parameters.
+    /// Triangles of the Delaunay triangulation of the parameters (without the
+    /// slivers along its hull, whose longest edge exceeds 4x the median).
     pub triangles: usize,
     /// Triangles whose orientation on the surface (data points, signed by the
     /// surface normal) is opposite to their orientation in `(u, v)`.
@@ -177,10 +178,23 @@ pub fn parameterization_quality(
         .collect();
     let tri: DelaunayTriangulation<Vertex> = DelaunayTriangulation::bulk_load(verts)
         .map_err(|e| Error::InvalidInput(format!("cannot triangulate the parameters: {e:?}")))?;
-    let faces: Vec<[usize; 3]> = tri
+    let all: Vec<[usize; 3]> = tri
         .inner_faces()
         .map(|f| f.vertices().map(|v| v.data().index))
         .collect();
+    // Triangles with an edge longer than 4x the median edge are slivers along
+    // the convex hull of the parameters (or across holes): artefacts of
+    // triangulating a point set, not part of the parameterization.
+    let edge = |a: usize, b: usize| (uv[a][0] - uv[b][0]).hypot(uv[a][1] - uv[b][1]);
+    let longest = |f: &[usize; 3]| edge(f[0], f[1]).max(edge(f[1], f[2])).max(edge(f[2], f[0]));
+    let mut lengths: Vec<f64> = all.iter().map(longest).collect();
+    lengths.sort_by(f64::total_cmp);
+    let limit = 4.0
+        * lengths
+            .get(lengths.len() / 2)
+            .copied()
+            .unwrap_or(f64::INFINITY);
+    let faces: Vec<[usize; 3]> = all.into_iter().filter(|f| longest(f) <= limit).collect();
     let (p, q) = surface.degrees();
     // per triangle: (folded, 3D area, uv area, L2^2, anisotropy)
     let per: Vec<(bool, f64, f64, f64, f64)> = faces

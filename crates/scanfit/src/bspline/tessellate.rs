@@ -39,7 +39,12 @@ pub fn tessellate(surface: &Surface, nu: usize, nv: usize) -> Mesh {
     let w = (nv + 1) as u32;
     for i in 0..nu as u32 {
         for j in 0..nv as u32 {
-            let (a, b, c, e) = (i * w + j, (i + 1) * w + j, (i + 1) * w + j + 1, i * w + j + 1);
+            let (a, b, c, e) = (
+                i * w + j,
+                (i + 1) * w + j,
+                (i + 1) * w + j + 1,
+                i * w + j + 1,
+            );
             mesh.triangles.push([a, b, c]);
             mesh.triangles.push([a, c, e]);
         }

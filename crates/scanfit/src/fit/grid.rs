@@ -75,7 +75,7 @@ pub fn fit_grid(
     }
     let at = |k: usize, l: usize| points[k * cols + l];
     // averaged chord-length parameters; a closed u direction includes the closing chord
-    let params_u = averaged(rows, cols, cfg.periodic_u, |k, l| at(k, l))?;
+    let params_u = averaged(rows, cols, cfg.periodic_u, at)?;
     let params_v = averaged(cols, rows, false, |l, k| at(k, l))?;
     let (ku, kv) = match cfg.ctrl {
         None => (
