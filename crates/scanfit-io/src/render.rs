@@ -56,7 +56,7 @@ pub fn auto_exaggeration(points: &[Point3]) -> f64 {
     );
     let ext = hi - lo;
     let horizontal = ext.x.max(ext.y);
-    if !(ext.z > 0.0) || ext.z >= 0.1 * horizontal {
+    if ext.z.is_nan() || ext.z <= 0.0 || ext.z >= 0.1 * horizontal {
         return 1.0;
     }
     let f = 0.2 * horizontal / ext.z;
@@ -269,7 +269,7 @@ pub fn viridis(t: f64) -> [f64; 3] {
         [0.164, 0.471, 0.558],
         [0.128, 0.567, 0.551],
         [0.135, 0.659, 0.518],
-        [0.478, 0.821, 0.318],
+        [0.478, 0.821, 0.319],
         [0.993, 0.906, 0.144],
     ];
     let x = t.clamp(0.0, 1.0) * 8.0;
