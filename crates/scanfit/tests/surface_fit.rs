@@ -243,12 +243,7 @@ fn bad_input_is_reported() {
 fn grid_interpolation_matches_the_nurbs_book_algorithm() {
     use scanfit::fit::grid::{fit_grid, GridFitConfig};
     let g = load("surface_grid_interp.json");
-    let grid: Vec<Point3> = g["grid"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .flat_map(|row| pts(row))
-        .collect();
+    let grid: Vec<Point3> = g["grid"].as_array().unwrap().iter().flat_map(pts).collect();
     let (rows, cols) = (
         g["grid"].as_array().unwrap().len(),
         g["grid"][0].as_array().unwrap().len(),
