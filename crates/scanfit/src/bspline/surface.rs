@@ -195,6 +195,36 @@ impl Surface {
         let (ku, kv) = (du.len() / (p + 1) - 1, dv.len() / (q + 1) - 1);
         let cv = self.knots_v.basis_count();
         out.iter_mut().for_each(|o| *o = Vector3::zeros());
+        if self.weights.is_none() && (order + 1) * (p + 1) <= 64 {
+            // Non-rational fast path, contracted in two stages: first along v,
+            // tmp[l][a] = sum_b M_b^(l)(v) P_{a,b}, then along u,
+            // S^(k,l) = sum_a N_a^(k)(u) tmp[l][a].
+            let mut tmp = [Vector3::zeros(); 64];
+            let lmax = order.min(kv);
+            for a in 0..=p {
+                let row = (su - p + a) * cv + sv - q;
+                let ctrl = &self.ctrl[row..=row + q];
+                for l in 0..=lmax {
+                    let dvl = &dv[l * (q + 1)..(l + 1) * (q + 1)];
+                    let mut acc = Vector3::zeros();
+                    for (c, &m) in ctrl.iter().zip(dvl) {
+                        acc += c.coords * m;
+                    }
+                    tmp[l * (p + 1) + a] = acc;
+                }
+            }
+            for k in 0..=order.min(ku) {
+                let duk = &du[k * (p + 1)..(k + 1) * (p + 1)];
+                for l in 0..=(order - k).min(lmax) {
+                    let mut acc = Vector3::zeros();
+                    for (t, &nk) in tmp[l * (p + 1)..(l + 1) * (p + 1)].iter().zip(duk) {
+                        acc += t * nk;
+                    }
+                    out[k * d1 + l] = acc;
+                }
+            }
+            return;
+        }
         // homogeneous derivatives A^(k,l) and w^(k,l) (w = 1 when non-rational);
         // orders above 7 are not supported for rational surfaces (stack buffer)
         // (stride 8 in `wd`: orders up to 7)

@@ -2,7 +2,9 @@
 //! (*The NURBS Book* section 6.1, eqs. 6.5-6.8).
 //!
 //! Start: the nearest vertex of a parameter grid sampled on the surface, found
-//! with a KD-tree (kiddo). Iteration: Newton on `f = r.S_u = 0`, `g = r.S_v = 0`
+//! with a KD-tree (kiddo), moved by one Gauss-Newton step on the tangent plane
+//! stored with the vertex (no surface evaluation; the start error drops from
+//! O(h) to O(h^2)). Iteration: Newton on `f = r.S_u = 0`, `g = r.S_v = 0`
 //! (`r = S - P`) with the full Jacobian; when it is not positive definite (far
 //! from a minimum) a Gauss-Newton step is taken instead, and a step that does
 //! not reduce the distance is halved. Parameters are clamped to the domain, or
@@ -81,6 +83,8 @@ pub struct SurfaceInverter<'s> {
     surface: &'s Surface,
     tree: ImmutableKdTree<f64, 3>,
     grid: Vec<[f64; 2]>,
+    /// Point and tangents `S, S_u, S_v` at each grid vertex.
+    frames: Vec<[Vector3; 3]>,
     cfg: InversionConfig,
     scale: f64,
 }
@@ -102,13 +106,18 @@ impl<'s> SurfaceInverter<'s> {
                 ]);
             }
         }
-        let pts: Vec<[f64; 3]> = grid
+        let frames: Vec<[Vector3; 3]> = grid
             .par_iter()
-            .map(|t| {
-                let p = surface.point(t[0], t[1]);
-                [p.x, p.y, p.z]
-            })
+            .map_init(
+                || InversionWorkspace::new(surface),
+                |ws, t| {
+                    let mut d = [Vector3::zeros(); 4];
+                    surface.derivatives_into(t[0], t[1], &mut ws.wu, &mut ws.wv, 1, &mut d);
+                    [d[0], d[2], d[1]]
+                },
+            )
             .collect();
+        let pts: Vec<[f64; 3]> = frames.iter().map(|f| [f[0].x, f[0].y, f[0].z]).collect();
         let scale = crate::geom::bbox_diagonal(surface.control_points()).max(f64::MIN_POSITIVE);
         let tree = ImmutableKdTree::new_from_slice(&pts).map_err(|e| {
             Error::InvalidInput(format!("could not index the surface samples: {e:?}"))
@@ -117,6 +126,7 @@ impl<'s> SurfaceInverter<'s> {
             surface,
             tree,
             grid,
+            frames,
             cfg,
             scale,
         })
@@ -135,7 +145,7 @@ impl<'s> SurfaceInverter<'s> {
             .query(&q)
             .nearest_one::<SquaredEuclidean<f64>>()
             .execute();
-        let mut best = self.invert_from(p, self.grid[first.item as usize], ws);
+        let mut best = self.invert_from(p, self.refined_start(p, first.item as usize), ws);
         if best.converged || self.cfg.starts <= 1 {
             return best;
         }
@@ -148,7 +158,7 @@ impl<'s> SurfaceInverter<'s> {
             .execute();
         let mut iterations = best.iterations;
         for item in more.iter().skip(1) {
-            let r = self.invert_from(p, self.grid[item.item as usize], ws);
+            let r = self.invert_from(p, self.refined_start(p, item.item as usize), ws);
             iterations += r.iterations;
             if (r.converged && !best.converged) || r.distance < best.distance {
                 best = r;
@@ -188,6 +198,34 @@ impl<'s> SurfaceInverter<'s> {
                 },
             )
             .collect()
+    }
+
+    /// The grid vertex `k` moved by one Gauss-Newton step on its stored tangent
+    /// plane: the start's error drops from O(h) to O(h^2) without evaluating
+    /// the surface.
+    fn refined_start(&self, p: &Point3, k: usize) -> [f64; 2] {
+        let [s, su, sv] = self.frames[k];
+        let r = s - p.coords;
+        let (a, b, c) = (su.norm_squared(), su.dot(&sv), sv.norm_squared());
+        let det = a * c - b * b;
+        let [u, v] = self.grid[k];
+        if det.is_nan() || det <= 1e-300 {
+            return [u, v];
+        }
+        let (f, g) = (r.dot(&su), r.dot(&sv));
+        let ((u0, u1), (v0, v1)) = self.surface.domain();
+        let (pu, pv) = self.surface.periodic();
+        let wrap = |x: f64, lo: f64, hi: f64, periodic: bool| {
+            if periodic {
+                lo + (x - lo).rem_euclid(hi - lo)
+            } else {
+                x.clamp(lo, hi)
+            }
+        };
+        [
+            wrap(u - (c * f - b * g) / det, u0, u1, pu),
+            wrap(v - (a * g - b * f) / det, v0, v1, pv),
+        ]
     }
 
     /// Newton iteration from `uv0`.
@@ -263,15 +301,17 @@ impl<'s> SurfaceInverter<'s> {
                 dv = 0.0;
                 du = if a > 0.0 { -f / a } else { -f / (nsu * nsu) };
             }
-            // halve the step until the distance decreases
+            // halve the step until the distance decreases (judged on the point
+            // alone; derivatives are evaluated only where the iteration goes on)
             let mut t = 1.0;
             let mut accepted = false;
             let (mut nu_, mut nv_) = (u, v);
+            let mut np = Point3::origin();
             for _ in 0..30 {
                 nu_ = wrap(u + t * du, u0, u1, pu);
                 nv_ = wrap(v + t * dv, v0, v1, pv);
-                s.derivatives_into(nu_, nv_, &mut ws.wu, &mut ws.wv, 2, &mut d);
-                let nr = d[0] - p.coords;
+                np = s.point(nu_, nv_);
+                let nr = np - p;
                 let nd = nr.norm();
                 // accept unless the distance grows beyond rounding: near the
                 // minimum it is flat to rounding while the parameters still improve
@@ -286,16 +326,23 @@ impl<'s> SurfaceInverter<'s> {
             let step = ((nu_ - u) * nsu).hypot((nv_ - v) * nsv);
             if !accepted {
                 // no decrease along the step: at a (constrained) minimum up to rounding
-                s.derivatives_into(u, v, &mut ws.wu, &mut ws.wv, 2, &mut d);
                 converged = step <= 1e3 * eps1.max(dist * 1e-12);
                 break;
             }
+            let dparam = ((nu_ - u) / (u1 - u0))
+                .abs()
+                .max(((nv_ - v) / (v1 - v0)).abs());
             u = nu_;
             v = nv_;
-            if step <= eps1 {
+            // Newton converges quadratically: after a relative parameter step
+            // below 1e-7 the remaining error is of order 1e-14, so the iteration
+            // stops here without evaluating derivatives again
+            if step <= eps1 || (dparam <= 1e-7 && t == 1.0) {
+                d[0] = np.coords;
                 converged = true;
                 break;
             }
+            s.derivatives_into(u, v, &mut ws.wu, &mut ws.wv, 2, &mut d);
         }
         Inversion {
             uv: [u, v],
