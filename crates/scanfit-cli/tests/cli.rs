@@ -330,3 +330,221 @@ fn review_regressions() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(String::from_utf8_lossy(&o.stdout).contains("centripetal"));
 }
+
+/// Writes `n` points of a smooth sheet, with a header, optionally with u, v columns.
+fn sheet(path: &std::path::Path, n: usize, with_uv: bool) {
+    let mut s = String::from(if with_uv { "x y z u v\n" } else { "x y z\n" });
+    for k in 0..n {
+        let (u, v) = (
+            ((k * 7919) % n) as f64 / n as f64,
+            ((k * 104729) % 997) as f64 / 996.0,
+        );
+        let (x, y, z) = (
+            30.0 * u,
+            20.0 * v,
+            2.0 * (2.0 * u).sin() * (3.0 * v).cos() + u * v,
+        );
+        if with_uv {
+            s += &format!("{x} {y} {z} {u} {v}\n");
+        } else {
+            s += &format!("{x} {y} {z}\n");
+        }
+    }
+    std::fs::write(path, s).unwrap();
+}
+
+#[test]
+fn surface_fit_writes_every_output() {
+    let d = tmpdir("sfit");
+    let input = d.join("sheet.xyz");
+    sheet(&input, 3000, false);
+    let (json, png, mesh, ply) = (
+        d.join("s.json"),
+        d.join("s.png"),
+        d.join("s.obj"),
+        d.join("p.ply"),
+    );
+    let o = run(&[
+        "fit",
+        input.to_str().unwrap(),
+        "--ctrl",
+        "12x10",
+        "-o",
+        json.to_str().unwrap(),
+        "--png",
+        png.to_str().unwrap(),
+        "--mesh",
+        mesh.to_str().unwrap(),
+        "--points-out",
+        ply.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("eq. 15") && out.contains("MBA eq. 17") && out.contains("fold-overs"),
+        "{out}"
+    );
+    let (doc, s) = scanfit_io::json::read_surface(&json).unwrap();
+    assert_eq!(s.counts(), (12, 10));
+    let q = doc.quality.unwrap();
+    assert!(q.rmse < 0.05 && q.fold_overs == 0, "{q:?}");
+    assert!(q.max_distance <= q.max_error + 1e-12);
+    let png_bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&png_bytes[1..4], b"PNG");
+    let obj = std::fs::read_to_string(&mesh).unwrap();
+    assert!(obj.lines().filter(|l| l.starts_with("f ")).count() > 1000);
+    let ply_bytes = std::fs::read(&ply).unwrap();
+    let header = String::from_utf8_lossy(&ply_bytes[..400]);
+    assert!(header.contains("element vertex 3000") && header.contains("property double residual"));
+}
+
+#[test]
+fn surface_fit_from_uv_columns_is_exact_for_representable_data() {
+    let d = tmpdir("suv");
+    let input = d.join("plane.xyz");
+    // a bilinear-in-(u,v) sheet is represented exactly by any bicubic net
+    let mut s = String::from("x,y,z,u,v\n");
+    for k in 0..500 {
+        let (u, v) = (
+            ((k * 37) % 500) as f64 / 499.0,
+            ((k * 91) % 499) as f64 / 498.0,
+        );
+        s += &format!("{},{},{},{u},{v}\n", 3.0 * u + v, 2.0 * v, 0.5 * u * v - u);
+    }
+    std::fs::write(&input, s).unwrap();
+    let o = run(&[
+        "fit",
+        input.to_str().unwrap(),
+        "--params",
+        "uv-columns",
+        "--ctrl",
+        "6",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(v["quality"]["max_error"].as_f64().unwrap() < 1e-9, "{v}");
+    // correction rounds appear in the report
+    let o = run(&[
+        "fit",
+        input.to_str().unwrap(),
+        "--ctrl",
+        "6",
+        "--correct",
+        "3",
+        "--json",
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(!v["quality"]["correction_rmse"]
+        .as_array()
+        .unwrap()
+        .is_empty());
+}
+
+#[test]
+fn surface_fit_bad_input() {
+    let d = tmpdir("sbad");
+    let small = d.join("small.xyz");
+    sheet(&small, 50, true);
+    let expect = |args: &[&str], needle: &str| {
+        let o = run(args);
+        assert!(!o.status.success(), "{args:?} should fail");
+        let e = stderr(&o);
+        assert!(
+            e.contains(needle) && !e.contains("panicked"),
+            "{args:?}: '{needle}' not in {e}"
+        );
+    };
+    let f = small.to_str().unwrap();
+    expect(
+        &["fit", f, "--ctrl", "10x10"],
+        "50 points given, but a least-squares surface with 100 control points",
+    );
+    expect(
+        &[
+            "fit",
+            f,
+            "--params",
+            "uv-columns",
+            "--ctrl",
+            "4",
+            "--mesh",
+            "x.stl",
+        ],
+        "must end in .obj or .ply",
+    );
+    expect(
+        &["fit", f, "--periodic-u"],
+        "--periodic-u needs parameters that go around",
+    );
+    expect(
+        &["fit", f, "--ctrl", "axb"],
+        "--ctrl 'axb' must be N or NxM",
+    );
+    let same_u = d.join("sameu.xyz");
+    std::fs::write(
+        &same_u,
+        (0..40)
+            .map(|k| format!("{k} {} 0 0.5 {}\n", k % 7, k as f64 / 39.0))
+            .collect::<String>(),
+    )
+    .unwrap();
+    expect(
+        &[
+            "fit",
+            same_u.to_str().unwrap(),
+            "--params",
+            "uv-columns",
+            "--ctrl",
+            "4",
+        ],
+        "no columns named u and v",
+    );
+    let same_u2 = d.join("sameu2.xyz");
+    std::fs::write(
+        &same_u2,
+        String::from("x y z u v\n")
+            + &(0..40)
+                .map(|k| format!("{k} {} 0 0.5 {}\n", k % 7, k as f64 / 39.0))
+                .collect::<String>(),
+    )
+    .unwrap();
+    expect(
+        &[
+            "fit",
+            same_u2.to_str().unwrap(),
+            "--params",
+            "uv-columns",
+            "--ctrl",
+            "4",
+        ],
+        "only 1 distinct u parameters",
+    );
+    let outside = d.join("outside.xyz");
+    std::fs::write(
+        &outside,
+        String::from("x y z u v\n")
+            + &(0..40)
+                .map(|k| {
+                    format!(
+                        "{k} {} 0 {} {}\n",
+                        k % 7,
+                        1.5 - (k % 2) as f64,
+                        k as f64 / 39.0
+                    )
+                })
+                .collect::<String>(),
+    )
+    .unwrap();
+    expect(
+        &[
+            "fit",
+            outside.to_str().unwrap(),
+            "--params",
+            "uv-columns",
+            "--ctrl",
+            "4",
+        ],
+        "outside the domain",
+    );
+}
