@@ -177,22 +177,71 @@ impl Curve {
 
     /// Evaluates the curve at every `us[i]` into `out[i]`. Allocation-free for any
     /// degree up to 15; consecutive parameters in the same span skip the search.
+    /// Degrees 1 to 3 run a loop specialised at compile time (unrolled basis).
     pub fn eval_many(&self, us: &[f64], out: &mut [Point3]) {
-        let p = self.degree();
-        if p > STACK_DEGREE {
-            for (o, &u) in out.iter_mut().zip(us) {
-                *o = self.point(u);
+        match self.degree() {
+            1 => self.eval_many_fixed::<2>(us, out),
+            2 => self.eval_many_fixed::<3>(us, out),
+            3 => self.eval_many_fixed::<4>(us, out),
+            p if p <= STACK_DEGREE => self.eval_many_generic(us, out),
+            _ => {
+                for (o, &u) in out.iter_mut().zip(us) {
+                    *o = self.point(u);
+                }
             }
-            return;
         }
+    }
+
+    /// `eval_many` for degree `Q - 1`, with the basis recursion on fixed-size arrays.
+    fn eval_many_fixed<const Q: usize>(&self, us: &[f64], out: &mut [Point3]) {
         let t = self.knots.as_slice();
+        let p = Q - 1;
+        let (a, b) = self.domain();
+        let last = t.len() - p - 2;
+        let mut s = p;
+        let mut n = [0.0; Q];
+        let (mut left, mut right) = ([0.0; Q], [0.0; Q]);
+        for (o, &u) in out.iter_mut().zip(us) {
+            let u = if self.periodic {
+                self.wrap(u)
+            } else {
+                u.clamp(a, b)
+            };
+            if !(t[s] <= u && (u < t[s + 1] || (s == last && u <= t[s + 1]))) {
+                s = find_span(t, p, u);
+            }
+            // A2.2 with compile-time bounds
+            n[0] = 1.0;
+            for j in 1..Q {
+                left[j] = u - t[s + 1 - j];
+                right[j] = t[s + j] - u;
+                let mut saved = 0.0;
+                for r in 0..j {
+                    let temp = n[r] / (right[r + 1] + left[j - r]);
+                    n[r] = saved + right[r + 1] * temp;
+                    saved = left[j - r] * temp;
+                }
+                n[j] = saved;
+            }
+            *o = self.combine(s, &n);
+        }
+    }
+
+    fn eval_many_generic(&self, us: &[f64], out: &mut [Point3]) {
+        let p = self.degree();
+        let t = self.knots.as_slice();
+        let (a, b) = self.domain();
         let mut n = [0.0; STACK_DEGREE + 1];
         let mut left = [0.0; STACK_DEGREE + 1];
         let mut right = [0.0; STACK_DEGREE + 1];
         let last = t.len() - p - 2;
         let mut s = p;
         for (o, &u) in out.iter_mut().zip(us) {
-            let u = self.wrap(u);
+            let u = if self.periodic {
+                self.wrap(u)
+            } else {
+                u.clamp(a, b)
+            };
             // span hint: reuse the previous span when u is still inside it
             if !(t[s] <= u && (u < t[s + 1] || (s == last && u <= t[s + 1]))) {
                 s = find_span(t, p, u);
