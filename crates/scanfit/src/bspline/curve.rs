@@ -192,7 +192,9 @@ impl Curve {
         }
     }
 
-    /// `eval_many` for degree `Q - 1`, with the basis recursion on fixed-size arrays.
+    /// `eval_many` for degree `Q - 1`, with the basis recursion (A2.2) written out
+    /// on fixed-size arrays. This repeats [`basis_funs`] on purpose: calling it
+    /// with a constant degree does not unroll (45 M points/s instead of 75 M).
     fn eval_many_fixed<const Q: usize>(&self, us: &[f64], out: &mut [Point3]) {
         let t = self.knots.as_slice();
         let p = Q - 1;

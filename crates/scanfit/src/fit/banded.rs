@@ -217,39 +217,59 @@ impl BandLu {
         }
     }
 
-    /// Hager's estimate of `||A^{-1}||_1` (Higham 1988, Algorithm 2.1), times `||A||_1`.
+    /// Hager's estimate of `||A^{-1}||_1`, times `||A||_1`.
     fn estimate_condition(&self) -> f64 {
-        let n = self.a.n;
-        let mut x = vec![1.0 / n as f64; n];
-        let mut est = 0.0;
-        for _ in 0..5 {
-            let mut y = x.clone();
-            self.solve_in_place(&mut y, 1);
-            est = y.iter().map(|v| v.abs()).sum::<f64>();
-            let mut z: Vec<f64> = y
-                .iter()
-                .map(|&v| if v >= 0.0 { 1.0 } else { -1.0 })
-                .collect();
-            self.solve_transposed(&mut z);
-            let (jmax, zmax) = z.iter().enumerate().fold((0, 0.0f64), |(bj, bv), (j, &v)| {
-                if v.abs() > bv {
-                    (j, v.abs())
-                } else {
-                    (bj, bv)
-                }
-            });
-            let ztx: f64 = z.iter().zip(&x).map(|(a, b)| a * b).sum();
-            if zmax <= ztx {
-                break;
-            }
-            x.iter_mut().for_each(|v| *v = 0.0);
-            x[jmax] = 1.0;
+        let est = hager_inverse_norm1(
+            self.a.n,
+            |x| {
+                self.solve_in_place(x, 1);
+                Ok(())
+            },
+            |x| {
+                self.solve_transposed(x);
+                Ok(())
+            },
+        );
+        match est {
+            Ok(e) if e.is_finite() => e * self.norm,
+            _ => f64::INFINITY,
         }
-        if !est.is_finite() {
-            return f64::INFINITY;
-        }
-        est * self.norm
     }
+}
+
+/// Hager's estimate of `||A^{-1}||_1` (Higham 1988, Algorithm 2.1) from solves
+/// with `A` and `A^T` (each overwriting its argument with the solution).
+pub(crate) fn hager_inverse_norm1(
+    n: usize,
+    mut solve: impl FnMut(&mut [f64]) -> Result<()>,
+    mut solve_t: impl FnMut(&mut [f64]) -> Result<()>,
+) -> Result<f64> {
+    let mut x = vec![1.0 / n as f64; n];
+    let mut est = 0.0;
+    for _ in 0..5 {
+        let mut y = x.clone();
+        solve(&mut y)?;
+        est = y.iter().map(|v| v.abs()).sum::<f64>();
+        let mut z: Vec<f64> = y
+            .iter()
+            .map(|&v| if v >= 0.0 { 1.0 } else { -1.0 })
+            .collect();
+        solve_t(&mut z)?;
+        let (jmax, zmax) = z.iter().enumerate().fold((0, 0.0f64), |(bj, bv), (j, &v)| {
+            if v.abs() > bv {
+                (j, v.abs())
+            } else {
+                (bj, bv)
+            }
+        });
+        let ztx: f64 = z.iter().zip(&x).map(|(a, b)| a * b).sum();
+        if zmax <= ztx {
+            break;
+        }
+        x.iter_mut().for_each(|v| *v = 0.0);
+        x[jmax] = 1.0;
+    }
+    Ok(est)
 }
 
 /// Solves a small dense system `A x = b` (row-major `n x n`, `nrhs` columns) by

@@ -9,7 +9,7 @@
 //! Schoenberg-Whitney conditions (interpolation), so it is factored by
 //! [`super::banded`] without pivoting. Cost `O(n w^2)`, memory `O(n w)`.
 
-use super::banded::{dense_solve, BandMatrix};
+use super::banded::{dense_solve, hager_inverse_norm1, BandMatrix};
 use crate::{Error, Result};
 
 /// An `n x n` matrix whose non-zeros lie within cyclic distance `w` of the diagonal.
@@ -96,31 +96,11 @@ impl CyclicBandMatrix {
         }
         let norm = col.into_iter().fold(0.0, f64::max);
         let at = self.transpose();
-        let mut x = vec![1.0 / n as f64; n];
-        let mut est = 0.0;
-        for _ in 0..5 {
-            let mut y = x.clone();
-            self.solve_raw(&mut y, 1, what)?;
-            est = y.iter().map(|v| v.abs()).sum::<f64>();
-            let mut z: Vec<f64> = y
-                .iter()
-                .map(|&v| if v >= 0.0 { 1.0 } else { -1.0 })
-                .collect();
-            at.solve_raw(&mut z, 1, what)?;
-            let (jmax, zmax) = z.iter().enumerate().fold((0, 0.0f64), |(bj, bv), (j, &v)| {
-                if v.abs() > bv {
-                    (j, v.abs())
-                } else {
-                    (bj, bv)
-                }
-            });
-            let ztx: f64 = z.iter().zip(&x).map(|(a, b)| a * b).sum();
-            if zmax <= ztx {
-                break;
-            }
-            x.iter_mut().for_each(|v| *v = 0.0);
-            x[jmax] = 1.0;
-        }
+        let est = hager_inverse_norm1(
+            n,
+            |y| self.solve_raw(y, 1, what),
+            |z| at.solve_raw(z, 1, what),
+        )?;
         Ok(if est.is_finite() {
             est * norm
         } else {

@@ -122,27 +122,7 @@ fn check_inputs(points: &[Point3], params: &[f64], opts: &LeastSquaresOptions) -
             points.len()
         )));
     }
-    if let Some(w) = opts.weights {
-        if w.len() != points.len() {
-            return Err(Error::InvalidInput(format!(
-                "{} weights for {} points",
-                w.len(),
-                points.len()
-            )));
-        }
-        if let Some(i) = w.iter().position(|&v| !(v.is_finite() && v >= 0.0)) {
-            return Err(Error::InvalidInput(format!(
-                "weight of point {i} is {}; weights must be finite and non-negative",
-                w[i]
-            )));
-        }
-    }
-    if !(opts.smoothing.is_finite() && opts.smoothing >= 0.0) {
-        return Err(Error::InvalidInput(format!(
-            "smoothing weight {} must be finite and non-negative",
-            opts.smoothing
-        )));
-    }
+    super::validate_weights_and_smoothing(opts.weights, points.len(), opts.smoothing)?;
     Ok(())
 }
 

@@ -77,3 +77,32 @@ fn prepare_points<'a>(
     validate_distinct_consecutive(pts, closed)?;
     Ok(pts)
 }
+
+/// Checks optional point weights (one finite non-negative value per point) and
+/// a smoothing weight (finite, non-negative); shared by curve and surface fits.
+pub(crate) fn validate_weights_and_smoothing(
+    weights: Option<&[f64]>,
+    points: usize,
+    smoothing: f64,
+) -> Result<()> {
+    if let Some(w) = weights {
+        if w.len() != points {
+            return Err(Error::InvalidInput(format!(
+                "{} weights for {points} points",
+                w.len()
+            )));
+        }
+        if let Some(i) = w.iter().position(|&x| !(x.is_finite() && x >= 0.0)) {
+            return Err(Error::InvalidInput(format!(
+                "weight of point {i} is {}; weights must be finite and non-negative",
+                w[i]
+            )));
+        }
+    }
+    if !(smoothing.is_finite() && smoothing >= 0.0) {
+        return Err(Error::InvalidInput(format!(
+            "smoothing weight {smoothing} must be finite and non-negative"
+        )));
+    }
+    Ok(())
+}
