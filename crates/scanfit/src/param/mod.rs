@@ -162,30 +162,37 @@ pub fn parameterize(
             what: format!("{method} parameterization for degree {degree}"),
         });
     }
-    if let Some(a) = method.exponent() {
-        let params = exponential::params(points, a, closed)?;
-        check_increasing(&params, &method.to_string())?;
-        return Ok(Parameterization {
-            params,
-            knots: None,
-        });
-    }
-    if closed {
-        return Err(Error::InvalidInput(format!(
-            "{method} parameterization is defined for open curves only; use chord, centripetal or exponential for a closed curve"
-        )));
-    }
+    let open_only = |m: &Method| -> Result<()> {
+        if closed {
+            return Err(Error::InvalidInput(format!(
+                "{m} parameterization is defined for open curves only; use chord, centripetal or exponential for a closed curve"
+            )));
+        }
+        Ok(())
+    };
     let (params, knots) = match method {
-        Method::Universal => universal::params(points.len(), degree)?,
-        Method::Hybrid => hybrid::params(points, degree)?,
-        Method::Proposed(a) => proposed::params(points, degree, a)?,
-        _ => unreachable!("exponential family handled above"),
+        Method::Uniform | Method::ChordLength | Method::Centripetal | Method::Exponential(_) => {
+            let a = method.exponent().unwrap_or(1.0);
+            (exponential::params(points, a, closed)?, None)
+        }
+        Method::Universal => {
+            open_only(&method)?;
+            let (u, k) = universal::params(points.len(), degree)?;
+            (u, Some(k))
+        }
+        Method::Hybrid => {
+            open_only(&method)?;
+            let (u, k) = hybrid::params(points, degree)?;
+            (u, Some(k))
+        }
+        Method::Proposed(a) => {
+            open_only(&method)?;
+            let (u, k) = proposed::params(points, degree, a)?;
+            (u, Some(k))
+        }
     };
     check_increasing(&params, &method.to_string())?;
-    Ok(Parameterization {
-        params,
-        knots: Some(knots),
-    })
+    Ok(Parameterization { params, knots })
 }
 
 /// Errors unless `params` is strictly increasing, finite and in `[0, 1]`.
