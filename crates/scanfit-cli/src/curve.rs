@@ -9,6 +9,7 @@ use scanfit::param::Method;
 use scanfit::quality::{curve_quality, CurveQuality, QualityConfig};
 use scanfit::Vector3;
 use scanfit_io::json::{CurveDoc, Provenance, QualityDoc};
+use scanfit_io::step::{step_file, CadItem};
 use scanfit_io::svg::{curve_panels, Panel, PanelSize};
 use scanfit_io::{read_points, write_all_atomic, write_atomic, PointTable};
 use serde::Serialize;
@@ -91,6 +92,9 @@ pub struct FitArgs {
     /// Write a picture of the data, curve and control polygon.
     #[arg(long, value_name = "OUT.svg")]
     pub svg: Option<PathBuf>,
+    /// Write the curve as a STEP file (AP214 wireframe; open curves).
+    #[arg(long, value_name = "OUT.stp")]
+    pub step: Option<PathBuf>,
     /// Print the result as JSON on stdout instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -261,6 +265,17 @@ fn fit_cmd(a: FitArgs) -> Result<()> {
             curve_panels(&[panel], 1, "", PanelSize::SINGLE).into_bytes(),
         ));
     }
+    if let Some(st) = &a.step {
+        let name = a
+            .input
+            .file_stem()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        files.push((
+            st,
+            step_file(&[CadItem::Curve(&fit.curve)], &name)?.into_bytes(),
+        ));
+    }
     let refs: Vec<(&Path, &[u8])> = files.iter().map(|(p, b)| (*p, b.as_slice())).collect();
     write_all_atomic(&refs)?;
     if a.json {
@@ -347,7 +362,11 @@ fn print_fit(a: &FitArgs, fit: &CurveFit, q: &CurveQuality, kind: &str, n: usize
         t.row(vec![m.into(), v, u.into()]);
     }
     print!("{}", t.render());
-    for (what, p) in [("curve", &a.output), ("picture", &a.svg)] {
+    for (what, p) in [
+        ("curve", &a.output),
+        ("picture", &a.svg),
+        ("STEP file", &a.step),
+    ] {
         if let Some(p) = p {
             println!("wrote {what}: {}", p.display());
         }

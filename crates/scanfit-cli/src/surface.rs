@@ -16,6 +16,7 @@ use scanfit::project::{InversionConfig, SurfaceInverter};
 use scanfit_io::json::{Provenance, SurfaceDoc, SurfaceQualityDoc};
 use scanfit_io::ply::{mesh_obj, mesh_ply, points_ply, points_xyz, PlyFormat};
 use scanfit_io::render::{auto_exaggeration, render_png, Colouring, RenderOptions};
+use scanfit_io::step::{step_file, CadItem};
 use scanfit_io::{read_points, write_all_atomic};
 
 use crate::progress::Progress;
@@ -67,6 +68,9 @@ pub struct FitArgs {
     /// Write the surface as JSON (schema scanfit/1).
     #[arg(short, long, value_name = "SURFACE.json")]
     pub output: Option<PathBuf>,
+    /// Write the surface as a STEP file (AP214; a face in an open shell).
+    #[arg(long, value_name = "OUT.stp")]
+    pub step: Option<PathBuf>,
     /// Write a triangle mesh of the surface (.obj or .ply).
     #[arg(long, value_name = "OUT")]
     pub mesh: Option<PathBuf>,
@@ -118,6 +122,7 @@ pub fn run(a: FitArgs) -> Result<()> {
         (&a.mesh, "--mesh", &["obj", "ply"][..]),
         (&a.points_out, "--points-out", &["ply", "xyz"][..]),
         (&a.png, "--png", &["png"][..]),
+        (&a.step, "--step", &["stp", "step"][..]),
     ] {
         if let Some(p) = p {
             if !allowed.contains(&extension(p).as_str()) {
@@ -239,6 +244,17 @@ pub fn run(a: FitArgs) -> Result<()> {
     let mut files: Vec<(&Path, Vec<u8>)> = Vec::new();
     if let Some(o) = &a.output {
         files.push((o, doc.to_json().into_bytes()));
+    }
+    if let Some(st) = &a.step {
+        let name = a
+            .input
+            .file_stem()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        files.push((
+            st,
+            step_file(&[CadItem::Surface(&surface)], &name)?.into_bytes(),
+        ));
     }
     let (cu, cv) = surface.counts();
     let mesh = tessellate(&surface, (cu * 4).clamp(32, 400), (cv * 4).clamp(32, 400));

@@ -11,6 +11,7 @@ mod error;
 pub mod json;
 pub mod ply;
 pub mod render;
+pub mod step;
 pub mod svg;
 pub mod xyz;
 
