@@ -8,6 +8,7 @@ use scanfit::fit::{self, ApproximationConfig, CurveFit, InterpolationConfig};
 use scanfit::param::Method;
 use scanfit::quality::{curve_quality, CurveQuality, QualityConfig};
 use scanfit::Vector3;
+use scanfit_io::iges::iges_file;
 use scanfit_io::json::{CurveDoc, Provenance, QualityDoc};
 use scanfit_io::step::{step_file, CadItem};
 use scanfit_io::svg::{curve_panels, Panel, PanelSize};
@@ -95,6 +96,9 @@ pub struct FitArgs {
     /// Write the curve as a STEP file (AP214 wireframe; open curves).
     #[arg(long, value_name = "OUT.stp")]
     pub step: Option<PathBuf>,
+    /// Write the same as an IGES 5.3 file (entity 126 or 128).
+    #[arg(long, value_name = "OUT.igs")]
+    pub iges: Option<PathBuf>,
     /// Print the result as JSON on stdout instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -276,6 +280,17 @@ fn fit_cmd(a: FitArgs) -> Result<()> {
             step_file(&[CadItem::Curve(&fit.curve)], &name)?.into_bytes(),
         ));
     }
+    if let Some(ig) = &a.iges {
+        let name = a
+            .input
+            .file_stem()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        files.push((
+            ig,
+            iges_file(&[CadItem::Curve(&fit.curve)], &name)?.into_bytes(),
+        ));
+    }
     let refs: Vec<(&Path, &[u8])> = files.iter().map(|(p, b)| (*p, b.as_slice())).collect();
     write_all_atomic(&refs)?;
     if a.json {
@@ -366,6 +381,7 @@ fn print_fit(a: &FitArgs, fit: &CurveFit, q: &CurveQuality, kind: &str, n: usize
         ("curve", &a.output),
         ("picture", &a.svg),
         ("STEP file", &a.step),
+        ("IGES file", &a.iges),
     ] {
         if let Some(p) = p {
             println!("wrote {what}: {}", p.display());

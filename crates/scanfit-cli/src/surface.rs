@@ -13,6 +13,7 @@ use scanfit::metrics::{
     ParamQuality,
 };
 use scanfit::project::{InversionConfig, SurfaceInverter};
+use scanfit_io::iges::iges_file;
 use scanfit_io::json::{Provenance, SurfaceDoc, SurfaceQualityDoc};
 use scanfit_io::ply::{mesh_obj, mesh_ply, points_ply, points_xyz, PlyFormat};
 use scanfit_io::render::{auto_exaggeration, render_png, Colouring, RenderOptions};
@@ -71,6 +72,9 @@ pub struct FitArgs {
     /// Write the surface as a STEP file (AP214; a face in an open shell).
     #[arg(long, value_name = "OUT.stp")]
     pub step: Option<PathBuf>,
+    /// Write the same as an IGES 5.3 file (entity 126 or 128).
+    #[arg(long, value_name = "OUT.igs")]
+    pub iges: Option<PathBuf>,
     /// Write a triangle mesh of the surface (.obj or .ply).
     #[arg(long, value_name = "OUT")]
     pub mesh: Option<PathBuf>,
@@ -123,6 +127,7 @@ pub fn run(a: FitArgs) -> Result<()> {
         (&a.points_out, "--points-out", &["ply", "xyz"][..]),
         (&a.png, "--png", &["png"][..]),
         (&a.step, "--step", &["stp", "step"][..]),
+        (&a.iges, "--iges", &["igs", "iges"][..]),
     ] {
         if let Some(p) = p {
             if !allowed.contains(&extension(p).as_str()) {
@@ -254,6 +259,17 @@ pub fn run(a: FitArgs) -> Result<()> {
         files.push((
             st,
             step_file(&[CadItem::Surface(&surface)], &name)?.into_bytes(),
+        ));
+    }
+    if let Some(ig) = &a.iges {
+        let name = a
+            .input
+            .file_stem()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        files.push((
+            ig,
+            iges_file(&[CadItem::Surface(&surface)], &name)?.into_bytes(),
         ));
     }
     let (cu, cv) = surface.counts();

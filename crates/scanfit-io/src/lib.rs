@@ -8,6 +8,7 @@
 
 mod atomic;
 mod error;
+pub mod iges;
 pub mod json;
 pub mod ply;
 pub mod render;

@@ -1,5 +1,5 @@
 //! CAD files read back by a real CAD kernel: OpenCASCADE (the cadquery-ocp
-//! wheel) loads the STEP file and its surfaces and curves must evaluate equal
+//! wheel) loads the STEP and IGES files and its surfaces and curves must evaluate equal
 //! to scanfit's at sample parameters to 1e-9 (`tests/occ/check_cad.py`).
 //! Without OpenCASCADE the test says so loudly; with `SCANFIT_REQUIRE_OCC=1`
 //! (set by CI, which installs it) a missing OpenCASCADE is a failure.
@@ -11,6 +11,7 @@ use std::process::Command;
 
 use scanfit::bspline::{Curve, KnotVector, Surface};
 use scanfit::Point3;
+use scanfit_io::iges::iges_file;
 use scanfit_io::step::{step_file, CadItem};
 
 fn surfaces() -> (Surface, Surface) {
@@ -55,7 +56,7 @@ fn occ_available() -> bool {
 }
 
 #[test]
-fn step_read_back_by_opencascade() {
+fn step_and_iges_read_back_by_opencascade() {
     let dir = std::env::temp_dir().join(format!("scanfit-cad-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let (s1, s2) = surfaces();
@@ -75,6 +76,13 @@ fn step_read_back_by_opencascade() {
     assert_eq!(text.matches("RATIONAL_B_SPLINE_SURFACE(").count(), 1);
     let step = dir.join("t.stp");
     std::fs::write(&step, &text).unwrap();
+    let iges = dir.join("t.igs");
+    let items = [
+        CadItem::Surface(&s1),
+        CadItem::Surface(&s2),
+        CadItem::Curve(&c),
+    ];
+    std::fs::write(&iges, iges_file(&items, "scanfit test").unwrap()).unwrap();
     let mut samples = serde_json::json!({"surfaces": [], "curves": []});
     for s in [&s1, &s2] {
         let pts: Vec<[f64; 5]> = (0..=6)
@@ -118,12 +126,13 @@ fn step_read_back_by_opencascade() {
         .arg(script)
         .arg(&sp)
         .arg(&step)
+        .arg(&iges)
         .output()
         .unwrap();
     let out = String::from_utf8_lossy(&o.stdout);
     let err = String::from_utf8_lossy(&o.stderr);
     println!("{out}{err}");
     assert!(o.status.success(), "OpenCASCADE disagrees:\n{out}\n{err}");
-    assert!(out.contains("2 faces, 1 curves"), "{out}");
+    assert_eq!(out.matches("2 faces, 1 curves").count(), 2, "{out}");
     std::fs::remove_dir_all(&dir).ok();
 }
