@@ -9,14 +9,15 @@ use scanfit::bspline::{tessellate, Surface};
 use scanfit::fit::correction::{correct_parameters, CorrectionConfig, CorrectionRound};
 use scanfit::fit::surface::{fit_surface, KnotPlacement, SurfaceFitConfig};
 use scanfit::metrics::{
-    grid_rmse, orthogonal_errors, parameterization_quality, parametric_distances, ErrorStats,
-    ParamQuality,
+    grid_rmse, nearest_points, orthogonal_errors, parameterization_quality, parametric_distances,
+    ErrorStats, ParamQuality,
 };
 use scanfit::project::{InversionConfig, SurfaceInverter};
+use scanfit_io::gltf::mesh_glb;
 use scanfit_io::iges::iges_file;
 use scanfit_io::json::{Provenance, SurfaceDoc, SurfaceQualityDoc};
 use scanfit_io::ply::{mesh_obj, mesh_ply, points_ply, points_xyz, PlyFormat};
-use scanfit_io::render::{auto_exaggeration, render_png, Colouring, RenderOptions};
+use scanfit_io::render::{auto_exaggeration, render_png, viridis, Colouring, RenderOptions};
 use scanfit_io::step::{step_file, CadItem};
 use scanfit_io::{read_points, write_all_atomic};
 
@@ -75,12 +76,19 @@ pub struct FitArgs {
     /// Write the same as an IGES 5.3 file (entity 126 or 128).
     #[arg(long, value_name = "OUT.igs")]
     pub iges: Option<PathBuf>,
-    /// Write a triangle mesh of the surface (.obj or .ply).
+    /// Write a triangle mesh of the surface (.obj, .ply or .glb; PLY and glb
+    /// carry the local fit error, the orthogonal distance of each vertex's
+    /// nearest input point, as a colour, PLY also as the property `deviation`).
     #[arg(long, value_name = "OUT")]
     pub mesh: Option<PathBuf>,
     /// Write a shaded, height-coloured picture with the input points.
     #[arg(long, value_name = "OUT.png")]
     pub png: Option<PathBuf>,
+    /// Write a picture of the surface coloured by the local fit error (the
+    /// orthogonal distance of the nearest input point), with a colour bar and
+    /// the error figures.
+    #[arg(long, value_name = "OUT.png")]
+    pub deviation_png: Option<PathBuf>,
     /// Write the points with u, v, residual and orthogonal distance (.ply or .xyz).
     #[arg(long, value_name = "POINTS")]
     pub points_out: Option<PathBuf>,
@@ -123,7 +131,8 @@ pub fn run(a: FitArgs) -> Result<()> {
         k => bail!("unknown knot placement '{k}'; use distribution or uniform"),
     };
     for (p, what, allowed) in [
-        (&a.mesh, "--mesh", &["obj", "ply"][..]),
+        (&a.mesh, "--mesh", &["obj", "ply", "glb"][..]),
+        (&a.deviation_png, "--deviation-png", &["png"][..]),
         (&a.points_out, "--points-out", &["ply", "xyz"][..]),
         (&a.png, "--png", &["png"][..]),
         (&a.step, "--step", &["stp", "step"][..]),
@@ -274,16 +283,76 @@ pub fn run(a: FitArgs) -> Result<()> {
     }
     let (cu, cv) = surface.counts();
     let mesh = tessellate(&surface, (cu * 4).clamp(32, 400), (cv * 4).clamp(32, 400));
-    if let Some(m) = &a.mesh {
-        let bytes = if extension(m) == "obj" {
-            mesh_obj(
-                &mesh,
-                &format!("scanfit surface fitted to {}", a.input.display()),
+    // fit error on the surface: each mesh vertex shows the orthogonal distance
+    // of its nearest input point (the local residual), on the same scale as
+    // the error table
+    let deviation =
+        if a.deviation_png.is_some() || a.mesh.as_deref().is_some_and(|m| extension(m) != "obj") {
+            let near = nearest_points(pts, &mesh.vertices)?;
+            Some(
+                near.iter()
+                    .map(|&(i, _)| inv[i].distance)
+                    .collect::<Vec<f64>>(),
             )
         } else {
-            mesh_ply(&mesh, None, None, PlyFormat::Binary)
+            None
+        };
+    let dmax = orth.max;
+    let colours: Option<Vec<[u8; 3]>> = deviation.as_ref().map(|d| {
+        d.iter()
+            .map(|&x| {
+                viridis(if dmax > 0.0 { x / dmax } else { 0.0 }).map(|c| (c * 255.0).round() as u8)
+            })
+            .collect()
+    });
+    if let Some(m) = &a.mesh {
+        let name = a
+            .input
+            .file_stem()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let bytes = match extension(m).as_str() {
+            "obj" => mesh_obj(
+                &mesh,
+                &format!("scanfit surface fitted to {}", a.input.display()),
+            ),
+            "glb" => mesh_glb(&mesh, colours.as_deref(), &name),
+            _ => mesh_ply(
+                &mesh,
+                deviation.as_deref().map(|d| ("deviation", d)),
+                colours.as_deref(),
+                PlyFormat::Binary,
+            ),
         };
         files.push((m, bytes));
+    }
+    if let (Some(dp), Some(d)) = (&a.deviation_png, &deviation) {
+        let opts = RenderOptions {
+            z_scale: auto_exaggeration(pts),
+            legend: vec![
+                format!(
+                    "{}: colour = orthogonal distance of the nearest input point to the surface [data units]",
+                    a.input.display()
+                ),
+                format!(
+                    "input points to surface (orthogonal): mean {}  max {}  RMSE {}  [data units]",
+                    num(orth.mean),
+                    num(orth.max),
+                    num(orth.rmse)
+                ),
+            ],
+            ..Default::default()
+        };
+        let bytes = render_png(
+            &mesh,
+            None,
+            Colouring::Scalar {
+                values: d,
+                range: (0.0, dmax),
+            },
+            &opts,
+        )?;
+        files.push((dp, bytes));
     }
     if let Some(pout) = &a.points_out {
         let u: Vec<f64> = uv.iter().map(|t| t[0]).collect();

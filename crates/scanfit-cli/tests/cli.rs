@@ -548,3 +548,51 @@ fn surface_fit_bad_input() {
         "outside the domain",
     );
 }
+
+#[test]
+fn surface_fit_cad_mesh_and_deviation_outputs() {
+    let d = tmpdir("scad");
+    let input = d.join("sheet.xyz");
+    sheet(&input, 2000, false);
+    let names = ["s.stp", "s.igs", "s.glb", "m.ply", "dev.png"];
+    let paths: Vec<_> = names.iter().map(|n| d.join(n)).collect();
+    let o = run(&[
+        "fit",
+        input.to_str().unwrap(),
+        "--ctrl",
+        "10",
+        "--step",
+        paths[0].to_str().unwrap(),
+        "--iges",
+        paths[1].to_str().unwrap(),
+        "--mesh",
+        paths[2].to_str().unwrap(),
+        "--deviation-png",
+        paths[4].to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run(&[
+        "fit",
+        input.to_str().unwrap(),
+        "--ctrl",
+        "10",
+        "-q",
+        "--mesh",
+        paths[3].to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let step = std::fs::read_to_string(&paths[0]).unwrap();
+    assert!(step.contains("ADVANCED_FACE") && step.contains("B_SPLINE_SURFACE_WITH_KNOTS"));
+    let iges = std::fs::read_to_string(&paths[1]).unwrap();
+    assert!(iges.lines().all(|l| l.len() == 80) && iges.contains("     128"));
+    let glb = std::fs::read(&paths[2]).unwrap();
+    assert_eq!(&glb[0..4], b"glTF");
+    let ply = std::fs::read(&paths[3]).unwrap();
+    let head = String::from_utf8_lossy(&ply[..600]);
+    assert!(
+        head.contains("property double deviation") && head.contains("property uchar red"),
+        "{head}"
+    );
+    let png = std::fs::read(&paths[4]).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+}

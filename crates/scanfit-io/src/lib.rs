@@ -8,6 +8,7 @@
 
 mod atomic;
 mod error;
+pub mod gltf;
 pub mod iges;
 pub mod json;
 pub mod ply;

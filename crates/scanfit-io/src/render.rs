@@ -26,7 +26,7 @@ pub enum Colouring<'a> {
 }
 
 /// Camera and image settings.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct RenderOptions {
     /// Image width in pixels (default 1200).
     pub width: u32,
@@ -38,6 +38,8 @@ pub struct RenderOptions {
     pub elevation: f64,
     /// Iso-parameter lines per direction (default 10; 0 = none).
     pub iso_lines: usize,
+    /// Lines of text drawn at the top left (title, figures).
+    pub legend: Vec<String>,
     /// Vertical exaggeration: z is multiplied by this before drawing (default 1;
     /// see [`auto_exaggeration`] for flat data such as terrain).
     pub z_scale: f64,
@@ -72,6 +74,7 @@ impl Default for RenderOptions {
             azimuth: -60.0,
             elevation: 35.0,
             iso_lines: 10,
+            legend: Vec::new(),
             z_scale: 1.0,
         }
     }
@@ -256,7 +259,105 @@ pub fn render_rgb(
             }
         }
     }
+    if let Colouring::Scalar { range, .. } = colouring {
+        colour_bar(&mut img, w, h, range);
+    }
+    let mut canvas = Canvas {
+        rgb: &mut img,
+        width: w,
+        height: h,
+    };
+    for (k, line) in opts.legend.iter().enumerate() {
+        draw_text(&mut canvas, 8, 6 + 14 * k, line, 1, [20, 20, 20]);
+    }
     img
+}
+
+/// An RGB8 image being drawn on (row-major, top row first).
+pub struct Canvas<'a> {
+    /// The pixels, 3 bytes each.
+    pub rgb: &'a mut [u8],
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+}
+
+/// Draws `text` with the 8x8 bitmap font (font8x8, public domain) at pixel
+/// `(x, y)`, each font pixel `scale x scale` image pixels.
+pub fn draw_text(canvas: &mut Canvas, x: usize, y: usize, text: &str, scale: usize, rgb: [u8; 3]) {
+    use font8x8::UnicodeFonts;
+    for (k, ch) in text.chars().enumerate() {
+        let Some(glyph) = font8x8::BASIC_FONTS.get(ch) else {
+            continue;
+        };
+        for (row, bits) in glyph.iter().enumerate() {
+            for col in 0..8 {
+                if bits & (1 << col) == 0 {
+                    continue;
+                }
+                for dy in 0..scale {
+                    for dx in 0..scale {
+                        let (px, py) = (x + (k * 8 + col) * scale + dx, y + row * scale + dy);
+                        if px < canvas.width && py < canvas.height {
+                            let o = (py * canvas.width + px) * 3;
+                            canvas.rgb[o..o + 3].copy_from_slice(&rgb);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A vertical viridis bar at the right edge with its range written beside it.
+fn colour_bar(img: &mut [u8], w: usize, h: usize, range: (f64, f64)) {
+    let (x0, x1) = (w.saturating_sub(110), w.saturating_sub(90));
+    let (y0, y1) = (h / 6, h - h / 6);
+    for y in y0..y1 {
+        let t = 1.0 - (y - y0) as f64 / (y1 - y0).max(1) as f64;
+        let c = viridis(t).map(|v| (v * 255.0).round() as u8);
+        for x in x0..x1 {
+            img[(y * w + x) * 3..(y * w + x) * 3 + 3].copy_from_slice(&c);
+        }
+    }
+    let label = |v: f64| {
+        if v != 0.0 && !(1e-3..1e5).contains(&v.abs()) {
+            format!("{v:.2e}")
+        } else {
+            format!("{v:.4}")
+        }
+    };
+    let (lo, hi) = range;
+    let mut c = Canvas {
+        rgb: img,
+        width: w,
+        height: h,
+    };
+    draw_text(
+        &mut c,
+        x1 + 6,
+        y0.saturating_sub(4),
+        &label(hi),
+        1,
+        [20, 20, 20],
+    );
+    draw_text(
+        &mut c,
+        x1 + 6,
+        (y0 + y1) / 2 - 4,
+        &label(0.5 * (lo + hi)),
+        1,
+        [20, 20, 20],
+    );
+    draw_text(
+        &mut c,
+        x1 + 6,
+        y1.saturating_sub(4),
+        &label(lo),
+        1,
+        [20, 20, 20],
+    );
 }
 
 /// The viridis colour map (matplotlib), linear between 9 stops.

@@ -103,24 +103,46 @@ pub fn grid_rmse(
                 .collect(),
         ),
     };
+    let g: Vec<Point3> = us
+        .iter()
+        .flat_map(|&u| vs.iter().map(move |&v| (u, v)))
+        .map(|(u, v)| surface.point(u, v))
+        .collect();
+    let d = nearest_distances(points, &g)?;
+    let sum: f64 = d.iter().map(|x| x * x).sum();
+    Ok((sum / g.len() as f64).sqrt())
+}
+
+/// Distance from each of `queries` to the nearest of `points` (KD-tree, in
+/// parallel): the deviation of a surface's sample points (mesh vertices, grid
+/// points) from the data.
+pub fn nearest_distances(points: &[Point3], queries: &[Point3]) -> Result<Vec<f64>> {
+    Ok(nearest_points(points, queries)?
+        .into_iter()
+        .map(|(_, d)| d)
+        .collect())
+}
+
+/// Index of and distance to the nearest of `points` for each of `queries`.
+pub fn nearest_points(points: &[Point3], queries: &[Point3]) -> Result<Vec<(usize, f64)>> {
+    if points.is_empty() {
+        return Err(Error::InvalidInput(
+            "no points to measure distances to".into(),
+        ));
+    }
     let coords: Vec<[f64; 3]> = points.iter().map(|p| [p.x, p.y, p.z]).collect();
     let tree: ImmutableKdTree<f64, 3> = ImmutableKdTree::new_from_slice(&coords)
         .map_err(|e| Error::InvalidInput(format!("could not index the points: {e:?}")))?;
-    let g: Vec<[f64; 2]> = us
-        .iter()
-        .flat_map(|&u| vs.iter().map(move |&v| [u, v]))
-        .collect();
-    let sum: f64 = g
+    Ok(queries
         .par_iter()
-        .map(|t| {
-            let s = surface.point(t[0], t[1]);
-            tree.query(&[s.x, s.y, s.z])
+        .map(|q| {
+            let r = tree
+                .query(&[q.x, q.y, q.z])
                 .nearest_one::<SquaredEuclidean<f64>>()
-                .execute()
-                .distance
+                .execute();
+            (r.item as usize, r.distance.sqrt())
         })
-        .sum();
-    Ok((sum / g.len() as f64).sqrt())
+        .collect())
 }
 
 /// Quality of a parameterization of scattered points on a surface.
