@@ -5,6 +5,7 @@
 
 mod curve;
 mod progress;
+mod report;
 mod surface;
 mod table;
 
@@ -28,6 +29,8 @@ enum Command {
     Curve(curve::CurveCommand),
     /// Least-squares B-spline surface through scattered points, with an error table.
     Fit(surface::FitArgs),
+    /// Deviation of points from a fitted surface: statistics and an HTML report.
+    Report(report::ReportArgs),
 }
 
 fn main() {
@@ -35,6 +38,7 @@ fn main() {
     let result = match cli.command {
         Command::Curve(c) => curve::run(c),
         Command::Fit(a) => surface::run(a),
+        Command::Report(a) => report::run(a),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

@@ -596,3 +596,60 @@ fn surface_fit_cad_mesh_and_deviation_outputs() {
     let png = std::fs::read(&paths[4]).unwrap();
     assert_eq!(&png[1..4], b"PNG");
 }
+
+#[test]
+fn report_writes_a_self_contained_page() {
+    let d = tmpdir("report");
+    let input = d.join("sheet.xyz");
+    sheet(&input, 2000, false);
+    let json = d.join("s.json");
+    let o = run(&[
+        "fit",
+        input.to_str().unwrap(),
+        "--ctrl",
+        "10",
+        "-q",
+        "-o",
+        json.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let html = d.join("r.html");
+    let o = run(&[
+        "report",
+        json.to_str().unwrap(),
+        input.to_str().unwrap(),
+        "-o",
+        html.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    // the same surface and points as the fit: the same orthogonal RMSE
+    let (doc, _) = scanfit_io::json::read_surface(&json).unwrap();
+    let fit_rmse = doc.quality.unwrap().rmse_distance;
+    assert!((v["rmse"].as_f64().unwrap() - fit_rmse).abs() < 1e-12 * (1.0 + fit_rmse));
+    assert_eq!(
+        v["histogram"]["counts"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c.as_u64().unwrap())
+            .sum::<u64>(),
+        2000
+    );
+    let page = std::fs::read_to_string(&html).unwrap();
+    assert_eq!(page.matches("data:image/png;base64,").count(), 3);
+    assert!(page.contains("<svg") && page.contains("RMSE"));
+    // a surface file that is not one is reported, nothing written
+    let bad = d.join("bad.json");
+    std::fs::write(&bad, "{}").unwrap();
+    let o = run(&[
+        "report",
+        bad.to_str().unwrap(),
+        input.to_str().unwrap(),
+        "-o",
+        d.join("x.html").to_str().unwrap(),
+    ]);
+    assert!(!o.status.success() && stderr(&o).contains("not a scanfit surface document"));
+    assert!(!d.join("x.html").exists());
+}

@@ -91,6 +91,82 @@ pub fn render_png(
     encode_png(&img, opts.width, opts.height)
 }
 
+/// Renders a point cloud (each point a small square, coloured by height,
+/// nearer points on top) and returns the PNG bytes.
+pub fn render_points_png(points: &[Point3], opts: &RenderOptions) -> Result<Vec<u8>> {
+    let (w, h) = (opts.width.max(16) as usize, opts.height.max(16) as usize);
+    let (az, el) = (opts.azimuth.to_radians(), opts.elevation.to_radians());
+    let d = Vector3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
+    let right = Vector3::new(-az.sin(), az.cos(), 0.0);
+    let up = d.cross(&right);
+    let zs = if opts.z_scale > 0.0 && opts.z_scale.is_finite() {
+        opts.z_scale
+    } else {
+        1.0
+    };
+    let sp: Vec<(f64, f64, f64, f64)> = points
+        .iter()
+        .map(|p| {
+            let c = Vector3::new(p.x, p.y, p.z * zs);
+            (c.dot(&right), c.dot(&up), c.dot(&d), p.z)
+        })
+        .collect();
+    let mut img = vec![255u8; w * h * 3];
+    if sp.is_empty() {
+        return encode_png(&img, w as u32, h as u32);
+    }
+    let fold = |f: fn(f64, f64) -> f64, init: f64, g: fn(&(f64, f64, f64, f64)) -> f64| {
+        sp.iter().map(g).fold(init, f)
+    };
+    let (x0, x1) = (
+        fold(f64::min, f64::INFINITY, |t| t.0),
+        fold(f64::max, f64::NEG_INFINITY, |t| t.0),
+    );
+    let (y0, y1) = (
+        fold(f64::min, f64::INFINITY, |t| t.1),
+        fold(f64::max, f64::NEG_INFINITY, |t| t.1),
+    );
+    let (z0, z1) = (
+        fold(f64::min, f64::INFINITY, |t| t.3),
+        fold(f64::max, f64::NEG_INFINITY, |t| t.3),
+    );
+    let top = 14.0 * opts.legend.len() as f64;
+    let usable_h = h as f64 - top;
+    let scale =
+        (w as f64 * 0.9 / (x1 - x0).max(1e-300)).min(usable_h * 0.9 / (y1 - y0).max(1e-300));
+    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+    let mut depth = vec![f64::NEG_INFINITY; w * h];
+    let r = if sp.len() > 20_000 { 0 } else { 1 };
+    for &(x, y, z, height) in &sp {
+        let px = (w as f64 / 2.0 + (x - cx) * scale) as isize;
+        let py = (top + usable_h / 2.0 - (y - cy) * scale) as isize;
+        let col = viridis(((height - z0) / (z1 - z0).max(1e-300)).clamp(0.0, 1.0))
+            .map(|c| (c * 255.0).round() as u8);
+        for dy in -r..=r {
+            for dx in -r..=r {
+                let (qx, qy) = (px + dx, py + dy);
+                if qx < 0 || qy < 0 || qx >= w as isize || qy >= h as isize {
+                    continue;
+                }
+                let k = qy as usize * w + qx as usize;
+                if z > depth[k] {
+                    depth[k] = z;
+                    img[k * 3..k * 3 + 3].copy_from_slice(&col);
+                }
+            }
+        }
+    }
+    let mut canvas = Canvas {
+        rgb: &mut img,
+        width: w,
+        height: h,
+    };
+    for (k, line) in opts.legend.iter().enumerate() {
+        draw_text(&mut canvas, 8, 6 + 14 * k, line, 1, [20, 20, 20]);
+    }
+    encode_png(&img, w as u32, h as u32)
+}
+
 /// Encodes an RGB8 image.
 pub fn encode_png(rgb: &[u8], width: u32, height: u32) -> Result<Vec<u8>> {
     let mut out = Vec::new();
