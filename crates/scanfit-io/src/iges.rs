@@ -167,9 +167,18 @@ pub fn iges_file(items: &[CadItem], name: &str) -> Result<String> {
     let mut pdata = String::new();
     let mut pseq = 1usize;
     for (k, item) in items.iter().enumerate() {
+        // periodic or unclamped geometry goes out in the clamped form of the same shape
+        let bad = |e: scanfit::Error| Error::Invalid {
+            path: name.into(),
+            message: format!("item {k}: {e}"),
+        };
         let (etype, params, label) = match item {
-            CadItem::Curve(c) => (126, curve_params(c), "BSPLCRV"),
-            CadItem::Surface(s) => (128, surface_params(s), "BSPLSRF"),
+            CadItem::Curve(c) => (126, curve_params(&c.to_clamped().map_err(bad)?), "BSPLCRV"),
+            CadItem::Surface(s) => (
+                128,
+                surface_params(&s.to_clamped().map_err(bad)?),
+                "BSPLSRF",
+            ),
         };
         let de = 2 * k + 1; // sequence number of this entity's first DE line
         let lines = pack(&params, 64);

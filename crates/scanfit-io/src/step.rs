@@ -1,7 +1,8 @@
 //! STEP (ISO 10303-21, AP214 "automotive_design") export of B-spline curves
 //! and surfaces.
 //!
-//! Every clamped surface becomes an `ADVANCED_FACE` bounded by its four
+//! Periodic and other unclamped curves and surfaces are first converted to the
+//! clamped form of the same shape. Every surface becomes an `ADVANCED_FACE` bounded by its four
 //! boundary curves (exact: the boundary rows and columns of the control net) in
 //! one `OPEN_SHELL` of a `SHELL_BASED_SURFACE_MODEL`
 //! (`MANIFOLD_SURFACE_SHAPE_REPRESENTATION`), so that CAD systems that import
@@ -222,15 +223,11 @@ pub fn step_file(items: &[CadItem], name: &str) -> Result<String> {
     for (k, item) in items.iter().enumerate() {
         match item {
             CadItem::Surface(s) => {
-                if s.periodic().0
-                    || s.periodic().1
-                    || !s.knots_u().is_clamped()
-                    || !s.knots_v().is_clamped()
-                {
-                    return Err(bad(format!(
-                        "surface {k} is periodic or unclamped; only clamped surfaces are exported as faces so far"
-                    )));
-                }
+                // periodic or unclamped: the same surface in clamped form
+                let clamped = s
+                    .to_clamped()
+                    .map_err(|e| bad(format!("surface {k}: {e}")))?;
+                let s = &clamped;
                 let surf = surface_entity(&mut w, s);
                 let b = boundary_curves(s).map_err(|e| bad(format!("surface {k}: {e}")))?;
                 let ((u0, u1), (v0, v1)) = s.domain();
@@ -266,11 +263,8 @@ pub fn step_file(items: &[CadItem], name: &str) -> Result<String> {
                 faces.push(w.add(&format!("ADVANCED_FACE('',(#{fb}),#{surf},.T.)")));
             }
             CadItem::Curve(c) => {
-                if c.is_periodic() {
-                    return Err(bad(format!(
-                        "curve {k} is periodic; only clamped curves are exported so far"
-                    )));
-                }
+                let clamped = c.to_clamped().map_err(|e| bad(format!("curve {k}: {e}")))?;
+                let c = &clamped;
                 curves.push(curve_entity(&mut w, c));
             }
         }

@@ -47,6 +47,37 @@ fn curve() -> Curve {
     Curve::new(kv, c).unwrap()
 }
 
+/// A cylinder-like surface periodic in u, and a closed periodic curve.
+fn periodic_items() -> (Surface, Curve) {
+    let p = 3;
+    let nd = 8;
+    let ku = KnotVector::uniform_periodic(p, nd).unwrap();
+    let kv = KnotVector::uniform_clamped(2, 4).unwrap();
+    let mut c = Vec::new();
+    for i in 0..nd + p {
+        let a = (i % nd) as f64 / nd as f64 * std::f64::consts::TAU;
+        for j in 0..4 {
+            c.push(Point3::new(
+                40.0 + a.cos() * (2.0 + 0.1 * j as f64),
+                a.sin(),
+                j as f64,
+            ));
+        }
+    }
+    let s = Surface::with_options(ku, kv, c, None, true, false).unwrap();
+    let kc = KnotVector::uniform_periodic(3, 6).unwrap();
+    let mut q: Vec<Point3> = (0..6)
+        .map(|k| {
+            let a = k as f64 / 6.0 * std::f64::consts::TAU;
+            Point3::new(a.cos() * 3.0, 10.0 + a.sin(), 0.5)
+        })
+        .collect();
+    for j in 0..3 {
+        q.push(q[j]);
+    }
+    (s, Curve::new_periodic(kc, q, None).unwrap())
+}
+
 fn occ_available() -> bool {
     Command::new("python3")
         .args(["-c", "import OCP"])
@@ -61,30 +92,25 @@ fn step_and_iges_read_back_by_opencascade() {
     std::fs::create_dir_all(&dir).unwrap();
     let (s1, s2) = surfaces();
     let c = curve();
-    let text = step_file(
-        &[
-            CadItem::Surface(&s1),
-            CadItem::Surface(&s2),
-            CadItem::Curve(&c),
-        ],
-        "scanfit test",
-    )
-    .unwrap();
+    let (s3, c2) = periodic_items();
+    let items = [
+        CadItem::Surface(&s1),
+        CadItem::Surface(&s2),
+        CadItem::Surface(&s3),
+        CadItem::Curve(&c),
+        CadItem::Curve(&c2),
+    ];
+    let text = step_file(&items, "scanfit test").unwrap();
     // structural checks that need no CAD kernel
     assert!(text.starts_with("ISO-10303-21;") && text.ends_with("END-ISO-10303-21;\n"));
-    assert_eq!(text.matches("ADVANCED_FACE(").count(), 2);
+    assert_eq!(text.matches("ADVANCED_FACE(").count(), 3);
     assert_eq!(text.matches("RATIONAL_B_SPLINE_SURFACE(").count(), 1);
     let step = dir.join("t.stp");
     std::fs::write(&step, &text).unwrap();
     let iges = dir.join("t.igs");
-    let items = [
-        CadItem::Surface(&s1),
-        CadItem::Surface(&s2),
-        CadItem::Curve(&c),
-    ];
     std::fs::write(&iges, iges_file(&items, "scanfit test").unwrap()).unwrap();
     let mut samples = serde_json::json!({"surfaces": [], "curves": []});
-    for s in [&s1, &s2] {
+    for s in [&s1, &s2, &s3] {
         let pts: Vec<[f64; 5]> = (0..=6)
             .flat_map(|i| (0..=6).map(move |j| (i as f64 / 6.0, j as f64 / 6.0)))
             .map(|(u, v)| {
@@ -97,17 +123,19 @@ fn step_and_iges_read_back_by_opencascade() {
             .unwrap()
             .push(serde_json::json!(pts));
     }
-    let cp: Vec<[f64; 4]> = (0..=20)
-        .map(|k| {
-            let t = k as f64 / 20.0;
-            let p = c.point(t);
-            [t, p.x, p.y, p.z]
-        })
-        .collect();
-    samples["curves"]
-        .as_array_mut()
-        .unwrap()
-        .push(serde_json::json!(cp));
+    for cc in [&c, &c2] {
+        let cp: Vec<[f64; 4]> = (0..=20)
+            .map(|k| {
+                let t = k as f64 / 20.0;
+                let p = cc.point(t);
+                [t, p.x, p.y, p.z]
+            })
+            .collect();
+        samples["curves"]
+            .as_array_mut()
+            .unwrap()
+            .push(serde_json::json!(cp));
+    }
     let sp = dir.join("samples.json");
     std::fs::write(&sp, samples.to_string()).unwrap();
     if !occ_available() {
@@ -133,6 +161,6 @@ fn step_and_iges_read_back_by_opencascade() {
     let err = String::from_utf8_lossy(&o.stderr);
     println!("{out}{err}");
     assert!(o.status.success(), "OpenCASCADE disagrees:\n{out}\n{err}");
-    assert_eq!(out.matches("2 faces, 1 curves").count(), 2, "{out}");
+    assert_eq!(out.matches("3 faces, 2 curves").count(), 2, "{out}");
     std::fs::remove_dir_all(&dir).ok();
 }

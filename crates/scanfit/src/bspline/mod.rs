@@ -1,6 +1,7 @@
 //! The B-spline kernel: knot vectors, basis functions, curves and surfaces.
 
 mod basis;
+mod clamp;
 mod curve;
 mod knots;
 mod surface;
