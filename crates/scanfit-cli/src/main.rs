@@ -8,6 +8,7 @@ mod progress;
 mod report;
 mod surface;
 mod table;
+mod view;
 
 use clap::{Parser, Subcommand};
 

@@ -12,9 +12,7 @@ use scanfit::metrics::{nearest_points, orthogonal_errors};
 use scanfit::project::{InversionConfig, SurfaceInverter};
 use scanfit_io::json::read_surface;
 use scanfit_io::read_points;
-use scanfit_io::render::{
-    auto_exaggeration, render_png, render_points_png, Colouring, RenderOptions,
-};
+use scanfit_io::render::{render_png, render_points_png, Colouring, RenderOptions};
 use scanfit_io::write_atomic;
 
 use crate::progress::Progress;
@@ -38,6 +36,8 @@ pub struct ReportArgs {
     /// The HTML report [default: SURFACE with .html].
     #[arg(short, long, value_name = "OUT.html")]
     pub output: Option<PathBuf>,
+    #[command(flatten)]
+    pub view: crate::view::ViewArgs,
     /// Print the statistics as JSON on stdout instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -101,13 +101,12 @@ pub fn run(a: ReportArgs) -> Result<()> {
     let mesh = tessellate(&surface, (cu * 4).clamp(32, 300), (cv * 4).clamp(32, 300));
     let near = nearest_points(pts, &mesh.vertices)?;
     let local: Vec<f64> = near.iter().map(|&(i, _)| inv[i].distance).collect();
-    let z_scale = auto_exaggeration(pts);
     let base = RenderOptions {
         width: 900,
         height: 650,
-        z_scale,
-        ..Default::default()
+        ..a.view.options(pts)?
     };
+    let z_scale = base.z_scale;
     let shown: Vec<_> = pts
         .iter()
         .step_by((pts.len() / 5000).max(1))

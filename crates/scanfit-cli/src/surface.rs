@@ -17,7 +17,7 @@ use scanfit_io::gltf::mesh_glb;
 use scanfit_io::iges::iges_file;
 use scanfit_io::json::{Provenance, SurfaceDoc, SurfaceQualityDoc};
 use scanfit_io::ply::{mesh_obj, mesh_ply, points_ply, points_xyz, PlyFormat};
-use scanfit_io::render::{auto_exaggeration, render_png, viridis, Colouring, RenderOptions};
+use scanfit_io::render::{render_png, viridis, Colouring, RenderOptions};
 use scanfit_io::step::{step_file, CadItem};
 use scanfit_io::{read_points, write_all_atomic};
 
@@ -92,6 +92,8 @@ pub struct FitArgs {
     /// Write the points with u, v, residual and orthogonal distance (.ply or .xyz).
     #[arg(long, value_name = "POINTS")]
     pub points_out: Option<PathBuf>,
+    #[command(flatten)]
+    pub view: crate::view::ViewArgs,
     /// Print the report as JSON on stdout instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -328,7 +330,6 @@ pub fn run(a: FitArgs) -> Result<()> {
     }
     if let (Some(dp), Some(d)) = (&a.deviation_png, &deviation) {
         let opts = RenderOptions {
-            z_scale: auto_exaggeration(pts),
             legend: vec![
                 format!(
                     "{}: colour = orthogonal distance of the nearest input point to the surface [data units]",
@@ -341,7 +342,7 @@ pub fn run(a: FitArgs) -> Result<()> {
                     num(orth.rmse)
                 ),
             ],
-            ..Default::default()
+            ..a.view.options(pts)?
         };
         let bytes = render_png(
             &mesh,
@@ -376,10 +377,7 @@ pub fn run(a: FitArgs) -> Result<()> {
         // at most 5,000 points drawn, evenly picked; flat data (terrain) exaggerated
         let step = (pts.len() / 5_000).max(1);
         let shown: Vec<_> = pts.iter().step_by(step).copied().collect();
-        let opts = RenderOptions {
-            z_scale: auto_exaggeration(pts),
-            ..Default::default()
-        };
+        let opts = a.view.options(pts)?;
         exaggeration = opts.z_scale;
         let bytes = render_png(&mesh, Some(&shown), Colouring::Height, &opts)?;
         files.push((png, bytes));
