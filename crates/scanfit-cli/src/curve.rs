@@ -11,8 +11,8 @@ use scanfit::Vector3;
 use scanfit_io::iges::iges_file;
 use scanfit_io::json::{CurveDoc, Provenance, QualityDoc};
 use scanfit_io::step::{step_file, CadItem};
-use scanfit_io::svg::{curve_panels, Panel, PanelSize};
-use scanfit_io::{read_points, write_all_atomic, write_atomic, PointTable};
+use scanfit_io::svg::{curve_panels, curve_panels_png, Panel, PanelSize};
+use scanfit_io::{read_points, write_all_atomic, PointTable};
 use serde::Serialize;
 
 use crate::progress::Progress;
@@ -93,7 +93,10 @@ pub struct FitArgs {
     /// Write a picture of the data, curve and control polygon.
     #[arg(long, value_name = "OUT.svg")]
     pub svg: Option<PathBuf>,
-    /// Write the curve as a STEP file (AP214 wireframe; open curves).
+    /// Write the same picture as a PNG.
+    #[arg(long, value_name = "OUT.png")]
+    pub png: Option<PathBuf>,
+    /// Write the curve as a STEP file (AP214 wireframe).
     #[arg(long, value_name = "OUT.stp")]
     pub step: Option<PathBuf>,
     /// Write the same as an IGES 5.3 file (entity 126 or 128).
@@ -118,6 +121,9 @@ pub struct CompareArgs {
     /// The SVG with one panel per method [default: INPUT-compare.svg].
     #[arg(short, long, value_name = "OUT.svg")]
     pub output: Option<PathBuf>,
+    /// Also write the panels as a PNG.
+    #[arg(long, value_name = "OUT.png")]
+    pub png: Option<PathBuf>,
     /// Print the comparison as JSON on stdout instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -269,6 +275,15 @@ fn fit_cmd(a: FitArgs) -> Result<()> {
             curve_panels(&[panel], 1, "", PanelSize::SINGLE).into_bytes(),
         ));
     }
+    if let Some(png) = &a.png {
+        let panel = Panel {
+            title: format!("{method} ({kind}, degree {})", a.degree),
+            subtitle: summary(&q),
+            points: used,
+            curve: Some(&fit.curve),
+        };
+        files.push((png, curve_panels_png(&[panel], 1, "", PanelSize::SINGLE)?));
+    }
     if let Some(st) = &a.step {
         let name = a
             .input
@@ -380,6 +395,7 @@ fn print_fit(a: &FitArgs, fit: &CurveFit, q: &CurveQuality, kind: &str, n: usize
     for (what, p) in [
         ("curve", &a.output),
         ("picture", &a.svg),
+        ("PNG picture", &a.png),
         ("STEP file", &a.step),
         ("IGES file", &a.iges),
     ] {
@@ -458,10 +474,15 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
         a.degree,
         pts.len()
     );
-    write_atomic(
+    let mut files: Vec<(&Path, Vec<u8>)> = vec![(
         &out,
-        curve_panels(&panels, 4, &title, PanelSize::GRID).as_bytes(),
-    )?;
+        curve_panels(&panels, 4, &title, PanelSize::GRID).into_bytes(),
+    )];
+    if let Some(png) = &a.png {
+        files.push((png, curve_panels_png(&panels, 4, &title, PanelSize::GRID)?));
+    }
+    let refs: Vec<(&Path, &[u8])> = files.iter().map(|(p, b)| (*p, b.as_slice())).collect();
+    write_all_atomic(&refs)?;
 
     if a.json {
         let rows: Vec<CompareRow> = results
@@ -543,5 +564,8 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
     }
     println!("\nlength ratio = curve length / data polygon length (1 = tight; large = bulges).");
     println!("wrote picture: {}", out.display());
+    if let Some(png) = &a.png {
+        println!("wrote picture: {}", png.display());
+    }
     Ok(())
 }

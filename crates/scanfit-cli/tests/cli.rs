@@ -653,3 +653,34 @@ fn report_writes_a_self_contained_page() {
     assert!(!o.status.success() && stderr(&o).contains("not a scanfit surface document"));
     assert!(!d.join("x.html").exists());
 }
+
+#[test]
+fn curve_pictures_as_png() {
+    let d = tmpdir("cpng");
+    let (svg, png, fpng) = (d.join("c.svg"), d.join("c.png"), d.join("f.png"));
+    let input = examples().join("dataset2.csv");
+    let o = run(&[
+        "curve",
+        "compare",
+        input.to_str().unwrap(),
+        "-q",
+        "-o",
+        svg.to_str().unwrap(),
+        "--png",
+        png.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run(&[
+        "curve",
+        "fit",
+        input.to_str().unwrap(),
+        "--png",
+        fpng.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for p in [&png, &fpng] {
+        let bytes = std::fs::read(p).unwrap();
+        assert_eq!(&bytes[1..4], b"PNG");
+        assert!(bytes.len() > 5000, "{} is suspiciously small", p.display());
+    }
+}

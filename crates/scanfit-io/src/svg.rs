@@ -1,4 +1,4 @@
-//! SVG pictures of fitted curves: one panel per curve with the data points
+//! Pictures of fitted curves, as SVG and as PNG ([`curve_panels_png`]): one panel per curve with the data points
 //! (squares), the curve, and its control polygon (circles, dashed), in the
 //! style of the curve paper's figures 11-21.
 //!
@@ -127,7 +127,17 @@ pub fn curve_panels(panels: &[Panel], columns: usize, title: &str, size: PanelSi
     s
 }
 
-fn draw_panel(s: &mut String, panel: &Panel, x0: f64, y0: f64, id: usize, size: PanelSize) {
+/// Pixel coordinates of a panel's data points, curve samples and control
+/// points: projected into the data's plane, and the view fitted to the data
+/// and the curve (at most the data box grown by 60% on each side, so that a
+/// wild curve does not shrink the data to a dot). Shared by SVG and PNG.
+pub(crate) struct PanelLayout {
+    pub(crate) data: Vec<(f64, f64)>,
+    pub(crate) samples: Vec<(f64, f64)>,
+    pub(crate) ctrl: Vec<(f64, f64)>,
+}
+
+pub(crate) fn panel_layout(panel: &Panel, x0: f64, y0: f64, size: PanelSize) -> PanelLayout {
     let (panel_w, panel_h) = (size.width, size.height);
     let proj = Projection::fit(panel.points);
     let data: Vec<(f64, f64)> = panel.points.iter().map(|p| proj.apply(p)).collect();
@@ -180,6 +190,21 @@ fn draw_panel(s: &mut String, panel: &Panel, x0: f64, y0: f64, id: usize, size: 
         y0 + HEADER + MARGIN + (ah - vh * scale) / 2.0,
     );
     let map = |p: &(f64, f64)| (ox + (p.0 - view.0) * scale, oy + (view.3 - p.1) * scale);
+    PanelLayout {
+        data: data.iter().map(map).collect(),
+        samples: samples.iter().map(map).collect(),
+        ctrl: ctrl.iter().map(map).collect(),
+    }
+}
+
+fn draw_panel(s: &mut String, panel: &Panel, x0: f64, y0: f64, id: usize, size: PanelSize) {
+    let (panel_w, panel_h) = (size.width, size.height);
+    let PanelLayout {
+        data,
+        samples,
+        ctrl,
+    } = panel_layout(panel, x0, y0, size);
+    let map = |p: &(f64, f64)| *p;
 
     let _ = writeln!(
         s,
@@ -294,6 +319,144 @@ fn escape(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")
+}
+
+/// The same panels as [`curve_panels`], rasterised to a PNG (bitmap font, no
+/// system fonts): data points as red squares, the curve in blue, the control
+/// polygon dashed grey with hollow circles.
+pub fn curve_panels_png(
+    panels: &[Panel],
+    columns: usize,
+    title: &str,
+    size: PanelSize,
+) -> crate::Result<Vec<u8>> {
+    use crate::render::{draw_text, encode_png, Canvas};
+    let columns = columns.max(1);
+    let rows = panels.len().div_ceil(columns).max(1);
+    let top = if title.is_empty() { 0.0 } else { 30.0 };
+    let (w, h) = (
+        (size.width * columns as f64) as usize,
+        (size.height * rows as f64 + top) as usize,
+    );
+    let mut img = vec![255u8; w * h * 3];
+    let put = |img: &mut [u8], x: f64, y: f64, c: [u8; 3]| {
+        let (xi, yi) = (x.round() as isize, y.round() as isize);
+        if xi >= 0 && yi >= 0 && (xi as usize) < w && (yi as usize) < h {
+            let o = (yi as usize * w + xi as usize) * 3;
+            img[o..o + 3].copy_from_slice(&c);
+        }
+    };
+    // a line of the given width; `dash` > 0 leaves gaps of that length
+    let line = |img: &mut [u8], a: (f64, f64), b: (f64, f64), c: [u8; 3], width: f64, dash: f64| {
+        let len = (b.0 - a.0).hypot(b.1 - a.1);
+        let steps = (len * 2.0).ceil().max(1.0) as usize;
+        for k in 0..=steps {
+            let t = k as f64 / steps as f64;
+            if dash > 0.0 && ((t * len) / dash) as usize % 2 == 1 {
+                continue;
+            }
+            let (x, y) = (a.0 + (b.0 - a.0) * t, a.1 + (b.1 - a.1) * t);
+            let r = (width / 2.0).floor() as isize;
+            for dx in -r..=r {
+                for dy in -r..=r {
+                    put(img, x + dx as f64, y + dy as f64, c);
+                }
+            }
+        }
+    };
+    for (k, panel) in panels.iter().enumerate() {
+        let (x0, y0) = (
+            (k % columns) as f64 * size.width,
+            top + (k / columns) as f64 * size.height,
+        );
+        // clip to the panel: draw into a panel-sized view of the layout
+        let l = panel_layout(panel, x0, y0, size);
+        let inside = |p: &(f64, f64)| {
+            p.0 >= x0 + 3.0
+                && p.0 <= x0 + size.width - 3.0
+                && p.1 >= y0 + HEADER
+                && p.1 <= y0 + size.height - 3.0
+        };
+        let grey = [140, 140, 140];
+        for s in l.ctrl.windows(2) {
+            if inside(&s[0]) && inside(&s[1]) {
+                line(&mut img, s[0], s[1], grey, 1.0, 4.0);
+            }
+        }
+        for c in l.ctrl.iter().filter(|p| inside(p)) {
+            for a in 0..24 {
+                let t = a as f64 / 24.0 * std::f64::consts::TAU;
+                put(&mut img, c.0 + 3.0 * t.cos(), c.1 + 3.0 * t.sin(), grey);
+            }
+        }
+        for s in l.samples.windows(2) {
+            if inside(&s[0]) && inside(&s[1]) {
+                line(&mut img, s[0], s[1], [31, 95, 191], 2.0, 0.0);
+            }
+        }
+        let side = (6.0 * (20.0 / l.data.len().max(1) as f64).sqrt()).clamp(2.0, 6.0);
+        for p in &l.data {
+            for dx in 0..side as usize {
+                for dy in 0..side as usize {
+                    put(
+                        &mut img,
+                        p.0 - side / 2.0 + dx as f64,
+                        p.1 - side / 2.0 + dy as f64,
+                        [209, 55, 43],
+                    );
+                }
+            }
+        }
+        // frame, title, caption
+        for t in 0..(size.width as usize - 4) {
+            put(&mut img, x0 + 2.0 + t as f64, y0 + 2.0, [204, 204, 204]);
+            put(
+                &mut img,
+                x0 + 2.0 + t as f64,
+                y0 + size.height - 2.0,
+                [204, 204, 204],
+            );
+        }
+        for t in 0..(size.height as usize - 4) {
+            put(&mut img, x0 + 2.0, y0 + 2.0 + t as f64, [204, 204, 204]);
+            put(
+                &mut img,
+                x0 + size.width - 2.0,
+                y0 + 2.0 + t as f64,
+                [204, 204, 204],
+            );
+        }
+        let mut canvas = Canvas {
+            rgb: &mut img,
+            width: w,
+            height: h,
+        };
+        let (tx, ty) = (x0 as usize + 10, y0 as usize + 8);
+        draw_text(&mut canvas, tx, ty, &panel.title, 1, [0, 0, 0]);
+        draw_text(&mut canvas, tx + 1, ty, &panel.title, 1, [0, 0, 0]); // bold
+        let colour = if panel.curve.is_some() {
+            [50, 50, 50]
+        } else {
+            [180, 0, 0]
+        };
+        for (i, s) in wrap(&panel.subtitle, ((size.width - 20.0) / 8.0) as usize, 2)
+            .iter()
+            .enumerate()
+        {
+            draw_text(&mut canvas, tx, ty + 14 + 11 * i, s, 1, colour);
+        }
+    }
+    if !title.is_empty() {
+        let mut canvas = Canvas {
+            rgb: &mut img,
+            width: w,
+            height: h,
+        };
+        let x = (w / 2).saturating_sub(title.chars().count() * 8 / 2);
+        draw_text(&mut canvas, x, 10, title, 1, [0, 0, 0]);
+        draw_text(&mut canvas, x + 1, 10, title, 1, [0, 0, 0]);
+    }
+    encode_png(&img, w as u32, h as u32)
 }
 
 #[cfg(test)]
