@@ -8,9 +8,8 @@ use scanfit::fit::{self, ApproximationConfig, CurveFit, InterpolationConfig};
 use scanfit::param::Method;
 use scanfit::quality::{curve_quality, CurveQuality, QualityConfig};
 use scanfit::Vector3;
-use scanfit_io::iges::iges_file;
 use scanfit_io::json::{CurveDoc, Provenance, QualityDoc};
-use scanfit_io::step::{step_file, CadItem};
+use scanfit_io::step::CadItem;
 use scanfit_io::svg::{curve_panels, curve_panels_png, Panel, PanelSize};
 use scanfit_io::{read_points, write_all_atomic, PointTable};
 use serde::Serialize;
@@ -284,28 +283,12 @@ fn fit_cmd(a: FitArgs) -> Result<()> {
         };
         files.push((png, curve_panels_png(&[panel], 1, "", PanelSize::SINGLE)?));
     }
-    if let Some(st) = &a.step {
-        let name = a
-            .input
-            .file_stem()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        files.push((
-            st,
-            step_file(&[CadItem::Curve(&fit.curve)], &name)?.into_bytes(),
-        ));
-    }
-    if let Some(ig) = &a.iges {
-        let name = a
-            .input
-            .file_stem()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        files.push((
-            ig,
-            iges_file(&[CadItem::Curve(&fit.curve)], &name)?.into_bytes(),
-        ));
-    }
+    files.extend(crate::cad::cad_files(
+        &a.step,
+        &a.iges,
+        CadItem::Curve(&fit.curve),
+        &a.input,
+    )?);
     let refs: Vec<(&Path, &[u8])> = files.iter().map(|(p, b)| (*p, b.as_slice())).collect();
     write_all_atomic(&refs)?;
     if a.json {

@@ -14,11 +14,10 @@ use scanfit::metrics::{
 };
 use scanfit::project::{InversionConfig, SurfaceInverter};
 use scanfit_io::gltf::mesh_glb;
-use scanfit_io::iges::iges_file;
 use scanfit_io::json::{Provenance, SurfaceDoc, SurfaceQualityDoc};
 use scanfit_io::ply::{mesh_obj, mesh_ply, points_ply, points_xyz, PlyFormat};
 use scanfit_io::render::{render_png, viridis, Colouring, RenderOptions};
-use scanfit_io::step::{step_file, CadItem};
+use scanfit_io::step::CadItem;
 use scanfit_io::{read_points, write_all_atomic};
 
 use crate::progress::Progress;
@@ -261,28 +260,12 @@ pub fn run(a: FitArgs) -> Result<()> {
     if let Some(o) = &a.output {
         files.push((o, doc.to_json().into_bytes()));
     }
-    if let Some(st) = &a.step {
-        let name = a
-            .input
-            .file_stem()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        files.push((
-            st,
-            step_file(&[CadItem::Surface(&surface)], &name)?.into_bytes(),
-        ));
-    }
-    if let Some(ig) = &a.iges {
-        let name = a
-            .input
-            .file_stem()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        files.push((
-            ig,
-            iges_file(&[CadItem::Surface(&surface)], &name)?.into_bytes(),
-        ));
-    }
+    files.extend(crate::cad::cad_files(
+        &a.step,
+        &a.iges,
+        CadItem::Surface(&surface),
+        &a.input,
+    )?);
     let (cu, cv) = surface.counts();
     let mesh = tessellate(&surface, (cu * 4).clamp(32, 400), (cv * 4).clamp(32, 400));
     // fit error on the surface: each mesh vertex shows the orthogonal distance

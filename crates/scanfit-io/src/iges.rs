@@ -11,23 +11,8 @@ use scanfit::bspline::{Curve, Surface};
 use crate::step::CadItem;
 use crate::{Error, Result};
 
-/// An IGES real: shortest round-trip digits with a decimal point.
-fn real(v: f64) -> String {
-    let s = format!("{v:?}");
-    let (mant, exp) = match s.split_once('e') {
-        Some((m, e)) => (m.to_string(), Some(e.to_string())),
-        None => (s, None),
-    };
-    let mant = if mant.contains('.') {
-        mant
-    } else {
-        format!("{mant}.")
-    };
-    match exp {
-        Some(e) => format!("{mant}E{e}"),
-        None => mant,
-    }
-}
+/// IGES reals use the same form as STEP's (shortest round trip, a decimal point).
+use crate::step::real;
 
 fn hollerith(s: &str) -> String {
     format!("{}H{s}", s.len())

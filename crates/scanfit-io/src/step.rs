@@ -51,8 +51,8 @@ impl Writer {
     }
 }
 
-/// A STEP real: always with a decimal point, shortest round-trip digits.
-fn real(v: f64) -> String {
+/// A STEP (and IGES) real: always with a decimal point, shortest round-trip digits.
+pub(crate) fn real(v: f64) -> String {
     let s = format!("{v:?}");
     let (mant, exp) = match s.split_once('e') {
         Some((m, e)) => (m.to_string(), Some(e.to_string())),
