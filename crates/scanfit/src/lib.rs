@@ -15,12 +15,15 @@
 //! * [`fit`]: curve interpolation (open, with end tangents, closed/periodic) and
 //!   least-squares approximation with optional bending-energy smoothing, on banded
 //!   solvers.
+//! * [`cloud`]: point clouds with named attributes and KD-tree neighbour
+//!   queries, normals, hidden point removal, boundary loops, corners.
 //! * [`metrics`]: surface error measures and parameterization quality.
 //! * [`project`]: point inversion (orthogonal projection onto surfaces).
 //! * [`quality`]: per-curve quality report (deviation, curvature, loops, length).
 
 pub mod base;
 pub mod bspline;
+pub mod cloud;
 mod error;
 pub mod fit;
 mod geom;
@@ -29,5 +32,6 @@ pub mod param;
 pub mod project;
 pub mod quality;
 
+pub use cloud::PointCloud;
 pub use error::{Error, Result};
 pub use geom::{validate_points, Point3, Vector3};

@@ -1,0 +1,199 @@
+//! Point clouds and the geometry toolkit the pipelines stand on.
+//!
+//! [`PointCloud`] holds the positions of a scan and any per-point attributes
+//! read with it (normals, colours, labels, parameters...) as named `f64`
+//! columns, and answers neighbour queries over a KD-tree (kiddo's
+//! `ImmutableKdTree`, built once on first use and shared by all queries).
+//!
+//! * [`neighbours`]: k-nearest and radius queries, one at a time or in
+//!   parallel batches.
+
+pub mod neighbours;
+
+use std::sync::OnceLock;
+
+use kiddo::ImmutableKdTree;
+
+use crate::{validate_points, Error, Point3, Result, Vector3};
+
+/// A named per-point attribute column.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Attribute {
+    /// Name as in the file (`nx`, `red`, `label`, `u`, ...).
+    pub name: String,
+    /// One value per point.
+    pub values: Vec<f64>,
+}
+
+/// A point cloud: positions, named per-point attributes and a lazily built
+/// KD-tree for neighbour queries.
+///
+/// Positions are validated on construction (finite, magnitude below
+/// 1e150), so every algorithm over a cloud can
+/// rely on them.
+#[derive(Debug, Default)]
+pub struct PointCloud {
+    points: Vec<Point3>,
+    attributes: Vec<Attribute>,
+    tree: OnceLock<ImmutableKdTree<f64, 3>>,
+}
+
+impl Clone for PointCloud {
+    fn clone(&self) -> Self {
+        Self {
+            points: self.points.clone(),
+            attributes: self.attributes.clone(),
+            tree: OnceLock::new(),
+        }
+    }
+}
+
+impl PartialEq for PointCloud {
+    fn eq(&self, other: &Self) -> bool {
+        self.points == other.points && self.attributes == other.attributes
+    }
+}
+
+impl PointCloud {
+    /// A cloud of `points` without attributes. Errors name the first point
+    /// with a non-finite or out-of-range coordinate.
+    pub fn new(points: Vec<Point3>) -> Result<Self> {
+        validate_points(&points)?;
+        Ok(Self {
+            points,
+            attributes: Vec::new(),
+            tree: OnceLock::new(),
+        })
+    }
+
+    /// Adds (or replaces) the attribute `name`; it needs one value per point.
+    pub fn with_attribute(mut self, name: &str, values: Vec<f64>) -> Result<Self> {
+        self.set_attribute(name, values)?;
+        Ok(self)
+    }
+
+    /// Sets (adds or replaces) the attribute `name`; it needs one value per point.
+    pub fn set_attribute(&mut self, name: &str, values: Vec<f64>) -> Result<()> {
+        if values.len() != self.points.len() {
+            return Err(Error::InvalidInput(format!(
+                "attribute '{name}' has {} values for {} points; give one value per point",
+                values.len(),
+                self.points.len()
+            )));
+        }
+        match self.attributes.iter_mut().find(|a| a.name == name) {
+            Some(a) => a.values = values,
+            None => self.attributes.push(Attribute {
+                name: name.to_string(),
+                values,
+            }),
+        }
+        Ok(())
+    }
+
+    /// The positions.
+    pub fn points(&self) -> &[Point3] {
+        &self.points
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    /// Whether the cloud has no points.
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+
+    /// All attributes, in file order.
+    pub fn attributes(&self) -> &[Attribute] {
+        &self.attributes
+    }
+
+    /// The attribute `name` (exact match first, then ASCII case-insensitive).
+    pub fn attribute(&self, name: &str) -> Option<&[f64]> {
+        self.attributes
+            .iter()
+            .find(|a| a.name == name)
+            .or_else(|| {
+                self.attributes
+                    .iter()
+                    .find(|a| a.name.eq_ignore_ascii_case(name))
+            })
+            .map(|a| a.values.as_slice())
+    }
+
+    /// Removes the attribute `name`, returning its values.
+    pub fn remove_attribute(&mut self, name: &str) -> Option<Vec<f64>> {
+        let i = self.attributes.iter().position(|a| a.name == name)?;
+        Some(self.attributes.remove(i).values)
+    }
+
+    /// Per-point normals from the `nx`, `ny`, `nz` attributes, if all three exist.
+    pub fn normals(&self) -> Option<Vec<Vector3>> {
+        let (x, y, z) = (
+            self.attribute("nx")?,
+            self.attribute("ny")?,
+            self.attribute("nz")?,
+        );
+        Some(
+            x.iter()
+                .zip(y)
+                .zip(z)
+                .map(|((&x, &y), &z)| Vector3::new(x, y, z))
+                .collect(),
+        )
+    }
+
+    /// Stores `normals` as the `nx`, `ny`, `nz` attributes.
+    pub fn set_normals(&mut self, normals: &[Vector3]) -> Result<()> {
+        for (c, name) in ["nx", "ny", "nz"].into_iter().enumerate() {
+            self.set_attribute(name, normals.iter().map(|n| n[c]).collect())?;
+        }
+        Ok(())
+    }
+
+    /// The sub-cloud of the points at `indices` (in that order), with their
+    /// attributes. Errors on an index out of range.
+    pub fn select(&self, indices: &[usize]) -> Result<PointCloud> {
+        if let Some(&bad) = indices.iter().find(|&&i| i >= self.points.len()) {
+            return Err(Error::InvalidInput(format!(
+                "point index {bad} is out of range for a cloud of {} points",
+                self.points.len()
+            )));
+        }
+        Ok(PointCloud {
+            points: indices.iter().map(|&i| self.points[i]).collect(),
+            attributes: self
+                .attributes
+                .iter()
+                .map(|a| Attribute {
+                    name: a.name.clone(),
+                    values: indices.iter().map(|&i| a.values[i]).collect(),
+                })
+                .collect(),
+            tree: OnceLock::new(),
+        })
+    }
+
+    /// Axis-aligned bounding box `(min, max)`; `None` for an empty cloud.
+    pub fn bounding_box(&self) -> Option<(Point3, Point3)> {
+        let first = *self.points.first()?;
+        Some(
+            self.points
+                .iter()
+                .fold((first, first), |(lo, hi), p| (lo.inf(p), hi.sup(p))),
+        )
+    }
+
+    /// Length of the bounding-box diagonal (0 for an empty cloud).
+    pub fn diagonal(&self) -> f64 {
+        self.bounding_box().map_or(0.0, |(lo, hi)| (hi - lo).norm())
+    }
+
+    /// Takes the positions and attributes out of the cloud.
+    pub fn into_parts(self) -> (Vec<Point3>, Vec<Attribute>) {
+        (self.points, self.attributes)
+    }
+}

@@ -1,0 +1,277 @@
+//! Neighbour queries on a [`PointCloud`]: k-nearest and radius search over a
+//! KD-tree (kiddo 6 `ImmutableKdTree`), one query at a time or batched in
+//! parallel (rayon).
+//!
+//! Distances returned are Euclidean (not squared). Results are sorted by
+//! distance, nearest first; ties keep the tree's order.
+
+use std::num::NonZeroUsize;
+
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use rayon::prelude::*;
+
+use super::PointCloud;
+use crate::{Error, Point3, Result};
+
+/// One neighbour: its index in the cloud and its distance to the query.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Neighbour {
+    /// Index of the point in the cloud.
+    pub index: usize,
+    /// Euclidean distance to the query point.
+    pub distance: f64,
+}
+
+/// The k nearest neighbours of many points, stored flat: row `i` holds the
+/// neighbours of point (or query) `i`, nearest first.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Neighbourhoods {
+    /// Neighbours per row (`k`, or fewer when the cloud is smaller).
+    pub k: usize,
+    /// `k` indices per row.
+    pub indices: Vec<u32>,
+    /// `k` distances per row.
+    pub distances: Vec<f64>,
+}
+
+impl Neighbourhoods {
+    /// Number of rows.
+    pub fn len(&self) -> usize {
+        self.indices.len().checked_div(self.k).unwrap_or(0)
+    }
+
+    /// Whether there are no rows.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Indices of row `i`.
+    pub fn indices_of(&self, i: usize) -> &[u32] {
+        &self.indices[i * self.k..(i + 1) * self.k]
+    }
+
+    /// Distances of row `i`.
+    pub fn distances_of(&self, i: usize) -> &[f64] {
+        &self.distances[i * self.k..(i + 1) * self.k]
+    }
+}
+
+fn coords(p: &Point3) -> [f64; 3] {
+    [p.x, p.y, p.z]
+}
+
+impl PointCloud {
+    /// The KD-tree over the points, built on first use (an error for an
+    /// empty cloud or more than 2^32 points).
+    pub fn tree(&self) -> Result<&ImmutableKdTree<f64, 3>> {
+        if self.points.is_empty() {
+            return Err(Error::InvalidInput(
+                "the point cloud is empty; neighbour queries need at least one point".into(),
+            ));
+        }
+        if self.points.len() > u32::MAX as usize {
+            return Err(Error::InvalidInput(format!(
+                "{} points exceed the KD-tree's limit of 2^32; split the cloud",
+                self.points.len()
+            )));
+        }
+        if let Some(t) = self.tree.get() {
+            return Ok(t);
+        }
+        let c: Vec<[f64; 3]> = self.points.iter().map(coords).collect();
+        let tree = ImmutableKdTree::new_from_slice(&c)
+            .map_err(|e| Error::InvalidInput(format!("could not index the points: {e:?}")))?;
+        Ok(self.tree.get_or_init(|| tree))
+    }
+
+    /// The nearest point to `query`.
+    pub fn nearest(&self, query: &Point3) -> Result<Neighbour> {
+        let r = self
+            .tree()?
+            .query(&coords(query))
+            .nearest_one::<SquaredEuclidean<f64>>()
+            .execute();
+        Ok(Neighbour {
+            index: r.item as usize,
+            distance: r.distance.sqrt(),
+        })
+    }
+
+    /// The `k` nearest points to `query` (fewer if the cloud is smaller),
+    /// nearest first.
+    pub fn knn(&self, query: &Point3, k: usize) -> Result<Vec<Neighbour>> {
+        let k = checked_k(k)?;
+        Ok(knn_with(self.tree()?, query, k))
+    }
+
+    /// All points within distance `radius` of `query` (inclusive), nearest first.
+    pub fn within(&self, query: &Point3, radius: f64) -> Result<Vec<Neighbour>> {
+        if !(radius.is_finite() && radius >= 0.0) {
+            return Err(Error::InvalidInput(format!(
+                "search radius {radius} must be finite and >= 0"
+            )));
+        }
+        let mut out: Vec<Neighbour> = self
+            .tree()?
+            .query(&coords(query))
+            .within::<SquaredEuclidean<f64>>(radius * radius)
+            .execute()
+            .into_iter()
+            .map(|r| Neighbour {
+                index: r.item as usize,
+                distance: r.distance.sqrt(),
+            })
+            .collect();
+        out.sort_by(|a, b| a.distance.total_cmp(&b.distance));
+        Ok(out)
+    }
+
+    /// The `k` nearest points of each of `queries`, in parallel.
+    pub fn knn_batch(&self, queries: &[Point3], k: usize) -> Result<Neighbourhoods> {
+        let kq = checked_k(k)?;
+        let tree = self.tree()?;
+        let k = kq.get().min(self.points.len());
+        let mut indices = vec![0u32; queries.len() * k];
+        let mut distances = vec![0.0; queries.len() * k];
+        indices
+            .par_chunks_mut(k)
+            .zip(distances.par_chunks_mut(k))
+            .zip(queries.par_iter())
+            .for_each(|((idx, dist), q)| {
+                for (j, n) in knn_with(tree, q, kq).into_iter().enumerate().take(k) {
+                    idx[j] = n.index as u32;
+                    dist[j] = n.distance;
+                }
+            });
+        Ok(Neighbourhoods {
+            k,
+            indices,
+            distances,
+        })
+    }
+
+    /// The `k` nearest *other* points of every point of the cloud (the point
+    /// itself excluded), in parallel: the neighbour graph that normals,
+    /// spacing statistics and orientation use.
+    pub fn knn_graph(&self, k: usize) -> Result<Neighbourhoods> {
+        if self.points.len() < 2 {
+            return Err(Error::TooFewPoints {
+                got: self.points.len(),
+                needed: 2,
+                what: "a neighbour graph".into(),
+            });
+        }
+        let k = checked_k(k)?.get().min(self.points.len() - 1);
+        let all = self.knn_batch(&self.points, k + 1)?;
+        let mut indices = Vec::with_capacity(self.points.len() * k);
+        let mut distances = Vec::with_capacity(self.points.len() * k);
+        for i in 0..self.points.len() {
+            let row = all.indices_of(i);
+            let drow = all.distances_of(i);
+            // drop the point itself (or, among duplicates, one copy of it)
+            let skip = row
+                .iter()
+                .position(|&j| j as usize == i)
+                .unwrap_or(row.len() - 1);
+            for j in 0..row.len() {
+                if j != skip {
+                    indices.push(row[j]);
+                    distances.push(drow[j]);
+                }
+            }
+        }
+        Ok(Neighbourhoods {
+            k,
+            indices,
+            distances,
+        })
+    }
+}
+
+fn checked_k(k: usize) -> Result<NonZeroUsize> {
+    NonZeroUsize::new(k)
+        .ok_or_else(|| Error::InvalidInput("k = 0 neighbours asked for; give k >= 1".into()))
+}
+
+fn knn_with(tree: &ImmutableKdTree<f64, 3>, query: &Point3, k: NonZeroUsize) -> Vec<Neighbour> {
+    tree.query(&coords(query))
+        .nearest_n::<SquaredEuclidean<f64>>(k)
+        .execute()
+        .into_iter()
+        .map(|r| Neighbour {
+            index: r.item as usize,
+            distance: r.distance.sqrt(),
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid(n: usize) -> PointCloud {
+        let mut p = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                p.push(Point3::new(i as f64, j as f64, 0.0));
+            }
+        }
+        PointCloud::new(p).unwrap()
+    }
+
+    fn brute(cloud: &PointCloud, q: &Point3, k: usize) -> Vec<f64> {
+        let mut d: Vec<f64> = cloud.points().iter().map(|p| (p - q).norm()).collect();
+        d.sort_by(f64::total_cmp);
+        d.truncate(k);
+        d
+    }
+
+    #[test]
+    fn knn_matches_brute_force() {
+        let c = grid(20);
+        let q = Point3::new(3.3, 7.9, 0.4);
+        let got: Vec<f64> = c.knn(&q, 9).unwrap().iter().map(|n| n.distance).collect();
+        let want = brute(&c, &q, 9);
+        for (a, b) in got.iter().zip(&want) {
+            assert!((a - b).abs() < 1e-12);
+        }
+        assert_eq!(c.nearest(&q).unwrap().index, 3 * 20 + 8);
+    }
+
+    #[test]
+    fn within_returns_the_disc() {
+        let c = grid(20);
+        let q = Point3::new(10.0, 10.0, 0.0);
+        let r = c.within(&q, 1.0).unwrap();
+        // the centre and its four axis neighbours (distance exactly 1: inclusive)
+        assert_eq!(r.len(), 5);
+        assert_eq!(r[0].index, 10 * 20 + 10);
+        assert!(c.within(&q, f64::NAN).is_err());
+    }
+
+    #[test]
+    fn graph_excludes_self_and_caps_k() {
+        let c = grid(3);
+        let g = c.knn_graph(4).unwrap();
+        assert_eq!(g.k, 4);
+        for i in 0..c.len() {
+            assert!(!g.indices_of(i).contains(&(i as u32)));
+            assert!(g.distances_of(i).iter().all(|&d| d >= 1.0 - 1e-12));
+        }
+        // the centre's four neighbours are at distance 1
+        assert_eq!(g.distances_of(4), &[1.0, 1.0, 1.0, 1.0]);
+        assert_eq!(c.knn_graph(100).unwrap().k, 8);
+        let batch = c.knn_batch(&[Point3::new(0.0, 0.0, 0.0)], 50).unwrap();
+        assert_eq!(batch.k, 9);
+    }
+
+    #[test]
+    fn empty_and_bad_input_are_errors() {
+        let c = PointCloud::new(vec![]).unwrap();
+        assert!(c.knn(&Point3::origin(), 3).is_err());
+        assert!(grid(2).knn(&Point3::origin(), 0).is_err());
+        assert!(PointCloud::new(vec![Point3::new(f64::NAN, 0.0, 0.0)]).is_err());
+        let one = PointCloud::new(vec![Point3::origin()]).unwrap();
+        assert!(one.knn_graph(3).is_err());
+    }
+}
