@@ -74,3 +74,54 @@ pub(crate) fn bbox_diagonal(points: &[Point3]) -> f64 {
     }
     (hi - lo).norm()
 }
+
+/// Principal component analysis of a point set: centroid, covariance
+/// eigenvalues (descending) and the matching unit axes. The last axis is the
+/// normal of the best-fit (total least squares) plane.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pca {
+    /// Mean of the points.
+    pub centroid: Point3,
+    /// Eigenvalues of the covariance matrix, largest first (variances along the axes).
+    pub values: [f64; 3],
+    /// Unit eigenvectors, in the order of `values`; the signs are the eigen solver's.
+    pub axes: [Vector3; 3],
+}
+
+impl Pca {
+    /// Surface variation `l3 / (l1 + l2 + l3)` (Pauly et al. 2002): 0 on a
+    /// plane, 1/3 for isotropic noise; a cheap curvature/noise indicator.
+    pub fn variation(&self) -> f64 {
+        let s = self.values[0] + self.values[1] + self.values[2];
+        if s > 0.0 {
+            self.values[2].max(0.0) / s
+        } else {
+            0.0
+        }
+    }
+}
+
+/// PCA of `points` (`None` for no points). The covariance is accumulated
+/// about the first point and then re-centred, which keeps it accurate for
+/// coordinates far from the origin (georeferenced scans).
+pub fn pca<'a>(points: impl IntoIterator<Item = &'a Point3>) -> Option<Pca> {
+    let mut it = points.into_iter();
+    let first = it.next()?.coords;
+    let (mut n, mut sum, mut cov) = (1.0, Vector3::zeros(), nalgebra::Matrix3::zeros());
+    for p in it {
+        let d = p.coords - first;
+        sum += d;
+        cov += d * d.transpose();
+        n += 1.0;
+    }
+    let mean = sum / n;
+    let cov = cov / n - mean * mean.transpose();
+    let eig = nalgebra::SymmetricEigen::new(cov);
+    let mut idx = [0usize, 1, 2];
+    idx.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]));
+    Some(Pca {
+        centroid: Point3::from(first + mean),
+        values: idx.map(|i| eig.eigenvalues[i]),
+        axes: idx.map(|i| eig.eigenvectors.column(i).into()),
+    })
+}

@@ -34,4 +34,4 @@ pub mod quality;
 
 pub use cloud::PointCloud;
 pub use error::{Error, Result};
-pub use geom::{validate_points, Point3, Vector3};
+pub use geom::{pca, validate_points, Pca, Point3, Vector3};

@@ -37,16 +37,12 @@ pub fn plane_parameters(points: &[Point3]) -> Result<PlaneParameterization> {
             what: "a best-fit plane".into(),
         });
     }
-    let n = points.len() as f64;
-    let c = points.iter().fold(Vector3::zeros(), |a, p| a + p.coords) / n;
-    let mut cov = nalgebra::Matrix3::zeros();
-    for p in points {
-        let d = p.coords - c;
-        cov += d * d.transpose();
-    }
-    let eig = nalgebra::SymmetricEigen::new(cov / n);
-    let mut idx = [0usize, 1, 2];
-    idx.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]));
+    let pca = crate::geom::pca(points).ok_or(Error::TooFewPoints {
+        got: 0,
+        needed: 3,
+        what: "a best-fit plane".into(),
+    })?;
+    let c = pca.centroid.coords;
     let orient = |v: Vector3| {
         let j = v.iamax();
         if v[j] < 0.0 {
@@ -55,10 +51,10 @@ pub fn plane_parameters(points: &[Point3]) -> Result<PlaneParameterization> {
             v
         }
     };
-    let a1 = orient(eig.eigenvectors.column(idx[0]).into());
-    let normal = orient(eig.eigenvectors.column(idx[2]).into());
+    let a1 = orient(pca.axes[0]);
+    let normal = orient(pca.axes[2]);
     let a2 = normal.cross(&a1);
-    let (l1, l2) = (eig.eigenvalues[idx[0]], eig.eigenvalues[idx[1]]);
+    let (l1, l2) = (pca.values[0], pca.values[1]);
     if l2.is_nan() || l2 <= 1e-24 * l1.max(f64::MIN_POSITIVE) {
         return Err(Error::InvalidInput(
             "the points are collinear (or coincide): they span no plane to parameterize over"

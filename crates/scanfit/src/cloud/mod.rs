@@ -7,8 +7,11 @@
 //!
 //! * [`neighbours`]: k-nearest and radius queries, one at a time or in
 //!   parallel batches.
+//! * [`normals`]: PCA normals over k neighbours, oriented towards a viewpoint
+//!   or over a minimum spanning tree (Hoppe et al. 1992).
 
 pub mod neighbours;
+pub mod normals;
 
 use std::sync::OnceLock;
 

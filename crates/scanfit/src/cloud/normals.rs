@@ -1,0 +1,388 @@
+//! Point normals: PCA over the k nearest neighbours, consistently oriented.
+//!
+//! The normal of point `i` is the eigenvector of the smallest eigenvalue of
+//! the covariance of `i` and its k nearest neighbours (Hoppe et al. 1992,
+//! "Surface reconstruction from unorganized points", section 3.2). PCA gives
+//! the normal's line, not its sign; two orientations are offered:
+//!
+//! * [`Orientation::Viewpoint`]: every normal points towards a viewpoint (the
+//!   scanner position), as PCL's `flipNormalTowardsViewpoint`.
+//! * [`Orientation::SpanningTree`]: Hoppe's propagation: a minimum spanning
+//!   tree of the neighbour graph with edge cost `1 - |n_i . n_j|` is walked
+//!   from a seed whose normal is fixed, flipping each child to agree with its
+//!   parent. The seed of every connected component is its point of largest
+//!   `hint . p` (the extreme point along `hint`), oriented to `hint` (by
+//!   default +z: a scan seen from above has its normals pointing up).
+//! * [`Orientation::None`]: the eigen solver's signs.
+
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+use rayon::prelude::*;
+
+use super::PointCloud;
+use crate::{pca, Error, Point3, Result, Vector3};
+
+/// How to choose the sign of each normal.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Orientation {
+    /// Leave the eigen solver's signs.
+    None,
+    /// Every normal points towards this viewpoint.
+    Viewpoint(Point3),
+    /// Propagate over a minimum spanning tree of the neighbour graph; each
+    /// component's seed (its extreme point along the hint) points along the hint.
+    SpanningTree {
+        /// Direction the seed normals point along.
+        hint: Vector3,
+    },
+}
+
+/// Normal estimation settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NormalsConfig {
+    /// Neighbours per point, the point itself excluded (default 16, as
+    /// Open3D's and PCL's common setting; at least 2).
+    pub k: usize,
+    /// Sign choice (default: spanning tree with hint +z).
+    pub orientation: Orientation,
+}
+
+impl Default for NormalsConfig {
+    fn default() -> Self {
+        Self {
+            k: 16,
+            orientation: Orientation::SpanningTree { hint: Vector3::z() },
+        }
+    }
+}
+
+/// Normals and what the estimate says about the surface.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Normals {
+    /// Unit normal per point.
+    pub normals: Vec<Vector3>,
+    /// Surface variation per point (`l3 / (l1 + l2 + l3)` of the
+    /// neighbourhood covariance): 0 on a plane, up to 1/3 at corners and noise.
+    pub variation: Vec<f64>,
+    /// Points whose neighbourhood spans no plane (all neighbours collinear or
+    /// coincident); their normal is the best the line allows (perpendicular
+    /// to it) and should not be trusted.
+    pub degenerate: Vec<usize>,
+    /// Connected components of the neighbour graph (1 for a well-sampled
+    /// single surface; with the spanning-tree orientation each component is
+    /// oriented on its own).
+    pub components: usize,
+}
+
+/// Estimates oriented normals of `cloud` (see the module documentation).
+pub fn estimate_normals(cloud: &PointCloud, config: &NormalsConfig) -> Result<Normals> {
+    if config.k < 2 {
+        return Err(Error::InvalidInput(format!(
+            "normals need k >= 2 neighbours (got {}); 16 is a good default",
+            config.k
+        )));
+    }
+    if cloud.len() < 3 {
+        return Err(Error::TooFewPoints {
+            got: cloud.len(),
+            needed: 3,
+            what: "normal estimation".into(),
+        });
+    }
+    let graph = cloud.knn_graph(config.k)?;
+    let points = cloud.points();
+    let scale = cloud.diagonal();
+    let per_point: Vec<(Vector3, f64, bool)> = (0..points.len())
+        .into_par_iter()
+        .map(|i| {
+            let nb = graph.indices_of(i);
+            let hood = std::iter::once(&points[i]).chain(nb.iter().map(|&j| &points[j as usize]));
+            match pca(hood) {
+                Some(p) => {
+                    let flat = p.values[1] <= 1e-24 * scale * scale;
+                    let n = if flat {
+                        // collinear neighbourhood: any perpendicular of the line
+                        p.axes[0].cross(&least_aligned_axis(&p.axes[0])).normalize()
+                    } else {
+                        p.axes[2]
+                    };
+                    (n, p.variation(), flat)
+                }
+                None => (Vector3::z(), 0.0, true),
+            }
+        })
+        .collect();
+    let mut normals: Vec<Vector3> = per_point.iter().map(|t| t.0).collect();
+    let variation = per_point.iter().map(|t| t.1).collect();
+    let degenerate = (0..points.len()).filter(|&i| per_point[i].2).collect();
+    let mut components = count_components(&graph_edges(&graph), points.len());
+    match config.orientation {
+        Orientation::None => {}
+        Orientation::Viewpoint(v) => {
+            for (n, p) in normals.iter_mut().zip(points) {
+                if n.dot(&(v - p)) < 0.0 {
+                    *n = -*n;
+                }
+            }
+        }
+        Orientation::SpanningTree { hint } => {
+            if !(hint.iter().all(|c| c.is_finite()) && hint.norm() > 0.0) {
+                return Err(Error::InvalidInput(
+                    "the orientation hint must be a finite non-zero vector".into(),
+                ));
+            }
+            components = orient_by_spanning_tree(points, &graph, &mut normals, &hint);
+        }
+    }
+    Ok(Normals {
+        normals,
+        variation,
+        degenerate,
+        components,
+    })
+}
+
+fn least_aligned_axis(v: &Vector3) -> Vector3 {
+    let a = v.abs();
+    if a.x <= a.y && a.x <= a.z {
+        Vector3::x()
+    } else if a.y <= a.z {
+        Vector3::y()
+    } else {
+        Vector3::z()
+    }
+}
+
+/// Undirected adjacency of the k-NN graph (both directions, deduplicated).
+fn graph_edges(graph: &super::neighbours::Neighbourhoods) -> Vec<Vec<u32>> {
+    let n = graph.len();
+    let mut adj: Vec<Vec<u32>> = (0..n).map(|i| graph.indices_of(i).to_vec()).collect();
+    for i in 0..n {
+        for &j in graph.indices_of(i) {
+            adj[j as usize].push(i as u32);
+        }
+    }
+    for a in &mut adj {
+        a.sort_unstable();
+        a.dedup();
+    }
+    adj
+}
+
+fn count_components(adj: &[Vec<u32>], n: usize) -> usize {
+    let mut seen = vec![false; n];
+    let mut count = 0;
+    let mut stack = Vec::new();
+    for s in 0..n {
+        if seen[s] {
+            continue;
+        }
+        count += 1;
+        seen[s] = true;
+        stack.push(s);
+        while let Some(i) = stack.pop() {
+            for &j in &adj[i] {
+                if !seen[j as usize] {
+                    seen[j as usize] = true;
+                    stack.push(j as usize);
+                }
+            }
+        }
+    }
+    count
+}
+
+/// Heap entry of Prim's algorithm: smallest cost first.
+#[derive(PartialEq)]
+struct Edge {
+    cost: f64,
+    from: u32,
+    to: u32,
+}
+
+impl Eq for Edge {}
+
+impl Ord for Edge {
+    fn cmp(&self, other: &Self) -> Ordering {
+        other
+            .cost
+            .total_cmp(&self.cost)
+            .then_with(|| other.to.cmp(&self.to))
+    }
+}
+
+impl PartialOrd for Edge {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+/// Hoppe's orientation propagation (see the module documentation); returns
+/// the number of connected components.
+fn orient_by_spanning_tree(
+    points: &[Point3],
+    graph: &super::neighbours::Neighbourhoods,
+    normals: &mut [Vector3],
+    hint: &Vector3,
+) -> usize {
+    let n = points.len();
+    let adj = graph_edges(graph);
+    // seeds: visit points by decreasing extent along the hint, so each
+    // component starts at its extreme point
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| {
+        hint.dot(&points[b].coords)
+            .total_cmp(&hint.dot(&points[a].coords))
+    });
+    let mut done = vec![false; n];
+    let mut heap = BinaryHeap::new();
+    let mut components = 0;
+    for &seed in &order {
+        if done[seed] {
+            continue;
+        }
+        components += 1;
+        if normals[seed].dot(hint) < 0.0 {
+            normals[seed] = -normals[seed];
+        }
+        done[seed] = true;
+        push_edges(seed, &adj, normals, &done, &mut heap);
+        while let Some(e) = heap.pop() {
+            let (from, to) = (e.from as usize, e.to as usize);
+            if done[to] {
+                continue;
+            }
+            if normals[to].dot(&normals[from]) < 0.0 {
+                normals[to] = -normals[to];
+            }
+            done[to] = true;
+            push_edges(to, &adj, normals, &done, &mut heap);
+        }
+    }
+    components
+}
+
+fn push_edges(
+    i: usize,
+    adj: &[Vec<u32>],
+    normals: &[Vector3],
+    done: &[bool],
+    heap: &mut BinaryHeap<Edge>,
+) {
+    for &j in &adj[i] {
+        if !done[j as usize] {
+            heap.push(Edge {
+                cost: 1.0 - normals[i].dot(&normals[j as usize]).abs(),
+                from: i as u32,
+                to: j,
+            });
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Points on a sphere (Fibonacci lattice).
+    fn sphere(n: usize, r: f64) -> Vec<Point3> {
+        let g = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+        (0..n)
+            .map(|i| {
+                let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+                let s = (1.0 - z * z).sqrt();
+                let a = g * i as f64;
+                Point3::new(r * s * a.cos(), r * s * a.sin(), r * z)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn plane_normals_are_exact_and_point_up() {
+        let mut p = Vec::new();
+        for i in 0..30 {
+            for j in 0..20 {
+                // a tilted plane z = 0.3x - 0.2y + 5
+                let (x, y) = (i as f64 * 0.1, j as f64 * 0.13);
+                p.push(Point3::new(x, y, 0.3 * x - 0.2 * y + 5.0));
+            }
+        }
+        let c = PointCloud::new(p).unwrap();
+        let r = estimate_normals(&c, &NormalsConfig::default()).unwrap();
+        let want = Vector3::new(-0.3, 0.2, 1.0).normalize();
+        for n in &r.normals {
+            assert!((n - want).norm() < 1e-10, "{n:?}");
+        }
+        assert!(r.variation.iter().all(|&v| v.abs() < 1e-14));
+        assert_eq!(r.components, 1);
+        assert!(r.degenerate.is_empty());
+    }
+
+    #[test]
+    fn sphere_normals_point_outwards_by_spanning_tree_and_inwards_by_viewpoint() {
+        let p = sphere(4000, 2.0);
+        let c = PointCloud::new(p.clone()).unwrap();
+        let r = estimate_normals(&c, &NormalsConfig::default()).unwrap();
+        let mut worst: f64 = 1.0;
+        for (n, q) in r.normals.iter().zip(&p) {
+            worst = worst.min(n.dot(&(q.coords / 2.0)));
+        }
+        // every normal radial and outward (PCA error on a curved patch of 17 points)
+        assert!(worst > 0.995, "worst cosine {worst}");
+        let inward = estimate_normals(
+            &c,
+            &NormalsConfig {
+                k: 16,
+                orientation: Orientation::Viewpoint(Point3::origin()),
+            },
+        )
+        .unwrap();
+        assert!(inward
+            .normals
+            .iter()
+            .zip(&p)
+            .all(|(n, q)| n.dot(&q.coords) < 0.0));
+    }
+
+    #[test]
+    fn separate_components_are_each_oriented() {
+        let mut p = Vec::new();
+        for i in 0..10 {
+            for j in 0..10 {
+                p.push(Point3::new(i as f64, j as f64, 0.0));
+                p.push(Point3::new(i as f64 + 100.0, j as f64, 50.0));
+            }
+        }
+        let c = PointCloud::new(p).unwrap();
+        let r = estimate_normals(
+            &c,
+            &NormalsConfig {
+                k: 8,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert_eq!(r.components, 2);
+        assert!(r.normals.iter().all(|n| (n - Vector3::z()).norm() < 1e-12));
+    }
+
+    #[test]
+    fn bad_input() {
+        let c = PointCloud::new(vec![Point3::origin(), Point3::new(1.0, 0.0, 0.0)]).unwrap();
+        assert!(estimate_normals(&c, &NormalsConfig::default()).is_err());
+        let line: Vec<Point3> = (0..10).map(|i| Point3::new(i as f64, 0.0, 0.0)).collect();
+        let c = PointCloud::new(line).unwrap();
+        let r = estimate_normals(&c, &NormalsConfig::default()).unwrap();
+        assert_eq!(r.degenerate.len(), 10);
+        assert!(r
+            .normals
+            .iter()
+            .all(|n| n.x.abs() < 1e-12 && (n.norm() - 1.0).abs() < 1e-12));
+        let cfg = NormalsConfig {
+            k: 1,
+            ..Default::default()
+        };
+        assert!(estimate_normals(&c, &cfg).is_err());
+    }
+}
