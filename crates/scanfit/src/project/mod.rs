@@ -1,8 +1,14 @@
 //! Projection of points onto surfaces: orthogonal projection (point inversion)
-//! and the Coons paper's grid iteration.
+//! and the Coons paper's grid iteration; and of points onto point clouds:
+//! directed projection (Azariadis 2004).
 
+mod directed;
 mod grid_iteration;
 mod inversion;
 
+pub use directed::{
+    project_directed, project_directed_batch, DirectedConfig, Neighbourhood, Projected,
+    WeightFactor,
+};
 pub use grid_iteration::{grid_iteration, GridIterationConfig};
 pub use inversion::{Inversion, InversionConfig, InversionWorkspace, SurfaceInverter};
