@@ -357,7 +357,7 @@ pub fn project_directed_batch(
         .enumerate()
         .map(|(i, (p, d))| {
             let len = d.norm();
-            if !(len.is_finite() && len > 0.0) || !p.coords.iter().all(|c| c.is_finite()) {
+            if !(len.is_finite() && len > 0.0 && p.coords.iter().all(|c| c.is_finite())) {
                 return Err(Error::InvalidInput(format!(
                     "query {i}: point {p:?} / direction {d:?} must be finite, the direction non-zero"
                 )));
