@@ -188,6 +188,43 @@ impl PointCloud {
     }
 }
 
+/// Nearest-neighbour distance statistics of a cloud: the sampling density
+/// that automatic parameters (alpha-shape radius, search radii) scale with.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Spacing {
+    /// Smallest distance from a point to its nearest other point (0 with duplicates).
+    pub min: f64,
+    /// Median nearest-neighbour distance.
+    pub median: f64,
+    /// Mean nearest-neighbour distance.
+    pub mean: f64,
+    /// Largest nearest-neighbour distance (an isolated outlier shows here).
+    pub max: f64,
+    /// Points that coincide with another point.
+    pub duplicates: usize,
+}
+
+impl PointCloud {
+    /// Nearest-neighbour distance statistics (needs at least 2 points).
+    pub fn spacing(&self) -> Result<Spacing> {
+        let g = self.knn_graph(1)?;
+        let mut d = g.distances;
+        let duplicates = d.iter().filter(|&&x| x == 0.0).count();
+        let mean = d.iter().sum::<f64>() / d.len() as f64;
+        let mid = d.len() / 2;
+        let (lo, &mut median, hi) = d.select_nth_unstable_by(mid, f64::total_cmp);
+        let min = lo.iter().copied().fold(median, f64::min);
+        let max = hi.iter().copied().fold(median, f64::max);
+        Ok(Spacing {
+            min,
+            median,
+            mean,
+            max,
+            duplicates,
+        })
+    }
+}
+
 fn checked_k(k: usize) -> Result<NonZeroUsize> {
     NonZeroUsize::new(k)
         .ok_or_else(|| Error::InvalidInput("k = 0 neighbours asked for; give k >= 1".into()))
@@ -263,6 +300,16 @@ mod tests {
         assert_eq!(c.knn_graph(100).unwrap().k, 8);
         let batch = c.knn_batch(&[Point3::new(0.0, 0.0, 0.0)], 50).unwrap();
         assert_eq!(batch.k, 9);
+    }
+
+    #[test]
+    fn spacing_of_a_grid_with_a_duplicate() {
+        let mut p: Vec<Point3> = grid(5).points().to_vec();
+        p.push(Point3::new(2.0, 2.0, 0.0));
+        p.push(Point3::new(10.0, 0.0, 0.0));
+        let s = PointCloud::new(p).unwrap().spacing().unwrap();
+        assert_eq!((s.min, s.median, s.max, s.duplicates), (0.0, 1.0, 6.0, 2));
+        assert!((s.mean - (24.0 + 6.0) / 27.0).abs() < 1e-15, "{s:?}");
     }
 
     #[test]
