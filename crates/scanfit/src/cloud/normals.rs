@@ -15,7 +15,7 @@
 //!   default +z: a scan seen from above has its normals pointing up).
 //! * [`Orientation::None`]: the eigen solver's signs.
 
-use std::cmp::Ordering;
+use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 use rayon::prelude::*;
@@ -116,7 +116,8 @@ pub fn estimate_normals(cloud: &PointCloud, config: &NormalsConfig) -> Result<No
     let mut normals: Vec<Vector3> = per_point.iter().map(|t| t.0).collect();
     let variation = per_point.iter().map(|t| t.1).collect();
     let degenerate = (0..points.len()).filter(|&i| per_point[i].2).collect();
-    let mut components = count_components(&graph_edges(&graph), points.len());
+    let adj = Adjacency::of(&graph);
+    let mut components = 0;
     match config.orientation {
         Orientation::None => {}
         Orientation::Viewpoint(v) => {
@@ -132,8 +133,11 @@ pub fn estimate_normals(cloud: &PointCloud, config: &NormalsConfig) -> Result<No
                     "the orientation hint must be a finite non-zero vector".into(),
                 ));
             }
-            components = orient_by_spanning_tree(points, &graph, &mut normals, &hint);
+            components = orient_by_spanning_tree(points, &adj, &mut normals, &hint);
         }
+    }
+    if components == 0 {
+        components = count_components(&adj, points.len());
     }
     Ok(Normals {
         normals,
@@ -154,23 +158,46 @@ fn least_aligned_axis(v: &Vector3) -> Vector3 {
     }
 }
 
-/// Undirected adjacency of the k-NN graph (both directions, deduplicated).
-fn graph_edges(graph: &super::neighbours::Neighbourhoods) -> Vec<Vec<u32>> {
-    let n = graph.len();
-    let mut adj: Vec<Vec<u32>> = (0..n).map(|i| graph.indices_of(i).to_vec()).collect();
-    for i in 0..n {
-        for &j in graph.indices_of(i) {
-            adj[j as usize].push(i as u32);
-        }
-    }
-    for a in &mut adj {
-        a.sort_unstable();
-        a.dedup();
-    }
-    adj
+/// Undirected adjacency of the k-NN graph in compressed rows: the
+/// neighbours of `i` are `targets[offsets[i]..offsets[i + 1]]` (both edge
+/// directions; an edge found from both ends appears twice, which is harmless).
+struct Adjacency {
+    offsets: Vec<usize>,
+    targets: Vec<u32>,
 }
 
-fn count_components(adj: &[Vec<u32>], n: usize) -> usize {
+impl Adjacency {
+    fn of(graph: &super::neighbours::Neighbourhoods) -> Self {
+        let n = graph.len();
+        let mut offsets = vec![0usize; n + 1];
+        for i in 0..n {
+            offsets[i + 1] += graph.k;
+            for &j in graph.indices_of(i) {
+                offsets[j as usize + 1] += 1;
+            }
+        }
+        for i in 0..n {
+            offsets[i + 1] += offsets[i];
+        }
+        let mut fill = offsets.clone();
+        let mut targets = vec![0u32; offsets[n]];
+        for i in 0..n {
+            for &j in graph.indices_of(i) {
+                targets[fill[i]] = j;
+                fill[i] += 1;
+                targets[fill[j as usize]] = i as u32;
+                fill[j as usize] += 1;
+            }
+        }
+        Self { offsets, targets }
+    }
+
+    fn of_point(&self, i: usize) -> &[u32] {
+        &self.targets[self.offsets[i]..self.offsets[i + 1]]
+    }
+}
+
+fn count_components(adj: &Adjacency, n: usize) -> usize {
     let mut seen = vec![false; n];
     let mut count = 0;
     let mut stack = Vec::new();
@@ -182,7 +209,7 @@ fn count_components(adj: &[Vec<u32>], n: usize) -> usize {
         seen[s] = true;
         stack.push(s);
         while let Some(i) = stack.pop() {
-            for &j in &adj[i] {
+            for &j in adj.of_point(i) {
                 if !seen[j as usize] {
                     seen[j as usize] = true;
                     stack.push(j as usize);
@@ -193,50 +220,27 @@ fn count_components(adj: &[Vec<u32>], n: usize) -> usize {
     count
 }
 
-/// Heap entry of Prim's algorithm: smallest cost first.
-#[derive(PartialEq)]
-struct Edge {
-    cost: f64,
-    from: u32,
-    to: u32,
-}
-
-impl Eq for Edge {}
-
-impl Ord for Edge {
-    fn cmp(&self, other: &Self) -> Ordering {
-        other
-            .cost
-            .total_cmp(&self.cost)
-            .then_with(|| other.to.cmp(&self.to))
-    }
-}
-
-impl PartialOrd for Edge {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
-/// Hoppe's orientation propagation (see the module documentation); returns
-/// the number of connected components.
+/// Hoppe's orientation propagation (see the module documentation): Prim's
+/// minimum spanning tree with edge cost `1 - |n_i . n_j|`, keeping for each
+/// point its cheapest known edge (key) and parent, heap entries packed as
+/// `(cost as f32 bits) << 32 | point` (costs are in [0, 1], where the f32
+/// bit pattern orders like the value). Returns the number of components.
 fn orient_by_spanning_tree(
     points: &[Point3],
-    graph: &super::neighbours::Neighbourhoods,
+    adj: &Adjacency,
     normals: &mut [Vector3],
     hint: &Vector3,
 ) -> usize {
     let n = points.len();
-    let adj = graph_edges(graph);
     // seeds: visit points by decreasing extent along the hint, so each
     // component starts at its extreme point
     let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by(|&a, &b| {
-        hint.dot(&points[b].coords)
-            .total_cmp(&hint.dot(&points[a].coords))
-    });
+    let along: Vec<f64> = points.iter().map(|p| hint.dot(&p.coords)).collect();
+    order.sort_unstable_by(|&a, &b| along[b].total_cmp(&along[a]).then(a.cmp(&b)));
     let mut done = vec![false; n];
-    let mut heap = BinaryHeap::new();
+    let mut key = vec![f32::INFINITY; n];
+    let mut parent = vec![u32::MAX; n];
+    let mut heap: BinaryHeap<Reverse<u64>> = BinaryHeap::new();
     let mut components = 0;
     for &seed in &order {
         if done[seed] {
@@ -246,39 +250,33 @@ fn orient_by_spanning_tree(
         if normals[seed].dot(hint) < 0.0 {
             normals[seed] = -normals[seed];
         }
-        done[seed] = true;
-        push_edges(seed, &adj, normals, &done, &mut heap);
-        while let Some(e) = heap.pop() {
-            let (from, to) = (e.from as usize, e.to as usize);
-            if done[to] {
+        heap.push(Reverse(seed as u64));
+        parent[seed] = seed as u32;
+        while let Some(Reverse(entry)) = heap.pop() {
+            let i = (entry & 0xffff_ffff) as usize;
+            if done[i] {
                 continue;
             }
-            if normals[to].dot(&normals[from]) < 0.0 {
-                normals[to] = -normals[to];
+            done[i] = true;
+            let from = parent[i] as usize;
+            if from != i && normals[i].dot(&normals[from]) < 0.0 {
+                normals[i] = -normals[i];
             }
-            done[to] = true;
-            push_edges(to, &adj, normals, &done, &mut heap);
+            for &j in adj.of_point(i) {
+                let j = j as usize;
+                if done[j] {
+                    continue;
+                }
+                let cost = (1.0 - normals[i].dot(&normals[j]).abs()).max(0.0) as f32;
+                if cost < key[j] {
+                    key[j] = cost;
+                    parent[j] = i as u32;
+                    heap.push(Reverse(((cost.to_bits() as u64) << 32) | j as u64));
+                }
+            }
         }
     }
     components
-}
-
-fn push_edges(
-    i: usize,
-    adj: &[Vec<u32>],
-    normals: &[Vector3],
-    done: &[bool],
-    heap: &mut BinaryHeap<Edge>,
-) {
-    for &j in &adj[i] {
-        if !done[j as usize] {
-            heap.push(Edge {
-                cost: 1.0 - normals[i].dot(&normals[j as usize]).abs(),
-                from: i as u32,
-                to: j,
-            });
-        }
-    }
 }
 
 #[cfg(test)]
