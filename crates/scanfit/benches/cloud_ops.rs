@@ -1,4 +1,4 @@
-#![allow(clippy::unwrap_used, clippy::expect_used)]
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 //! Point-cloud benchmarks of issue 3: KD-tree build and 16-NN over 10^6
 //! points, normals for 10^6 points, directed projection of 10^4 points onto
 //! 10^6. Run: `cargo bench -p scanfit --bench cloud_ops -- --sample-size 10`.
