@@ -94,7 +94,67 @@ pub fn render_png(
 /// Renders a point cloud (each point a small square, coloured by height,
 /// nearer points on top) and returns the PNG bytes.
 pub fn render_points_png(points: &[Point3], opts: &RenderOptions) -> Result<Vec<u8>> {
+    render_scene_png(
+        &PointScene {
+            points,
+            ..Default::default()
+        },
+        opts,
+    )
+}
+
+/// A polyline drawn over a point picture.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Polyline {
+    /// Vertices, in order.
+    pub points: Vec<Point3>,
+    /// Line colour.
+    pub rgb: [u8; 3],
+    /// Joins the last vertex to the first.
+    pub closed: bool,
+}
+
+/// A labelled marker drawn over a point picture.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Marker {
+    /// Where.
+    pub at: Point3,
+    /// Fill colour.
+    pub rgb: [u8; 3],
+    /// Text written beside it (may be empty).
+    pub label: String,
+}
+
+/// What [`render_scene_png`] draws: points (by height or in given colours),
+/// then polylines and markers on top of everything.
+#[derive(Debug, Clone, Default)]
+pub struct PointScene<'a> {
+    /// The points.
+    pub points: &'a [Point3],
+    /// One colour per point; `None` colours by height (viridis).
+    pub colours: Option<&'a [[u8; 3]]>,
+    /// Lines over the points (boundaries, curves).
+    pub polylines: Vec<Polyline>,
+    /// Markers over the lines (corners, viewpoints).
+    pub markers: Vec<Marker>,
+}
+
+/// Renders a [`PointScene`] with an orthographic camera that fits points,
+/// lines and markers into the frame; returns the PNG bytes.
+pub fn render_scene_png(scene: &PointScene, opts: &RenderOptions) -> Result<Vec<u8>> {
     let (w, h) = (opts.width.max(16) as usize, opts.height.max(16) as usize);
+    if let Some(c) = scene.colours {
+        if c.len() != scene.points.len() {
+            return Err(Error::Invalid {
+                path: "<png>".into(),
+                message: format!(
+                    "{} colours for {} points; give one colour per point",
+                    c.len(),
+                    scene.points.len()
+                ),
+            });
+        }
+    }
     let (az, el) = (opts.azimuth.to_radians(), opts.elevation.to_radians());
     let d = Vector3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
     let right = Vector3::new(-az.sin(), az.cos(), 0.0);
@@ -104,44 +164,57 @@ pub fn render_points_png(points: &[Point3], opts: &RenderOptions) -> Result<Vec<
     } else {
         1.0
     };
-    let sp: Vec<(f64, f64, f64, f64)> = points
-        .iter()
-        .map(|p| {
-            let c = Vector3::new(p.x, p.y, p.z * zs);
-            (c.dot(&right), c.dot(&up), c.dot(&d), p.z)
-        })
-        .collect();
+    let view = |p: &Point3| {
+        let c = Vector3::new(p.x, p.y, p.z * zs);
+        (c.dot(&right), c.dot(&up), c.dot(&d))
+    };
+    let sp: Vec<(f64, f64, f64)> = scene.points.iter().map(view).collect();
     let mut img = vec![255u8; w * h * 3];
-    if sp.is_empty() {
+    let extra = scene
+        .polylines
+        .iter()
+        .flat_map(|l| l.points.iter())
+        .chain(scene.markers.iter().map(|m| &m.at))
+        .map(view);
+    let all: Vec<(f64, f64, f64)> = sp.iter().copied().chain(extra).collect();
+    if all.is_empty() {
         return encode_png(&img, w as u32, h as u32);
     }
-    let fold = |f: fn(f64, f64) -> f64, init: f64, g: fn(&(f64, f64, f64, f64)) -> f64| {
-        sp.iter().map(g).fold(init, f)
-    };
-    let (x0, x1) = (
-        fold(f64::min, f64::INFINITY, |t| t.0),
-        fold(f64::max, f64::NEG_INFINITY, |t| t.0),
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
     );
-    let (y0, y1) = (
-        fold(f64::min, f64::INFINITY, |t| t.1),
-        fold(f64::max, f64::NEG_INFINITY, |t| t.1),
-    );
-    let (z0, z1) = (
-        fold(f64::min, f64::INFINITY, |t| t.3),
-        fold(f64::max, f64::NEG_INFINITY, |t| t.3),
-    );
+    for &(x, y, _) in &all {
+        (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+    }
+    let (z0, z1) = scene
+        .points
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+            (a.min(p.z), b.max(p.z))
+        });
     let top = 14.0 * opts.legend.len() as f64;
     let usable_h = h as f64 - top;
     let scale =
         (w as f64 * 0.9 / (x1 - x0).max(1e-300)).min(usable_h * 0.9 / (y1 - y0).max(1e-300));
     let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+    let pixel = |x: f64, y: f64| {
+        (
+            (w as f64 / 2.0 + (x - cx) * scale) as isize,
+            (top + usable_h / 2.0 - (y - cy) * scale) as isize,
+        )
+    };
     let mut depth = vec![f64::NEG_INFINITY; w * h];
     let r = if sp.len() > 20_000 { 0 } else { 1 };
-    for &(x, y, z, height) in &sp {
-        let px = (w as f64 / 2.0 + (x - cx) * scale) as isize;
-        let py = (top + usable_h / 2.0 - (y - cy) * scale) as isize;
-        let col = viridis(((height - z0) / (z1 - z0).max(1e-300)).clamp(0.0, 1.0))
-            .map(|c| (c * 255.0).round() as u8);
+    for (i, &(x, y, z)) in sp.iter().enumerate() {
+        let (px, py) = pixel(x, y);
+        let col = match scene.colours {
+            Some(c) => c[i],
+            None => viridis(((scene.points[i].z - z0) / (z1 - z0).max(1e-300)).clamp(0.0, 1.0))
+                .map(|c| (c * 255.0).round() as u8),
+        };
         for dy in -r..=r {
             for dx in -r..=r {
                 let (qx, qy) = (px + dx, py + dy);
@@ -156,6 +229,65 @@ pub fn render_points_png(points: &[Point3], opts: &RenderOptions) -> Result<Vec<
             }
         }
     }
+    let put = |x: isize, y: isize, rgb: [u8; 3], img: &mut [u8]| {
+        if x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h {
+            let k = (y as usize * w + x as usize) * 3;
+            img[k..k + 3].copy_from_slice(&rgb);
+        }
+    };
+    for line in &scene.polylines {
+        let n = line.points.len();
+        let segments = if line.closed { n } else { n.saturating_sub(1) };
+        for s in 0..segments {
+            let (ax, ay, _) = view(&line.points[s]);
+            let (bx, by, _) = view(&line.points[(s + 1) % n]);
+            let (pa, pb) = (pixel(ax, ay), pixel(bx, by));
+            let steps = (pb.0 - pa.0).abs().max((pb.1 - pa.1).abs()).max(1);
+            for t in 0..=steps {
+                let f = t as f64 / steps as f64;
+                let x = pa.0 as f64 + f * (pb.0 - pa.0) as f64;
+                let y = pa.1 as f64 + f * (pb.1 - pa.1) as f64;
+                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                    put(
+                        x.round() as isize + dx,
+                        y.round() as isize + dy,
+                        line.rgb,
+                        &mut img,
+                    );
+                }
+            }
+        }
+    }
+    for m in &scene.markers {
+        let (x, y, _) = view(&m.at);
+        let (px, py) = pixel(x, y);
+        for dy in -6..=6isize {
+            for dx in -6..=6isize {
+                let edge = dx.abs() == 6 || dy.abs() == 6;
+                put(
+                    px + dx,
+                    py + dy,
+                    if edge { [0, 0, 0] } else { m.rgb },
+                    &mut img,
+                );
+            }
+        }
+        if !m.label.is_empty() {
+            let mut canvas = Canvas {
+                rgb: &mut img,
+                width: w,
+                height: h,
+            };
+            draw_text(
+                &mut canvas,
+                (px + 10).max(0) as usize,
+                (py - 16).max(0) as usize,
+                &m.label,
+                2,
+                [0, 0, 0],
+            );
+        }
+    }
     let mut canvas = Canvas {
         rgb: &mut img,
         width: w,
@@ -165,6 +297,24 @@ pub fn render_points_png(points: &[Point3], opts: &RenderOptions) -> Result<Vec<
         draw_text(&mut canvas, 8, 6 + 14 * k, line, 1, [20, 20, 20]);
     }
     encode_png(&img, w as u32, h as u32)
+}
+
+/// Camera angles `(azimuth, elevation)` in degrees that look along `-n`,
+/// i.e. from the side `n` points to (z up): a top view of a patch with
+/// normal `n`.
+pub fn angles_facing(n: &Vector3) -> (f64, f64) {
+    let len = n.norm();
+    if !(len > 0.0 && len.is_finite()) {
+        return (-60.0, 35.0);
+    }
+    let n = n / len;
+    let el = n.z.clamp(-1.0, 1.0).asin().to_degrees();
+    let az = if n.x.abs() + n.y.abs() < 1e-12 {
+        -90.0
+    } else {
+        n.y.atan2(n.x).to_degrees()
+    };
+    (az, el)
 }
 
 /// Encodes an RGB8 image.
