@@ -4,6 +4,7 @@
 //! read files, call the library, print tables, write outputs.
 
 mod cad;
+mod cloud;
 mod curve;
 mod progress;
 mod report;
@@ -17,7 +18,7 @@ use clap::{Parser, Subcommand};
 #[derive(Parser, Debug)]
 #[command(name = "scanfit", version, about, long_about = None)]
 #[command(
-    after_help = "Examples:\n  scanfit curve compare examples/data/dataset5.csv\n  scanfit curve fit examples/data/dataset6.csv --ctrl 20 -o curve.json"
+    after_help = "Examples:\n  scanfit curve compare examples/data/dataset5.csv\n  scanfit curve fit examples/data/dataset6.csv --ctrl 20 -o curve.json\n  scanfit cloud info examples/data/terrain_50k.xyz"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -26,6 +27,9 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Point clouds: statistics, normals, hidden point removal, boundary and corners.
+    #[command(subcommand)]
+    Cloud(cloud::CloudCommand),
     /// B-spline curves through or near a sequence of points.
     #[command(subcommand)]
     Curve(curve::CurveCommand),
@@ -38,6 +42,7 @@ enum Command {
 fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
+        Command::Cloud(c) => cloud::run(c),
         Command::Curve(c) => curve::run(c),
         Command::Fit(a) => surface::run(a),
         Command::Report(a) => report::run(a),
