@@ -225,6 +225,28 @@ mod tests {
     }
 
     #[test]
+    fn non_finite_coordinates_dropped_on_request_and_kept_in_extra_columns() {
+        let text = "x y z w\n1 2 3 nan\n1 inf 3 0.5\n4 5 6 -inf\n";
+        let t = parse_points_with(Path::new("t.xyz"), text, NonFinite::Drop).unwrap();
+        assert_eq!(
+            t.points,
+            vec![Point3::new(1., 2., 3.), Point3::new(4., 5., 6.)]
+        );
+        assert_eq!(t.dropped_non_finite, 1);
+        assert_eq!(t.locate(1), "t.xyz:4");
+        let w = t.column("w").unwrap();
+        assert!(w[0].is_nan() && w[1] == f64::NEG_INFINITY);
+        let e = parse_points(Path::new("t.xyz"), text)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("t.xyz:3: value 2 is inf"), "{e}");
+        let e = parse_points_with(Path::new("t.xyz"), "nan 1 1\n", NonFinite::Drop)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("no points left: all 1"), "{e}");
+    }
+
+    #[test]
     fn missing_file_and_unsupported_extension() {
         let e = read_points(Path::new("/nonexistent/p.xyz"))
             .unwrap_err()

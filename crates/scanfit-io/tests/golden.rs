@@ -9,7 +9,9 @@ use scanfit::Point3;
 use scanfit_io::{read_cloud, read_points, Format, NonFinite, PointTable, ReadOptions};
 
 fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
 }
 
 fn body_start(path: &Path, marker: &[u8]) -> u64 {
@@ -18,12 +20,17 @@ fn body_start(path: &Path, marker: &[u8]) -> u64 {
 }
 
 fn col<'a>(t: &'a PointTable, name: &str) -> &'a [f64] {
-    t.column(name).unwrap_or_else(|| panic!("no column {name} in {:?}", t.columns))
+    t.column(name)
+        .unwrap_or_else(|| panic!("no column {name} in {:?}", t.columns))
 }
 
 #[test]
 fn ply_in_three_encodings() {
-    for name in ["sample_ascii.ply", "sample_binary_le.ply", "sample_binary_be.ply"] {
+    for name in [
+        "sample_ascii.ply",
+        "sample_binary_le.ply",
+        "sample_binary_be.ply",
+    ] {
         let path = data(name);
         // read_points (what the CLI calls) dispatches by extension
         let t = read_points(&path).unwrap();
@@ -52,7 +59,10 @@ fn ply_in_three_encodings() {
         assert_eq!(col(&t, "u"), &[0.0, 0.25, 0.75, 1.0]);
         assert_eq!(col(&t, "v"), &[0.125, 0.5, 0.875, 1.0]);
         let cloud = t.to_cloud().unwrap();
-        assert_eq!(cloud.normals().unwrap()[3], scanfit::Vector3::new(0.0, -1.0, 0.0));
+        assert_eq!(
+            cloud.normals().unwrap()[3],
+            scanfit::Vector3::new(0.0, -1.0, 0.0)
+        );
         assert_eq!(cloud.attribute("label").unwrap()[3], 65535.0);
         // where vertex 1 is: a line, or the byte offset of its record
         let h = body_start(&path, b"end_header\n");
@@ -71,7 +81,11 @@ fn ply_in_three_encodings() {
 
 #[test]
 fn pcd_in_three_encodings_with_a_nan_point() {
-    for name in ["sample_ascii.pcd", "sample_binary.pcd", "sample_binary_compressed.pcd"] {
+    for name in [
+        "sample_ascii.pcd",
+        "sample_binary.pcd",
+        "sample_binary_compressed.pcd",
+    ] {
         let path = data(name);
         let p = path.display();
         let e = read_points(&path).unwrap_err().to_string();
@@ -163,7 +177,10 @@ fn las_and_laz_keep_georeferenced_coordinates_and_attributes() {
         if name == "sample.las" {
             let b = std::fs::read(&path).unwrap();
             let start = u32::from_le_bytes(b[96..100].try_into().unwrap()) as u64;
-            assert_eq!(t.locate(1), format!("{p}: byte offset {} (point record 1)", start + 34));
+            assert_eq!(
+                t.locate(1),
+                format!("{p}: byte offset {} (point record 1)", start + 34)
+            );
         } else {
             assert_eq!(t.locate(1), format!("{p}: point record 1"));
         }
@@ -180,7 +197,10 @@ fn las_header_errors() {
     let mut more = b.clone();
     more[107..111].copy_from_slice(&1_000_000_000u32.to_le_bytes());
     let e = parse(&more).unwrap_err().to_string();
-    assert!(e.contains("declares 1000000000 point records of 34 bytes") && e.contains("3 complete"), "{e}");
+    assert!(
+        e.contains("declares 1000000000 point records of 34 bytes") && e.contains("3 complete"),
+        "{e}"
+    );
     let e = parse(&b[..b.len() - 10]).unwrap_err().to_string();
     assert!(e.contains("2 complete records"), "{e}");
     let e = parse(b"LASX and more").unwrap_err().to_string();

@@ -12,7 +12,12 @@ use scanfit::{Point3, PointCloud};
 use scanfit_io::{cloud_bytes, parse_cloud, NonFinite, ReadOptions, WriteFormat};
 
 fn sample(name: &str) -> Vec<u8> {
-    std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)).unwrap()
+    std::fs::read(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data")
+            .join(name),
+    )
+    .unwrap()
 }
 
 /// Small valid files of every format and encoding, named by extension.
@@ -72,12 +77,23 @@ fn every_truncation_and_byte_corruption() {
             non_finite: NonFinite::Drop,
             ..Default::default()
         };
-        assert!(parse_cloud(Path::new(name), &bytes, &opts).is_ok(), "{name}");
+        assert!(
+            parse_cloud(Path::new(name), &bytes, &opts).is_ok(),
+            "{name}"
+        );
         for cut in 0..bytes.len() {
             read(name, &bytes[..cut]);
         }
         for i in 0..bytes.len() {
-            for v in [0u8, 0xff, bytes[i] ^ 0x01, bytes[i] ^ 0x80, b'9', b'\n', b' '] {
+            for v in [
+                0u8,
+                0xff,
+                bytes[i] ^ 0x01,
+                bytes[i] ^ 0x80,
+                b'9',
+                b'\n',
+                b' ',
+            ] {
                 let mut b = bytes.clone();
                 b[i] = v;
                 read(name, &b);
@@ -104,8 +120,8 @@ fn huge_counts_are_refused_without_allocating() {
             b.extend(&bytes[end..]);
             let e = parse_cloud(Path::new(name), &b, &opts);
             // elements after the vertex element are not read
-            let after_vertex = key == "element face "
-                && text.find("element vertex").is_some_and(|v| v < at);
+            let after_vertex =
+                key == "element face " && text.find("element vertex").is_some_and(|v| v < at);
             assert_eq!(e.is_err(), !after_vertex, "{name} {key}");
         }
     }
