@@ -23,6 +23,16 @@ pub enum Error {
         /// what is wrong and what to change
         message: String,
     },
+    /// The binary content of the file is malformed at a given byte offset.
+    #[error("{path}: byte offset {offset}: {message}")]
+    Binary {
+        /// the file
+        path: PathBuf,
+        /// byte offset from the start of the file
+        offset: u64,
+        /// what is wrong and what to change
+        message: String,
+    },
     /// The file as a whole is unusable (empty, wrong format).
     #[error("{path}: {message}")]
     Invalid {

@@ -1,22 +1,31 @@
 //! # scanfit-io
 //!
-//! File formats for scanfit: point files in (XYZ/CSV/TXT), curves and surfaces
+//! File formats for scanfit: point files in (PLY, PCD, LAS/LAZ, XYZ/CSV/TXT;
+//! [`read_cloud`]) and out ([`write_cloud`]), curves and surfaces
 //! out and back (JSON), points and meshes out (PLY, OBJ, XYZ), pictures out
 //! (SVG, PNG). Every writer is atomic: it writes a temporary
 //! file next to the target and renames it on success, so a failed run never
 //! leaves a half-written file.
 
 mod atomic;
+mod binary;
+pub mod cloud;
 mod error;
 pub mod gltf;
 pub mod iges;
 pub mod json;
+mod las;
+mod pcd;
 pub mod ply;
+mod ply_read;
 pub mod render;
 pub mod step;
 pub mod svg;
+pub mod table;
 pub mod xyz;
 
 pub use atomic::{write_all_atomic, write_atomic};
+pub use cloud::{cloud_bytes, parse_cloud, read_cloud, write_cloud, WriteFormat};
 pub use error::{Error, Result};
-pub use xyz::{read_points, PointTable};
+pub use table::{Format, NonFinite, Origin, PointTable, ReadOptions};
+pub use xyz::read_points;

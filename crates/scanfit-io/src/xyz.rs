@@ -7,73 +7,26 @@
 //! `col4`, `col5`, ... without one). Every point remembers its line number, so
 //! errors about a point can name `file:line`.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use scanfit::Point3;
 
+use crate::table::{Format, NonFinite, Origin, PointTable, ReadOptions};
 use crate::{Error, Result};
 
-/// Points read from a file, with their extra columns and source lines.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PointTable {
-    /// The file the points came from.
-    pub path: PathBuf,
-    /// The points (x, y, z = the first three columns).
-    pub points: Vec<Point3>,
-    /// Names of all columns (header names, or x, y, z, col4, ...).
-    pub columns: Vec<String>,
-    /// Extra columns beyond x, y, z: `extra[c][i]` is column `c + 3` of point `i`.
-    pub extra: Vec<Vec<f64>>,
-    /// 1-based line number of each point in the file.
-    pub lines: Vec<usize>,
-}
-
-impl PointTable {
-    /// `file:line` of point `index` (for error messages).
-    pub fn locate(&self, index: usize) -> String {
-        match self.lines.get(index) {
-            Some(l) => format!("{}:{l}", self.path.display()),
-            None => self.path.display().to_string(),
-        }
-    }
-
-    /// The extra column named `name`, if any.
-    pub fn column(&self, name: &str) -> Option<&[f64]> {
-        let i = self
-            .columns
-            .iter()
-            .position(|c| c.eq_ignore_ascii_case(name))?;
-        if i < 3 {
-            return None;
-        }
-        self.extra.get(i - 3).map(|v| v.as_slice())
-    }
-}
-
-/// File types the reader knows, by extension.
-const TEXT_EXTENSIONS: [&str; 5] = ["xyz", "csv", "txt", "pts", "asc"];
-
-/// Reads a text point file (see the module documentation).
+/// Reads a point file of any supported format with the default options:
+/// the format by extension, non-finite coordinates rejected. Kept for the
+/// callers of the text-only reader; see [`crate::read_cloud`].
 pub fn read_points(path: &Path) -> Result<PointTable> {
-    let ext = path
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
-    if !ext.is_empty() && !TEXT_EXTENSIONS.contains(&ext.as_str()) {
-        return Err(Error::Invalid {
-            path: path.to_path_buf(),
-            message: format!(
-                "'.{ext}' files are not supported yet; give a text point file ({})",
-                TEXT_EXTENSIONS.map(|e| format!(".{e}")).join(", ")
-            ),
-        });
-    }
-    let bytes = std::fs::read(path).map_err(|error| Error::Io {
-        path: path.to_path_buf(),
-        error,
-    })?;
-    let text = String::from_utf8(bytes).map_err(|e| {
-        let line = 1 + e.as_bytes()[..e.utf8_error().valid_up_to()]
+    crate::read_cloud(path, &ReadOptions::default())
+}
+
+/// Parses the bytes of a text point file (`path` is used for messages only).
+pub(crate) fn parse_bytes(path: &Path, bytes: &[u8], policy: NonFinite) -> Result<PointTable> {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        let line = 1 + bytes
+            .get(..e.valid_up_to())
+            .unwrap_or_default()
             .iter()
             .filter(|&&b| b == b'\n')
             .count();
@@ -83,11 +36,19 @@ pub fn read_points(path: &Path) -> Result<PointTable> {
             message: "not UTF-8 text; is this a binary file?".into(),
         }
     })?;
-    parse_points(path, &text)
+    parse_points_with(path, text, policy)
 }
 
-/// Parses the text of a point file (`path` is used for messages only).
+/// Parses the text of a point file (`path` is used for messages only),
+/// rejecting non-finite coordinates.
 pub fn parse_points(path: &Path, text: &str) -> Result<PointTable> {
+    parse_points_with(path, text, NonFinite::Reject)
+}
+
+/// Parses the text of a point file with a policy for non-finite coordinates
+/// (`path` is used for messages only). Non-finite values in extra columns
+/// are kept: they are data (a missing normal, an undefined curvature).
+pub fn parse_points_with(path: &Path, text: &str, policy: NonFinite) -> Result<PointTable> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let perr = |line: usize, message: String| Error::Parse {
         path: path.to_path_buf(),
@@ -100,6 +61,7 @@ pub fn parse_points(path: &Path, text: &str) -> Result<PointTable> {
     let mut extra: Vec<Vec<f64>> = Vec::new();
     let mut lines = Vec::new();
     let mut values: Vec<f64> = Vec::new();
+    let mut dropped = 0usize;
     for (i, raw) in text.lines().enumerate() {
         let line_no = i + 1;
         let line = raw.trim();
@@ -162,26 +124,35 @@ pub fn parse_points(path: &Path, text: &str) -> Result<PointTable> {
                 ),
             ));
         }
-        if let Some(k) = values.iter().position(|v| !v.is_finite()) {
+        if let Some(k) = values.iter().take(3).position(|v| !v.is_finite()) {
+            if policy == NonFinite::Drop {
+                dropped += 1;
+                continue;
+            }
             return Err(perr(
                 line_no,
                 format!(
-                    "value {} is {}; every coordinate must be a finite number",
+                    "value {} is {}; every coordinate must be a finite number (fix the line, or read with ReadOptions {{ non_finite: NonFinite::Drop, .. }} to leave such points out)",
                     k + 1,
-                    values[k]
+                    values.get(k).copied().unwrap_or(f64::NAN)
                 ),
             ));
         }
-        points.push(Point3::new(values[0], values[1], values[2]));
+        let value = |k: usize| values.get(k).copied().unwrap_or(0.0);
+        points.push(Point3::new(value(0), value(1), value(2)));
         for (c, col) in extra.iter_mut().enumerate() {
-            col.push(values[3 + c]);
+            col.push(value(3 + c));
         }
         lines.push(line_no);
     }
     if points.is_empty() {
         return Err(Error::Invalid {
             path: path.to_path_buf(),
-            message: "no points found (the file is empty or holds only a header/comments)".into(),
+            message: if dropped > 0 {
+                format!("no points left: all {dropped} have a non-finite coordinate")
+            } else {
+                "no points found (the file is empty or holds only a header/comments)".into()
+            },
         });
     }
     let columns = columns.unwrap_or_else(|| {
@@ -191,10 +162,13 @@ pub fn parse_points(path: &Path, text: &str) -> Result<PointTable> {
     });
     Ok(PointTable {
         path: path.to_path_buf(),
+        format: Format::Text,
         points,
         columns,
         extra,
-        lines,
+        origin: Origin::Lines(lines),
+        file_index: None,
+        dropped_non_finite: dropped,
     })
 }
 
@@ -213,7 +187,7 @@ mod tests {
             t.points,
             vec![Point3::new(1., 2., 3.), Point3::new(4., 5., 6.)]
         );
-        assert_eq!(t.lines, vec![2, 5]);
+        assert_eq!(t.origin, Origin::Lines(vec![2, 5]));
         assert_eq!(t.column("w").unwrap(), &[0.5, 1.5]);
         assert_eq!(t.locate(1), "t.csv:5");
     }
@@ -248,6 +222,28 @@ mod tests {
         assert!(e.contains("no points found"), "{e}");
         let e = parse("1 2\n").unwrap_err().to_string();
         assert!(e.contains("at least x, y, z"), "{e}");
+    }
+
+    #[test]
+    fn non_finite_coordinates_dropped_on_request_and_kept_in_extra_columns() {
+        let text = "x y z w\n1 2 3 nan\n1 inf 3 0.5\n4 5 6 -inf\n";
+        let t = parse_points_with(Path::new("t.xyz"), text, NonFinite::Drop).unwrap();
+        assert_eq!(
+            t.points,
+            vec![Point3::new(1., 2., 3.), Point3::new(4., 5., 6.)]
+        );
+        assert_eq!(t.dropped_non_finite, 1);
+        assert_eq!(t.locate(1), "t.xyz:4");
+        let w = t.column("w").unwrap();
+        assert!(w[0].is_nan() && w[1] == f64::NEG_INFINITY);
+        let e = parse_points(Path::new("t.xyz"), text)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("t.xyz:3: value 2 is inf"), "{e}");
+        let e = parse_points_with(Path::new("t.xyz"), "nan 1 1\n", NonFinite::Drop)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("no points left: all 1"), "{e}");
     }
 
     #[test]
