@@ -8,9 +8,10 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
 use scanfit::cloud::normals::{estimate_normals, NormalsConfig, Orientation};
 use scanfit::{Point3, PointCloud, Vector3};
-use scanfit_io::ply::{points_ply, points_xyz, PlyFormat};
-use scanfit_io::render::{render_scene_png, PointScene};
-use scanfit_io::{read_points, write_all_atomic};
+use scanfit_io::render::{render_scene_png, PointScene, RenderOptions};
+use scanfit_io::{
+    cloud_bytes, read_cloud, write_all_atomic, Format, NonFinite, ReadOptions, WriteFormat,
+};
 
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -34,8 +35,8 @@ Spacing is the distance of each point to its nearest other point (KD-tree).";
 #[derive(Args, Debug)]
 #[command(after_help = INFO_EXAMPLES)]
 pub struct InfoArgs {
-    /// Input point file.
-    pub input: PathBuf,
+    #[command(flatten)]
+    pub input: InputArgs,
     /// Print the report as JSON on stdout instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -57,8 +58,8 @@ by its normal: wrongly oriented normals show as dark speckles.";
 #[derive(Args, Debug)]
 #[command(after_help = NORMALS_EXAMPLES)]
 pub struct NormalsArgs {
-    /// Input point file.
-    pub input: PathBuf,
+    #[command(flatten)]
+    pub input: InputArgs,
     /// Neighbours per point.
     #[arg(long, default_value_t = 16)]
     pub k: usize,
@@ -97,16 +98,49 @@ pub fn run(c: CloudCommand) -> Result<()> {
     }
 }
 
-/// Reads a point file into a cloud that keeps every extra column as an attribute.
-pub fn load(path: &Path) -> Result<PointCloud> {
-    let table = read_points(path)?;
-    let names: Vec<String> = table.columns.iter().skip(3).cloned().collect();
-    let mut cloud = PointCloud::new(table.points.clone())
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    for (name, values) in names.into_iter().zip(table.extra) {
-        cloud.set_attribute(&name, values)?;
+/// The input file of a `cloud` command and how to read it.
+#[derive(Args, Debug, Clone)]
+pub struct InputArgs {
+    /// Input point file (.ply, .pcd, .las/.laz, .xyz/.csv/.txt/.pts/.asc).
+    pub input: PathBuf,
+    /// Read as this format whatever the extension: ply, pcd, las, text.
+    #[arg(long, value_name = "FORMAT")]
+    pub format: Option<String>,
+    /// Drop points with NaN or infinite coordinates (and report how many)
+    /// instead of stopping at the first one.
+    #[arg(long)]
+    pub drop_non_finite: bool,
+}
+
+impl InputArgs {
+    /// Reads the file into a cloud that keeps every extra column as an
+    /// attribute; returns it with the number of non-finite points dropped.
+    pub fn load(&self) -> Result<(PointCloud, usize)> {
+        let format = match self
+            .format
+            .as_deref()
+            .map(str::to_ascii_lowercase)
+            .as_deref()
+        {
+            None => None,
+            Some("ply") => Some(Format::Ply),
+            Some("pcd") => Some(Format::Pcd),
+            Some("las") | Some("laz") => Some(Format::Las),
+            Some("text") | Some("xyz") | Some("csv") | Some("txt") => Some(Format::Text),
+            Some(f) => bail!("unknown --format '{f}'; use ply, pcd, las or text"),
+        };
+        let options = ReadOptions {
+            format,
+            non_finite: if self.drop_non_finite {
+                NonFinite::Drop
+            } else {
+                NonFinite::Reject
+            },
+        };
+        let table = read_cloud(&self.input, &options)?;
+        let dropped = table.dropped_non_finite;
+        Ok((table.into_cloud()?, dropped))
     }
-    Ok(cloud)
 }
 
 /// Parses "X,Y,Z".
@@ -149,27 +183,27 @@ pub fn check_outputs(outputs: &[(&Option<PathBuf>, &str, &[&str])]) -> Result<()
     Ok(())
 }
 
-/// The bytes of `cloud` with all its attributes as PLY (binary) or XYZ, by extension.
-pub fn cloud_bytes(path: &Path, cloud: &PointCloud) -> Vec<u8> {
-    let attrs: Vec<(&str, &[f64])> = cloud
-        .attributes()
-        .iter()
-        .map(|a| (a.name.as_str(), a.values.as_slice()))
-        .collect();
-    if extension(path) == "xyz" {
-        points_xyz(cloud.points(), &attrs)
-    } else {
-        points_ply(cloud.points(), &attrs, PlyFormat::Binary)
+/// The bytes of `cloud` with all its attributes as binary PLY or XYZ text, by extension.
+pub fn cloud_file(path: &Path, cloud: &PointCloud) -> Result<Vec<u8>> {
+    let format = WriteFormat::from_path(path)
+        .with_context(|| format!("{}: write points as .ply or .xyz", path.display()))?;
+    Ok(cloud_bytes(cloud, format))
+}
+
+/// Tells on stderr how many non-finite points were dropped (unless JSON is printed).
+fn note_dropped(dropped: usize, json: bool) {
+    if dropped > 0 && !json {
+        eprintln!("note: {dropped} points with NaN or infinite coordinates dropped");
     }
 }
 
 fn info(a: InfoArgs) -> Result<()> {
     let t0 = Instant::now();
-    let cloud = load(&a.input)?;
+    let (cloud, dropped) = a.input.load()?;
     let read_s = t0.elapsed().as_secs_f64();
     let (lo, hi) = cloud
         .bounding_box()
-        .with_context(|| format!("{}: no points", a.input.display()))?;
+        .with_context(|| format!("{}: no points", a.input.input.display()))?;
     let spacing = if cloud.len() >= 2 {
         Some(cloud.spacing()?)
     } else {
@@ -190,8 +224,9 @@ fn info(a: InfoArgs) -> Result<()> {
         .collect();
     if a.json {
         let report = serde_json::json!({
-            "file": a.input.display().to_string(),
+            "file": a.input.input.display().to_string(),
             "points": cloud.len(),
+            "dropped_non_finite": dropped,
             "bbox_min": [lo.x, lo.y, lo.z],
             "bbox_max": [hi.x, hi.y, hi.z],
             "diagonal": (hi - lo).norm(),
@@ -204,7 +239,7 @@ fn info(a: InfoArgs) -> Result<()> {
     }
     println!(
         "{}: {} points (read in {:.3} s)\n",
-        a.input.display(),
+        a.input.input.display(),
         cloud.len(),
         read_s
     );
@@ -246,26 +281,27 @@ fn info(a: InfoArgs) -> Result<()> {
 }
 
 /// Colours that shade each point by its normal against a light from the
-/// camera side: consistent normals give a smooth shading, flipped ones are dark.
-fn normal_shading(normals: &[Vector3], azimuth: f64, elevation: f64) -> Vec<[u8; 3]> {
-    let (az, el) = (azimuth.to_radians(), elevation.to_radians());
+/// camera side: normals towards the camera are shaded orange, normals facing
+/// away blue, so a consistent orientation gives one smooth colour and flipped
+/// normals stand out. `z_scale` is the picture's vertical exaggeration (the
+/// normals of the exaggerated shape are `(nx, ny, nz / z_scale)`).
+fn normal_shading(normals: &[Vector3], opts: &RenderOptions) -> Vec<[u8; 3]> {
+    let (az, el) = (opts.azimuth.to_radians(), opts.elevation.to_radians());
     let d = Vector3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
-    let light = (d + Vector3::new(0.0, 0.0, 0.3)).normalize();
+    let light = (d + Vector3::new(0.0, 0.0, 0.5)).normalize();
+    let zs = opts.z_scale;
     normals
         .iter()
         .map(|n| {
-            let l = n.dot(&light);
-            if l >= 0.0 {
-                let v = 0.25 + 0.75 * l;
-                [
-                    (90.0 + 150.0 * v) as u8,
-                    (110.0 + 130.0 * v) as u8,
-                    (140.0 + 110.0 * v) as u8,
-                ]
+            let m = Vector3::new(n.x, n.y, n.z / zs);
+            let m = m / m.norm().max(f64::MIN_POSITIVE);
+            let l = m.dot(&light);
+            let (v, base) = if m.dot(&d) >= 0.0 {
+                (0.25 + 0.75 * l.abs(), [235.0, 165.0, 70.0])
             } else {
-                let v = 0.3 + 0.5 * (-l);
-                [(120.0 * v) as u8, (40.0 * v) as u8, (40.0 * v) as u8]
-            }
+                (0.35 + 0.65 * l.abs(), [50.0, 80.0, 220.0])
+            };
+            base.map(|c: f64| (c * v).round() as u8)
         })
         .collect()
 }
@@ -287,7 +323,8 @@ fn normals(a: NormalsArgs) -> Result<()> {
     };
     let progress = Progress::spinner(a.quiet || a.json);
     progress.stage("reading");
-    let mut cloud = load(&a.input)?;
+    let (mut cloud, dropped) = a.input.load()?;
+    note_dropped(dropped, a.json);
     progress.stage(format!("normals of {} points", cloud.len()));
     let t0 = Instant::now();
     let r = estimate_normals(
@@ -297,13 +334,13 @@ fn normals(a: NormalsArgs) -> Result<()> {
             orientation,
         },
     )
-    .with_context(|| format!("normals of {}", a.input.display()))?;
+    .with_context(|| format!("normals of {}", a.input.input.display()))?;
     let secs = t0.elapsed().as_secs_f64();
     cloud.set_normals(&r.normals)?;
     cloud.set_attribute("variation", r.variation.clone())?;
     let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
     if let Some(o) = &a.output {
-        files.push((o.clone(), cloud_bytes(o, &cloud)));
+        files.push((o.clone(), cloud_file(o, &cloud)?));
     }
     if let Some(p) = &a.png {
         progress.stage("picture");
@@ -311,14 +348,15 @@ fn normals(a: NormalsArgs) -> Result<()> {
         opts.legend = vec![
             format!(
                 "{}: normals of {} points, k = {}, orientation {}",
-                a.input.display(),
+                a.input.input.display(),
                 cloud.len(),
                 a.k,
                 a.orient
             ),
-            "light = consistent, dark red = facing away from the camera".into(),
+            "orange = normal towards the camera (shaded by the light), blue = normal facing away"
+                .into(),
         ];
-        let colours = normal_shading(&r.normals, opts.azimuth, opts.elevation);
+        let colours = normal_shading(&r.normals, &opts);
         let png = render_scene_png(
             &PointScene {
                 points: cloud.points(),
@@ -338,7 +376,7 @@ fn normals(a: NormalsArgs) -> Result<()> {
     let mean_var = r.variation.iter().sum::<f64>() / r.variation.len().max(1) as f64;
     if a.json {
         let report = serde_json::json!({
-            "file": a.input.display().to_string(),
+            "file": a.input.input.display().to_string(),
             "points": cloud.len(),
             "k": a.k,
             "orientation": a.orient,

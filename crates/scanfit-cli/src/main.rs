@@ -40,6 +40,21 @@ enum Command {
 }
 
 fn main() {
+    // `scanfit ... | head`: a closed stdout ends the program quietly, as for
+    // any Unix tool, instead of a panic message from println!
+    let default_hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let msg = info
+            .payload()
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| info.payload().downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if msg.contains("failed printing to stdout") && msg.contains("Broken pipe") {
+            std::process::exit(141);
+        }
+        default_hook(info);
+    }));
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Cloud(c) => cloud::run(c),
