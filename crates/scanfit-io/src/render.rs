@@ -207,7 +207,31 @@ pub fn render_scene_png(scene: &PointScene, opts: &RenderOptions) -> Result<Vec<
         )
     };
     let mut depth = vec![f64::NEG_INFINITY; w * h];
-    let r = if sp.len() > 20_000 { 0 } else { 1 };
+    // splat size: points cover the picture of a surface (about half of the
+    // projected box, twice over for the front of a closed body), so nearer
+    // points hide farther ones
+    let area = (x1 - x0) * (y1 - y0) * scale * scale;
+    let spacing_px = (2.0 * area / sp.len().max(1) as f64).sqrt();
+    let r = (0.5 * spacing_px).round().clamp(0.0, 4.0) as isize;
+    // visibility in two passes: the depth of the front surface with wider
+    // splats (so it has no holes), then the colours of the points within a
+    // few point spacings of that front (the back of a closed body stays hidden)
+    let wide = (2 * r + 2).min(10);
+    let tolerance = (2.0 * (wide as f64 + 1.0) + 3.0 * spacing_px.max(1.0)) / scale;
+    let footprint = |px: isize, py: isize, r: isize| {
+        (-r..=r).flat_map(move |dy| (-r..=r).map(move |dx| (px + dx, py + dy)))
+    };
+    let inside = |qx: isize, qy: isize| qx >= 0 && qy >= 0 && qx < w as isize && qy < h as isize;
+    for &(x, y, z) in &sp {
+        let (px, py) = pixel(x, y);
+        for (qx, qy) in footprint(px, py, wide) {
+            if inside(qx, qy) {
+                let k = qy as usize * w + qx as usize;
+                depth[k] = depth[k].max(z);
+            }
+        }
+    }
+    let mut drawn = vec![f64::NEG_INFINITY; w * h];
     for (i, &(x, y, z)) in sp.iter().enumerate() {
         let (px, py) = pixel(x, y);
         let col = match scene.colours {
@@ -215,17 +239,14 @@ pub fn render_scene_png(scene: &PointScene, opts: &RenderOptions) -> Result<Vec<
             None => viridis(((scene.points[i].z - z0) / (z1 - z0).max(1e-300)).clamp(0.0, 1.0))
                 .map(|c| (c * 255.0).round() as u8),
         };
-        for dy in -r..=r {
-            for dx in -r..=r {
-                let (qx, qy) = (px + dx, py + dy);
-                if qx < 0 || qy < 0 || qx >= w as isize || qy >= h as isize {
-                    continue;
-                }
-                let k = qy as usize * w + qx as usize;
-                if z > depth[k] {
-                    depth[k] = z;
-                    img[k * 3..k * 3 + 3].copy_from_slice(&col);
-                }
+        for (qx, qy) in footprint(px, py, r) {
+            if !inside(qx, qy) {
+                continue;
+            }
+            let k = qy as usize * w + qx as usize;
+            if z >= depth[k] - tolerance && z > drawn[k] {
+                drawn[k] = z;
+                img[k * 3..k * 3 + 3].copy_from_slice(&col);
             }
         }
     }
