@@ -2,13 +2,13 @@
 //!
 //! The PDE/Coons reconstruction paper (Zhu et al.,
 //! `pde-coons-surface-reconstruction`, §4.1) extracts the boundary of each
-//! segmented subset with alpha shapes (Edelsbrunner, ref. [29] there) and
+//! segmented subset with alpha shapes (Edelsbrunner, ref. 29 there) and
 //! tunes the alpha parameter when the boundary has outliers or too few
 //! points. For a patch that is a height field over its best-fit plane this
 //! is done in the plane:
 //!
 //! 1. project the points onto the best-fit plane
-//!    ([`plane_parameters`](crate::base::plane_parameters): PCA normal,
+//!    ([`plane_parameters`]: PCA normal,
 //!    minimum-area-rectangle axes);
 //! 2. Delaunay-triangulate the projections (spade);
 //! 3. keep the triangles whose circumradius is below `alpha` (the alpha

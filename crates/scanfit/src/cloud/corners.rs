@@ -15,7 +15,7 @@
 //!   this angle comes out to be least are selected".
 //! * [`CornerCriterion::ThreePointCurvature`], PDE/Coons reconstruction
 //!   paper (`pde-coons-surface-reconstruction`, §4.1, the unnumbered
-//!   equation after ref. [30], Belyaev's three-point curvature):
+//!   equation after ref. 30, Belyaev's three-point curvature):
 //!   `k = 4 S / (a b c)`, `S` the area of the triangle `A = P[n-m]`,
 //!   `B = P[n]`, `C = P[n+m]`, `a = |AB|`, `b = |BC|`, `c = |AC|` (the
 //!   inverse circumradius); "the top four or three curvature points will be

@@ -2,8 +2,10 @@
 //! 1996, "The quickhull algorithm for convex hulls") on exact orientation
 //! predicates.
 //!
-//! Every "is point `q` above face `abc`" decision is Shewchuk's adaptive
-//! exact `orient3d` (the `robust` crate), so coplanar and duplicate points
+//! Every "is point `q` above face `abc`" decision is exact: a floating-point
+//! filter (the face normal times `q - a`, trusted when it exceeds the
+//! rounding-error bound of Shewchuk's orient3d) and otherwise Shewchuk's
+//! adaptive exact `orient3d` (the `robust` crate), so coplanar and duplicate points
 //! never make the algorithm inconsistent: a point exactly on a face plane
 //! counts as inside, and the hull is always a closed, outward-oriented
 //! triangulated polytope. Floating-point plane distances are only used to pick
@@ -72,8 +74,13 @@ struct Face {
     v: [u32; 3],
     /// `nb[i]`: the face across edge `(v[i], v[(i + 1) % 3])`.
     nb: [u32; 3],
-    /// Unit outward normal (floating point, for distances only).
+    /// Outward normal `(b - a) x (c - a)` as computed in floating point.
     n: [f64; 3],
+    /// `|u_y v_z| + |u_z v_y|`, ... for `u = b - a`, `v = c - a`: the
+    /// magnitudes behind `n`, for the rounding-error bound of `n . (q - a)`.
+    perm: [f64; 3],
+    /// `1 / |n|`, to turn `n . (q - a)` into a distance.
+    inv_len: f64,
     /// First point of the outside set (linked through `Hull::next`).
     head: u32,
     /// Farthest outside point and its distance.
@@ -124,7 +131,21 @@ fn norm(a: &[f64; 3]) -> f64 {
 impl Hull<'_> {
     /// Whether `q` is strictly above (outside) the plane of face `f` (exact).
     fn above(&self, f: u32, q: u32) -> bool {
-        let v = self.faces[f as usize].v;
+        let face = &self.faces[f as usize];
+        let v = face.v;
+        // floating-point filter: the determinant n . (q - a) with the error
+        // bound of Shewchuk's orient3d, (7 + 56 eps) eps * permanent, rounded
+        // up to 1e-15 (~9 eps); undecided cases go to the exact predicate
+        let d = sub(&self.p[q as usize], &self.p[v[0] as usize]);
+        let det = dot(&face.n, &d);
+        let bound = 1e-15
+            * (face.perm[0] * d[0].abs() + face.perm[1] * d[1].abs() + face.perm[2] * d[2].abs());
+        if det > bound {
+            return true;
+        }
+        if det < -bound {
+            return false;
+        }
         // robust's orient3d is negative when the fourth point is on the side
         // from which the first three appear counter-clockwise
         orient3d(
@@ -137,17 +158,20 @@ impl Hull<'_> {
 
     fn new_face(&mut self, v: [u32; 3]) -> u32 {
         let [a, b, c] = v.map(|i| &self.p[i as usize]);
-        let n = cross(&sub(b, a), &sub(c, a));
+        let (u, w) = (sub(b, a), sub(c, a));
+        let n = cross(&u, &w);
+        let perm = [
+            (u[1] * w[2]).abs() + (u[2] * w[1]).abs(),
+            (u[2] * w[0]).abs() + (u[0] * w[2]).abs(),
+            (u[0] * w[1]).abs() + (u[1] * w[0]).abs(),
+        ];
         let len = norm(&n);
-        let n = if len > 0.0 {
-            [n[0] / len, n[1] / len, n[2] / len]
-        } else {
-            [0.0; 3]
-        };
         let face = Face {
             v,
             nb: [NIL; 3],
             n,
+            perm,
+            inv_len: if len > 0.0 { 1.0 / len } else { 0.0 },
             head: NIL,
             far: NIL,
             far_d: f64::NEG_INFINITY,
@@ -174,7 +198,7 @@ impl Hull<'_> {
             if self.above(f, q) {
                 let face = &mut self.faces[f as usize];
                 let a = &self.p[face.v[0] as usize];
-                let d = dot(&face.n, &sub(&self.p[q as usize], a));
+                let d = dot(&face.n, &sub(&self.p[q as usize], a)) * face.inv_len;
                 self.next[q as usize] = face.head;
                 face.head = q;
                 if d > face.far_d {
@@ -243,9 +267,11 @@ pub fn convex_hull(points: &[Point3]) -> Result<ConvexHull> {
         .collect();
     let simplex = initial_simplex(&p)?;
     let faces = quickhull(&p, simplex)?;
-    let mut vertices: Vec<usize> = faces.iter().flatten().copied().collect();
-    vertices.sort_unstable();
-    vertices.dedup();
+    let mut is_vertex = vec![false; p.len()];
+    for &v in faces.iter().flatten() {
+        is_vertex[v] = true;
+    }
+    let vertices: Vec<usize> = (0..p.len()).filter(|&i| is_vertex[i]).collect();
     Ok(ConvexHull { faces, vertices })
 }
 
@@ -618,6 +644,33 @@ mod tests {
                 p[v]
             );
         }
+    }
+
+    #[test]
+    fn rotated_cube_grid_nearly_coplanar_points() {
+        // face grids of a rotated cube: coplanar up to rounding, the hard
+        // case for the floating-point filter in front of orient3d
+        let rot = nalgebra::Rotation3::from_euler_angles(0.3, -0.7, 1.1);
+        let mut p = Vec::new();
+        for i in 0..=20 {
+            for j in 0..=20 {
+                let (s, t) = (i as f64 * 0.1, j as f64 * 0.1);
+                for q in [
+                    [s, t, 0.0],
+                    [s, t, 2.0],
+                    [s, 0.0, t],
+                    [s, 2.0, t],
+                    [0.0, s, t],
+                    [2.0, s, t],
+                ] {
+                    p.push(rot * Point3::new(q[0] + 10.0, q[1] - 5.0, q[2] + 3.0));
+                }
+            }
+        }
+        let hull = convex_hull(&p).unwrap();
+        check_hull(&p, &hull);
+        assert!((hull.volume(&p) - 8.0).abs() < 1e-9, "{}", hull.volume(&p));
+        assert!((hull.area(&p) - 24.0).abs() < 1e-9, "{}", hull.area(&p));
     }
 
     #[test]
