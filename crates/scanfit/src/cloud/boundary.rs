@@ -26,6 +26,8 @@
 //! kept wedge. Each loop is then a simple polygon and the result does not
 //! depend on the order the edges were found in.
 
+use std::collections::HashMap;
+
 use spade::{DelaunayTriangulation, HasPosition, Point2, Triangulation};
 
 use crate::base::plane_parameters;
@@ -111,7 +113,7 @@ pub struct Boundary {
 impl Boundary {
     /// The outer loop.
     pub fn outer_loop(&self) -> &[usize] {
-        &self.loops[self.outer]
+        self.loops.get(self.outer).map_or(&[], Vec::as_slice)
     }
 }
 
@@ -131,8 +133,8 @@ impl HasPosition for Vertex {
 /// The boundary loops of a sheet-like patch: alpha shape of its projection
 /// on the best-fit plane (PDE paper §4.1, alpha shapes after Edelsbrunner).
 ///
-/// Points that project onto the same spot keep one representative (the
-/// first); the others are on no loop.
+/// Points that project onto the same spot are represented by the first of
+/// them (smallest index); the others are on no loop.
 ///
 /// Errors: fewer than 3 points; collinear or coincident points; a given
 /// `alpha` or `alpha_factor` that is not finite and positive; an `alpha` so
@@ -243,7 +245,30 @@ pub fn boundary_loops(points: &[Point3], config: &BoundaryConfig) -> Result<Boun
         .vertices()
         .map(|v| [v.position().x, v.position().y])
         .collect();
-    let index_of: Vec<usize> = tri.vertices().map(|v| v.data().index).collect();
+    // spade keeps one of several identical positions, not necessarily the
+    // first: represent each position by its smallest input index
+    let key = |p: Point2<f64>| (p.x.to_bits(), p.y.to_bits());
+    let mut first_of: HashMap<(u64, u64), usize> = HashMap::with_capacity(tri.num_vertices());
+    for v in tri.vertices() {
+        first_of.insert(key(v.position()), v.data().index);
+    }
+    if tri.num_vertices() < points.len() {
+        for (i, q) in flat.iter().enumerate() {
+            let k = key(Point2::new(unit(q[0]), unit(q[1])));
+            if let Some(slot) = first_of.get_mut(&k) {
+                *slot = (*slot).min(i);
+            }
+        }
+    }
+    let index_of: Vec<usize> = tri
+        .vertices()
+        .map(|v| {
+            first_of
+                .get(&key(v.position()))
+                .copied()
+                .unwrap_or(v.data().index)
+        })
+        .collect();
     let loops_v = chain(&edges, &pos, tri.num_vertices())?;
     let mut loops: Vec<Vec<usize>> = Vec::with_capacity(loops_v.len());
     let mut areas = Vec::with_capacity(loops_v.len());
@@ -385,6 +410,11 @@ mod tests {
         sorted.sort_unstable();
         sorted.dedup();
         assert_eq!(sorted.len(), 156);
+        // duplicated points: the first copy represents them, same loop
+        let mut twice = p.clone();
+        twice.extend(p.iter().copied());
+        let b2 = boundary_loops(&twice, &BoundaryConfig::default()).unwrap();
+        assert_eq!(b2.loops, b.loops);
     }
 
     #[test]

@@ -42,29 +42,39 @@ pub struct ConvexHull {
 }
 
 impl ConvexHull {
-    /// Enclosed volume (divergence theorem over the faces).
-    pub fn volume(&self, points: &[Point3]) -> f64 {
+    /// Enclosed volume (divergence theorem over the faces). `points` must be
+    /// the points the hull was computed from.
+    pub fn volume(&self, points: &[Point3]) -> Result<f64> {
         let Some(&[o, _, _]) = self.faces.first() else {
-            return 0.0;
+            return Ok(0.0);
         };
-        let o = points[o];
-        self.faces
-            .iter()
-            .map(|&[a, b, c]| (points[a] - o).dot(&(points[b] - o).cross(&(points[c] - o))))
-            .sum::<f64>()
-            / 6.0
+        let o = self.point(points, o)?;
+        let mut sum = 0.0;
+        for &[a, b, c] in &self.faces {
+            let [a, b, c] = [a, b, c].map(|i| self.point(points, i));
+            sum += (a? - o).dot(&(b? - o).cross(&(c? - o)));
+        }
+        Ok(sum / 6.0)
     }
 
-    /// Surface area.
-    pub fn area(&self, points: &[Point3]) -> f64 {
-        self.faces
-            .iter()
-            .map(|&[a, b, c]| {
-                0.5 * (points[b] - points[a])
-                    .cross(&(points[c] - points[a]))
-                    .norm()
-            })
-            .sum()
+    /// Surface area. `points` must be the points the hull was computed from.
+    pub fn area(&self, points: &[Point3]) -> Result<f64> {
+        let mut sum = 0.0;
+        for &[a, b, c] in &self.faces {
+            let [a, b, c] = [a, b, c].map(|i| self.point(points, i));
+            let a = a?;
+            sum += 0.5 * (b? - a).cross(&(c? - a)).norm();
+        }
+        Ok(sum)
+    }
+
+    fn point(&self, points: &[Point3], i: usize) -> Result<Point3> {
+        points.get(i).copied().ok_or_else(|| {
+            Error::InvalidInput(format!(
+                "hull vertex {i} is out of range for {} points; pass the points the hull was computed from",
+                points.len()
+            ))
+        })
     }
 }
 
@@ -586,7 +596,7 @@ mod tests {
         check_hull(&p, &hull);
         assert_eq!(hull.vertices, (0..n).collect::<Vec<_>>());
         assert_eq!(hull.faces.len(), 2 * n - 4);
-        let vol = hull.volume(&p);
+        let vol = hull.volume(&p).unwrap();
         let sphere = 4.0 / 3.0 * std::f64::consts::PI * 27.0;
         assert!(vol < sphere && vol > 0.98 * sphere, "{vol} vs {sphere}");
     }
@@ -623,8 +633,16 @@ mod tests {
         }
         let hull = convex_hull(&p).unwrap();
         check_hull(&p, &hull);
-        assert!((hull.volume(&p) - 8.0).abs() < 1e-12, "{}", hull.volume(&p));
-        assert!((hull.area(&p) - 24.0).abs() < 1e-12, "{}", hull.area(&p));
+        assert!(
+            (hull.volume(&p).unwrap() - 8.0).abs() < 1e-12,
+            "{}",
+            hull.volume(&p).unwrap()
+        );
+        assert!(
+            (hull.area(&p).unwrap() - 24.0).abs() < 1e-12,
+            "{}",
+            hull.area(&p).unwrap()
+        );
         // all 8 corners are vertices; every vertex is on the cube's surface
         for corner in 0..8 {
             let c = Point3::new(
@@ -669,8 +687,16 @@ mod tests {
         }
         let hull = convex_hull(&p).unwrap();
         check_hull(&p, &hull);
-        assert!((hull.volume(&p) - 8.0).abs() < 1e-9, "{}", hull.volume(&p));
-        assert!((hull.area(&p) - 24.0).abs() < 1e-9, "{}", hull.area(&p));
+        assert!(
+            (hull.volume(&p).unwrap() - 8.0).abs() < 1e-9,
+            "{}",
+            hull.volume(&p).unwrap()
+        );
+        assert!(
+            (hull.area(&p).unwrap() - 24.0).abs() < 1e-9,
+            "{}",
+            hull.area(&p).unwrap()
+        );
     }
 
     #[test]
@@ -684,7 +710,7 @@ mod tests {
         check_hull(&p, &hull);
         assert_eq!(hull.vertices.len(), 300);
         let single = convex_hull(&base).unwrap();
-        assert!((hull.volume(&p) - single.volume(&base)).abs() < 1e-12);
+        assert!((hull.volume(&p).unwrap() - single.volume(&base).unwrap()).abs() < 1e-12);
     }
 
     #[test]
