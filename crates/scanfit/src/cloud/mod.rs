@@ -9,9 +9,22 @@
 //!   parallel batches.
 //! * [`normals`]: PCA normals over k neighbours, oriented towards a viewpoint
 //!   or over a minimum spanning tree (Hoppe et al. 1992).
+//! * [`hull`]: 3D convex hull (quickhull on exact orientation predicates).
+//! * [`hpr`]: hidden point removal, the points visible from a viewpoint
+//!   (Katz, Tal & Basri 2007).
+//! * [`boundary`]: boundary loops of a sheet-like patch from the alpha shape
+//!   of its projection on the best-fit plane.
+//! * [`corners`]: corners of a closed boundary loop (smallest turning angle or
+//!   largest three-point curvature) and the loop's split into sides.
 
+pub mod boundary;
+pub mod corners;
+pub mod hpr;
+pub mod hull;
 pub mod neighbours;
 pub mod normals;
+#[cfg(test)]
+pub(crate) mod testutil;
 
 use std::sync::OnceLock;
 
