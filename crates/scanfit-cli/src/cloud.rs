@@ -797,8 +797,9 @@ fn boundary(a: BoundaryArgs) -> Result<()> {
                         side[q] = k as f64;
                     }
                 }
-                for &k in &c.corners {
-                    corner[k] = 1.0;
+                for (k, &q) in c.corners.iter().enumerate() {
+                    corner[q] = 1.0;
+                    side[q] = k as f64;
                 }
             }
             out.set_attribute("index", outer.iter().map(|&i| i as f64).collect())?;

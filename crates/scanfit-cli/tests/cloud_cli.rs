@@ -216,14 +216,22 @@ fn boundary_finds_the_four_corners_of_the_panel() {
     // the PLY loop: in order, with corner flags and side numbers
     let t = read_cloud(&ply, &ReadOptions::default()).unwrap();
     assert_eq!(t.points.len(), loop_len);
-    assert_eq!(
-        t.column("corner")
-            .unwrap()
-            .iter()
-            .filter(|&&c| c == 1.0)
-            .count(),
-        4
-    );
+    let corner = t.column("corner").unwrap();
+    assert_eq!(corner.iter().filter(|&&c| c == 1.0).count(), 4);
+    // side k starts at corner k and runs to the next corner (exclusive)
+    let side = t.column("side").unwrap();
+    let starts: Vec<usize> = (0..loop_len).filter(|&q| corner[q] == 1.0).collect();
+    for (k, &q) in starts.iter().enumerate() {
+        let first = side[q];
+        let end = starts.get(k + 1).copied().unwrap_or(loop_len + starts[0]);
+        assert!(
+            (q..end).all(|r| side[r % loop_len] == first),
+            "side of corner {k}"
+        );
+    }
+    let mut firsts: Vec<f64> = starts.iter().map(|&q| side[q]).collect();
+    firsts.sort_by(f64::total_cmp);
+    assert_eq!(firsts, [0.0, 1.0, 2.0, 3.0]);
     let pos = t.column("position").unwrap();
     assert!(pos.iter().enumerate().all(|(k, &p)| p == k as f64));
     let (ink, border) = png_coverage(&png);

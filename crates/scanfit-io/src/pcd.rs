@@ -230,6 +230,29 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
             count,
         });
     }
+    // a record holds sum(COUNT) values of at least one byte each (binary) or
+    // one character each (ascii): more than the file's size is a damaged or
+    // hostile header, refused before anything is allocated from it
+    let record = fields.iter().try_fold(0usize, |acc, f| {
+        f.ty.size()
+            .checked_mul(f.count)
+            .and_then(|b| acc.checked_add(b))
+    });
+    let values = fields
+        .iter()
+        .try_fold(0usize, |acc, f| acc.checked_add(f.count));
+    match (record, values) {
+        (Some(r), Some(v)) if r <= bytes.len() && v <= bytes.len() => {}
+        _ => {
+            return Err(perr(
+                line_no,
+                format!(
+                    "the COUNT and SIZE lines describe records larger than the whole file ({} bytes); the header is damaged",
+                    bytes.len()
+                ),
+            ))
+        }
+    }
     let points = match (points, width, height) {
         (Some(p), _, _) => p,
         (None, Some(w), Some(h)) => w.saturating_mul(h),

@@ -113,10 +113,6 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
             ));
         };
         let text = text.trim_end_matches('\r');
-        let mut tok = text.split_ascii_whitespace();
-        let Some(key) = tok.next() else {
-            continue;
-        };
         if line_no == 1 {
             if text.trim() != "ply" {
                 return Err(perr(
@@ -126,6 +122,10 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
             }
             continue;
         }
+        let mut tok = text.split_ascii_whitespace();
+        let Some(key) = tok.next() else {
+            continue;
+        };
         match key {
             "comment" | "obj_info" => {}
             "format" => {
@@ -723,6 +723,11 @@ mod tests {
             "{e}"
         );
         let e = read(b"plx\nformat ascii 1.0\n").unwrap_err().to_string();
+        assert!(e.contains("bad magic"), "{e}");
+        // a blank first line is no magic either
+        let e = read(b"\nformat ascii 1.0\nelement vertex 0\nend_header\n")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("bad magic"), "{e}");
         let e = read(b"ply\nformat utf8 1.0\nend_header\n")
             .unwrap_err()

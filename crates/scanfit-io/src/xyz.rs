@@ -62,6 +62,8 @@ pub fn parse_points_with(path: &Path, text: &str, policy: NonFinite) -> Result<P
     let mut lines = Vec::new();
     let mut values: Vec<f64> = Vec::new();
     let mut dropped = 0usize;
+    let mut order = [0usize, 1, 2];
+    let mut pts_count_seen = false;
     for (i, raw) in text.lines().enumerate() {
         let line_no = i + 1;
         let line = raw.trim();
@@ -105,8 +107,25 @@ pub fn parse_points_with(path: &Path, text: &str, policy: NonFinite) -> Result<P
                 format!("value {} ('{f}') is not a number", k + 1),
             ));
         }
+        // Leica PTS: the first data line holds only the point count
+        if width == 0
+            && !pts_count_seen
+            && values.len() == 1
+            && values[0] >= 0.0
+            && values[0].fract() == 0.0
+        {
+            pts_count_seen = true;
+            continue;
+        }
         if width == 0 {
             width = columns.as_ref().map_or(fields.len(), |c| c.len());
+            if let Some(c) = &columns {
+                // x, y, z by name when the header names them (any order)
+                let find = |axis: &str| c.iter().position(|n| n.eq_ignore_ascii_case(axis));
+                if let (Some(x), Some(y), Some(z)) = (find("x"), find("y"), find("z")) {
+                    order = [x, y, z];
+                }
+            }
             if width < 3 {
                 return Err(perr(
                     line_no,
@@ -124,7 +143,7 @@ pub fn parse_points_with(path: &Path, text: &str, policy: NonFinite) -> Result<P
                 ),
             ));
         }
-        if let Some(k) = values.iter().take(3).position(|v| !v.is_finite()) {
+        if let Some(k) = order.into_iter().find(|&k| !values[k].is_finite()) {
             if policy == NonFinite::Drop {
                 dropped += 1;
                 continue;
@@ -139,9 +158,16 @@ pub fn parse_points_with(path: &Path, text: &str, policy: NonFinite) -> Result<P
             ));
         }
         let value = |k: usize| values.get(k).copied().unwrap_or(0.0);
-        points.push(Point3::new(value(0), value(1), value(2)));
-        for (c, col) in extra.iter_mut().enumerate() {
-            col.push(value(3 + c));
+        points.push(Point3::new(
+            value(order[0]),
+            value(order[1]),
+            value(order[2]),
+        ));
+        for (col, k) in extra
+            .iter_mut()
+            .zip((0..width).filter(|k| !order.contains(k)))
+        {
+            col.push(value(k));
         }
         lines.push(line_no);
     }
@@ -155,6 +181,17 @@ pub fn parse_points_with(path: &Path, text: &str, policy: NonFinite) -> Result<P
             },
         });
     }
+    // the table's columns are x, y, z first, then the others in file order
+    let columns = columns.map(|c| {
+        let mut out: Vec<String> = order.iter().map(|&k| c[k].clone()).collect();
+        out.extend(
+            c.iter()
+                .enumerate()
+                .filter(|(k, _)| !order.contains(k))
+                .map(|(_, n)| n.clone()),
+        );
+        out
+    });
     let columns = columns.unwrap_or_else(|| {
         let mut c: Vec<String> = ["x", "y", "z"].iter().map(|s| s.to_string()).collect();
         c.extend((4..=width).map(|k| format!("col{k}")));
@@ -178,6 +215,30 @@ mod tests {
 
     fn parse(text: &str) -> Result<PointTable> {
         parse_points(Path::new("t.csv"), text)
+    }
+
+    #[test]
+    fn header_names_place_x_y_z_in_any_order() {
+        let t = parse("id,Z,x,y,w\n7,3,1,2,0.5\n8,6,4,5,1.5\n").unwrap();
+        assert_eq!(
+            t.points,
+            vec![Point3::new(1., 2., 3.), Point3::new(4., 5., 6.)]
+        );
+        assert_eq!(t.columns, ["x", "y", "Z", "id", "w"]);
+        assert_eq!(t.column("id"), Some(&[7.0, 8.0][..]));
+        assert_eq!(t.column("w"), Some(&[0.5, 1.5][..]));
+        // non-finite checks look at the named coordinates
+        let e = parse("id,x,y,z\nnan,1,2,3\n1,inf,2,3\n").unwrap_err();
+        assert!(e.to_string().contains("t.csv:3"), "{e}");
+    }
+
+    #[test]
+    fn leica_pts_count_line_is_skipped() {
+        let t = parse("2\n1 2 3 -100 200 10 20\n4 5 6 -90 10 20 30\n").unwrap();
+        assert_eq!(t.points.len(), 2);
+        assert_eq!(t.points[1], Point3::new(4., 5., 6.));
+        assert_eq!(t.extra.len(), 4);
+        assert_eq!(t.locate(0), "t.csv:2");
     }
 
     #[test]

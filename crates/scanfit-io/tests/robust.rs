@@ -125,6 +125,15 @@ fn huge_counts_are_refused_without_allocating() {
             assert_eq!(e.is_err(), !after_vertex, "{name} {key}");
         }
     }
+    // PCD: a COUNT (values per field) larger than the file, and one whose
+    // SIZE x COUNT overflows
+    for count in ["1000000000000", "18446744073709551615"] {
+        let text = format!(
+            "VERSION .7\nFIELDS x y z n\nSIZE 4 4 4 8\nTYPE F F F F\nCOUNT 1 1 1 {count}\nWIDTH 1\nPOINTS 0\nDATA ascii\n"
+        );
+        let e = parse_cloud(Path::new("c.pcd"), text.as_bytes(), &opts).unwrap_err();
+        assert!(e.to_string().contains("larger than the whole file"), "{e}");
+    }
     // LAS/LAZ: point counts (legacy and 64-bit) and the chunk-table count
     for name in ["s.las", "s.laz"] {
         let bytes = samples().into_iter().find(|s| s.0 == name).unwrap().1;

@@ -32,6 +32,9 @@ use kiddo::ImmutableKdTree;
 
 use crate::{validate_points, Error, Point3, Result, Vector3};
 
+/// The attribute names of normals the readers meet.
+const NORMAL_NAMES: [[&str; 3]; 2] = [["nx", "ny", "nz"], ["normal_x", "normal_y", "normal_z"]];
+
 /// A named per-point attribute column.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Attribute {
@@ -97,8 +100,19 @@ impl PointCloud {
                 self.points.len()
             )));
         }
-        match self.attributes.iter_mut().find(|a| a.name == name) {
-            Some(a) => a.values = values,
+        // exact name first, then a case-insensitive match (the one
+        // `attribute` would return), so reading and writing agree
+        let at = self
+            .attributes
+            .iter()
+            .position(|a| a.name == name)
+            .or_else(|| {
+                self.attributes
+                    .iter()
+                    .position(|a| a.name.eq_ignore_ascii_case(name))
+            });
+        match at {
+            Some(i) => self.attributes[i].values = values,
             None => self.attributes.push(Attribute {
                 name: name.to_string(),
                 values,
@@ -146,13 +160,20 @@ impl PointCloud {
         Some(self.attributes.remove(i).values)
     }
 
-    /// Per-point normals from the `nx`, `ny`, `nz` attributes, if all three exist.
+    /// The names under which the cloud holds normals: `nx, ny, nz` (PLY,
+    /// Open3D) or `normal_x, normal_y, normal_z` (PCL's PCD), if all three
+    /// exist (any case).
+    fn normal_names(&self) -> Option<[&'static str; 3]> {
+        NORMAL_NAMES
+            .into_iter()
+            .find(|names| names.iter().all(|n| self.attribute(n).is_some()))
+    }
+
+    /// Per-point normals from the `nx, ny, nz` (or PCL's `normal_x,
+    /// normal_y, normal_z`) attributes, if all three exist.
     pub fn normals(&self) -> Option<Vec<Vector3>> {
-        let (x, y, z) = (
-            self.attribute("nx")?,
-            self.attribute("ny")?,
-            self.attribute("nz")?,
-        );
+        let [a, b, c] = self.normal_names()?;
+        let (x, y, z) = (self.attribute(a)?, self.attribute(b)?, self.attribute(c)?);
         Some(
             x.iter()
                 .zip(y)
@@ -162,9 +183,11 @@ impl PointCloud {
         )
     }
 
-    /// Stores `normals` as the `nx`, `ny`, `nz` attributes.
+    /// Stores `normals` as the cloud's normal attributes (replacing those it
+    /// has under either naming, else as `nx`, `ny`, `nz`).
     pub fn set_normals(&mut self, normals: &[Vector3]) -> Result<()> {
-        for (c, name) in ["nx", "ny", "nz"].into_iter().enumerate() {
+        let names = self.normal_names().unwrap_or(NORMAL_NAMES[0]);
+        for (c, name) in names.into_iter().enumerate() {
             self.set_attribute(name, normals.iter().map(|n| n[c]).collect())?;
         }
         Ok(())
@@ -211,5 +234,34 @@ impl PointCloud {
     /// Takes the positions and attributes out of the cloud.
     pub fn into_parts(self) -> (Vec<Point3>, Vec<Attribute>) {
         (self.points, self.attributes)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn attributes_and_normals_under_either_naming() {
+        let p = vec![Point3::origin(), Point3::new(1.0, 0.0, 0.0)];
+        let mut c = PointCloud::new(p)
+            .unwrap()
+            .with_attribute("Normal_X", vec![0.0, 0.0])
+            .unwrap()
+            .with_attribute("normal_y", vec![0.0, 1.0])
+            .unwrap()
+            .with_attribute("normal_z", vec![1.0, 0.0])
+            .unwrap();
+        assert_eq!(c.normals().unwrap()[1], Vector3::y());
+        c.set_normals(&[Vector3::x(), Vector3::z()]).unwrap();
+        // replaced in place, no second set
+        assert_eq!(c.attributes().len(), 3);
+        assert_eq!(c.attributes()[0].name, "Normal_X");
+        assert_eq!(c.normals().unwrap(), vec![Vector3::x(), Vector3::z()]);
+        assert!(c.set_attribute("u", vec![1.0]).is_err());
+        let s = c.select(&[1, 1, 0]).unwrap();
+        assert_eq!(s.points()[0], Point3::new(1.0, 0.0, 0.0));
+        assert_eq!(s.attribute("normal_z"), Some(&[1.0, 1.0, 0.0][..]));
+        assert!(c.select(&[2]).is_err());
     }
 }

@@ -86,6 +86,7 @@ impl PointCloud {
 
     /// The nearest point to `query`.
     pub fn nearest(&self, query: &Point3) -> Result<Neighbour> {
+        check_query(query, "the query point")?;
         let r = self
             .tree()?
             .query(&coords(query))
@@ -101,7 +102,8 @@ impl PointCloud {
     /// nearest first.
     pub fn knn(&self, query: &Point3, k: usize) -> Result<Vec<Neighbour>> {
         let k = checked_k(k)?;
-        Ok(knn_with(self.tree()?, query, k))
+        check_query(query, "the query point")?;
+        Ok(knn_with(self.tree()?, self.points.len(), query, k))
     }
 
     /// All points within distance `radius` of `query` (inclusive), nearest first.
@@ -111,6 +113,7 @@ impl PointCloud {
                 "search radius {radius} must be finite and >= 0"
             )));
         }
+        check_query(query, "the query point")?;
         let mut out: Vec<Neighbour> = self
             .tree()?
             .query(&coords(query))
@@ -129,6 +132,9 @@ impl PointCloud {
     /// The `k` nearest points of each of `queries`, in parallel.
     pub fn knn_batch(&self, queries: &[Point3], k: usize) -> Result<Neighbourhoods> {
         let kq = checked_k(k)?;
+        for (i, q) in queries.iter().enumerate() {
+            check_query(q, &format!("query point {i}"))?;
+        }
         let tree = self.tree()?;
         let k = kq.get().min(self.points.len());
         let mut indices = vec![0u32; queries.len() * k];
@@ -138,7 +144,7 @@ impl PointCloud {
             .zip(distances.par_chunks_mut(k))
             .zip(queries.par_iter())
             .for_each(|((idx, dist), q)| {
-                for (j, n) in knn_with(tree, q, kq).into_iter().enumerate().take(k) {
+                for (j, n) in knn_with(tree, k, q, kq).into_iter().enumerate().take(k) {
                     idx[j] = n.index as u32;
                     dist[j] = n.distance;
                 }
@@ -230,7 +236,28 @@ fn checked_k(k: usize) -> Result<NonZeroUsize> {
         .ok_or_else(|| Error::InvalidInput("k = 0 neighbours asked for; give k >= 1".into()))
 }
 
-fn knn_with(tree: &ImmutableKdTree<f64, 3>, query: &Point3, k: NonZeroUsize) -> Vec<Neighbour> {
+/// Rejects a query point with a NaN or infinite coordinate (the tree would
+/// return fewer neighbours than asked for, or none).
+fn check_query(query: &Point3, which: &str) -> Result<()> {
+    if query.coords.iter().all(|c| c.is_finite()) {
+        Ok(())
+    } else {
+        Err(Error::InvalidInput(format!(
+            "{which} ({}, {}, {}) has a non-finite coordinate; neighbour queries need finite points",
+            query.x, query.y, query.z
+        )))
+    }
+}
+
+/// The `k` nearest of the `n` points in `tree` (k is capped at n: the tree
+/// reserves room for k results).
+fn knn_with(
+    tree: &ImmutableKdTree<f64, 3>,
+    n: usize,
+    query: &Point3,
+    k: NonZeroUsize,
+) -> Vec<Neighbour> {
+    let k = NonZeroUsize::new(k.get().min(n)).unwrap_or(NonZeroUsize::MIN);
     tree.query(&coords(query))
         .nearest_n::<SquaredEuclidean<f64>>(k)
         .execute()
@@ -303,6 +330,26 @@ mod tests {
     }
 
     #[test]
+    fn graph_excludes_one_copy_of_a_multiply_duplicated_point() {
+        // three coincident points and two others: each copy's neighbours are
+        // the other two copies first
+        let p = vec![
+            Point3::new(1.0, 1.0, 1.0),
+            Point3::new(1.0, 1.0, 1.0),
+            Point3::new(1.0, 1.0, 1.0),
+            Point3::new(2.0, 1.0, 1.0),
+            Point3::new(1.0, 3.0, 1.0),
+        ];
+        let g = PointCloud::new(p).unwrap().knn_graph(2).unwrap();
+        for i in 0..3 {
+            let row = g.indices_of(i);
+            assert!(!row.contains(&(i as u32)), "row {i}: {row:?}");
+            assert_eq!(g.distances_of(i), &[0.0, 0.0]);
+        }
+        assert_eq!(g.distances_of(3), &[1.0, 1.0]);
+    }
+
+    #[test]
     fn spacing_of_a_grid_with_a_duplicate() {
         let mut p: Vec<Point3> = grid(5).points().to_vec();
         p.push(Point3::new(2.0, 2.0, 0.0));
@@ -320,5 +367,13 @@ mod tests {
         assert!(PointCloud::new(vec![Point3::new(f64::NAN, 0.0, 0.0)]).is_err());
         let one = PointCloud::new(vec![Point3::origin()]).unwrap();
         assert!(one.knn_graph(3).is_err());
+        // a huge k is capped at the cloud's size, a non-finite query refused
+        let g = grid(3);
+        assert_eq!(g.knn(&Point3::origin(), usize::MAX).unwrap().len(), 9);
+        let nan = Point3::new(f64::NAN, 0.0, 0.0);
+        assert!(g.knn(&nan, 2).is_err() && g.nearest(&nan).is_err());
+        assert!(g.within(&nan, 1.0).is_err());
+        let e = g.knn_batch(&[Point3::origin(), nan], 2).unwrap_err();
+        assert!(e.to_string().contains("query point 1"), "{e}");
     }
 }

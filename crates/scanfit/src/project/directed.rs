@@ -130,7 +130,7 @@ pub struct Projected {
     /// Signed distance moved along the unit direction.
     pub t: f64,
     /// Weighted RMS distance of the cloud from `p*`, `sqrt(E(p*) / c0)`
-    /// (eq. 7 with the final weights).
+    /// (eq. 7 with the weights of the last step).
     pub residual: f64,
     /// Re-weighting steps taken.
     pub iterations: usize,
