@@ -8,7 +8,7 @@ pub enum Error {
     #[error("invalid knot vector: {0}")]
     InvalidKnots(String),
     /// Too few points for the requested degree or control-point count.
-    #[error("{got} points given, but {what} needs at least {needed}; lower the degree or give more points")]
+    #[error("{got} points given, but {what} needs at least {needed}; {}", too_few_hint(what))]
     TooFewPoints {
         /// points given
         got: usize,
@@ -66,3 +66,14 @@ pub enum Error {
 
 /// Result alias for the library.
 pub type Result<T> = std::result::Result<T, Error>;
+
+/// What to change when too few points are given for `what`.
+fn too_few_hint(what: &str) -> &'static str {
+    if what.contains("least-squares") || what.contains("control") {
+        "lower the control-point count (or the degree) or give more points"
+    } else if what.contains("degree") || what.contains("interpolation") {
+        "lower the degree or give more points"
+    } else {
+        "give more points"
+    }
+}
