@@ -8,7 +8,10 @@ pub enum Error {
     #[error("invalid knot vector: {0}")]
     InvalidKnots(String),
     /// Too few points for the requested degree or control-point count.
-    #[error("{got} points given, but {what} needs at least {needed}; {}", too_few_hint(what))]
+    #[error(
+        "{got} points given, but {what} needs at least {needed}; {}",
+        too_few_hint(what)
+    )]
     TooFewPoints {
         /// points given
         got: usize,
