@@ -17,6 +17,8 @@
 //!   solvers.
 //! * [`cloud`]: point clouds with named attributes and KD-tree neighbour
 //!   queries, normals, hidden point removal, boundary loops, corners.
+//! * [`mba`]: multilevel B-spline approximation of 2.5D data (Lee, Wolberg &
+//!   Shin 1997) and the MBA paper's projection adjustment of control points.
 //! * [`metrics`]: surface error measures and parameterization quality.
 //! * [`project`]: point inversion (orthogonal projection onto surfaces).
 //! * [`quality`]: per-curve quality report (deviation, curvature, loops, length).
@@ -27,6 +29,7 @@ pub mod cloud;
 mod error;
 pub mod fit;
 mod geom;
+pub mod mba;
 pub mod metrics;
 pub mod param;
 pub mod project;

@@ -9,13 +9,12 @@
 //!   (triangles of the Delaunay triangulation of the parameters whose
 //!   orientation flips on the surface) and stretch (Sander et al. 2001).
 
-use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
 use spade::{DelaunayTriangulation, HasPosition, Triangulation};
 
 use crate::bspline::{BasisWorkspace, Surface};
 use crate::project::{Inversion, SurfaceInverter};
-use crate::{Error, Point3, Result};
+use crate::{Error, Point3, PointCloud, Result};
 
 /// Mean, maximum and RMSE of a set of distances.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -108,9 +107,21 @@ pub fn grid_rmse(
         .flat_map(|&u| vs.iter().map(move |&v| (u, v)))
         .map(|(u, v)| surface.point(u, v))
         .collect();
-    let d = nearest_distances(points, &g)?;
-    let sum: f64 = d.iter().map(|x| x * x).sum();
-    Ok((sum / g.len() as f64).sqrt())
+    rmse_to_cloud(&PointCloud::new(points.to_vec())?, &g)
+}
+
+/// The MBA paper's eq. 17 for given grid points: the RMSE over `grid` of the
+/// distance from each grid point to its nearest point of `cloud` (the
+/// cloud's KD-tree, built once, serves repeated calls).
+pub fn rmse_to_cloud(cloud: &PointCloud, grid: &[Point3]) -> Result<f64> {
+    if grid.is_empty() {
+        return Err(Error::InvalidInput(
+            "no grid points for the grid RMSE".into(),
+        ));
+    }
+    let d = cloud.nearest_batch(grid)?;
+    let sum: f64 = d.iter().map(|n| n.distance * n.distance).sum();
+    Ok((sum / grid.len() as f64).sqrt())
 }
 
 /// Distance from each of `queries` to the nearest of `points` (KD-tree, in
@@ -130,18 +141,10 @@ pub fn nearest_points(points: &[Point3], queries: &[Point3]) -> Result<Vec<(usiz
             "no points to measure distances to".into(),
         ));
     }
-    let coords: Vec<[f64; 3]> = points.iter().map(|p| [p.x, p.y, p.z]).collect();
-    let tree: ImmutableKdTree<f64, 3> = ImmutableKdTree::new_from_slice(&coords)
-        .map_err(|e| Error::InvalidInput(format!("could not index the points: {e:?}")))?;
-    Ok(queries
-        .par_iter()
-        .map(|q| {
-            let r = tree
-                .query(&[q.x, q.y, q.z])
-                .nearest_one::<SquaredEuclidean<f64>>()
-                .execute();
-            (r.item as usize, r.distance.sqrt())
-        })
+    Ok(PointCloud::new(points.to_vec())?
+        .nearest_batch(queries)?
+        .into_iter()
+        .map(|n| (n.index, n.distance))
         .collect())
 }
 

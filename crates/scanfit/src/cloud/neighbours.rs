@@ -87,15 +87,30 @@ impl PointCloud {
     /// The nearest point to `query`.
     pub fn nearest(&self, query: &Point3) -> Result<Neighbour> {
         check_query(query, "the query point")?;
-        let r = self
-            .tree()?
-            .query(&coords(query))
-            .nearest_one::<SquaredEuclidean<f64>>()
-            .execute();
-        Ok(Neighbour {
-            index: r.item as usize,
-            distance: r.distance.sqrt(),
-        })
+        self.nearest_batch(std::slice::from_ref(query))?
+            .pop()
+            .ok_or_else(|| Error::InvalidInput("no nearest point found".into()))
+    }
+
+    /// The nearest point of each of `queries`, in parallel.
+    pub fn nearest_batch(&self, queries: &[Point3]) -> Result<Vec<Neighbour>> {
+        for (i, q) in queries.iter().enumerate() {
+            check_query(q, &format!("query point {i}"))?;
+        }
+        let tree = self.tree()?;
+        Ok(queries
+            .par_iter()
+            .map(|q| {
+                let r = tree
+                    .query(&coords(q))
+                    .nearest_one::<SquaredEuclidean<f64>>()
+                    .execute();
+                Neighbour {
+                    index: r.item as usize,
+                    distance: r.distance.sqrt(),
+                }
+            })
+            .collect())
     }
 
     /// The `k` nearest points to `query` (fewer if the cloud is smaller),
