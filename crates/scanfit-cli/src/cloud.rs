@@ -20,6 +20,7 @@ use scanfit_io::{
     cloud_bytes, read_cloud, write_all_atomic, Format, NonFinite, ReadOptions, WriteFormat,
 };
 
+use crate::outputs::{check_extensions, extension};
 use crate::progress::Progress;
 use crate::table::{num, Table};
 
@@ -269,33 +270,6 @@ pub fn triple(s: &str, what: &str) -> Result<[f64; 3]> {
     }
 }
 
-fn extension(p: &Path) -> String {
-    p.extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default()
-}
-
-/// Checks output extensions before any work is done.
-pub fn check_outputs(outputs: &[(&Option<PathBuf>, &str, &[&str])]) -> Result<()> {
-    for (p, what, allowed) in outputs {
-        if let Some(p) = p {
-            let e = extension(p);
-            if !allowed.contains(&e.as_str()) {
-                bail!(
-                    "{what} {}: unsupported extension '.{e}'; use {}",
-                    p.display(),
-                    allowed
-                        .iter()
-                        .map(|a| format!(".{a}"))
-                        .collect::<Vec<_>>()
-                        .join(" or ")
-                );
-            }
-        }
-    }
-    Ok(())
-}
-
 /// The bytes of `cloud` with all its attributes as binary PLY or XYZ text, by extension.
 pub fn cloud_file(path: &Path, cloud: &PointCloud) -> Result<Vec<u8>> {
     let format = WriteFormat::from_path(path)
@@ -420,7 +394,7 @@ fn normal_shading(normals: &[Vector3], opts: &RenderOptions) -> Vec<[u8; 3]> {
 }
 
 fn normals(a: NormalsArgs) -> Result<()> {
-    check_outputs(&[
+    check_extensions(&[
         (&a.output, "--output", &["ply", "xyz"][..]),
         (&a.png, "--png", &["png"][..]),
     ])?;
@@ -547,7 +521,7 @@ fn parse_angles(s: &str, what: &str) -> Result<(f64, f64)> {
 }
 
 fn hpr(a: HprArgs) -> Result<()> {
-    check_outputs(&[
+    check_extensions(&[
         (&a.output, "--output", &["ply", "xyz"][..]),
         (&a.png, "--png", &["png"][..]),
     ])?;
@@ -676,7 +650,7 @@ const SIDE_COLOURS: [[u8; 3]; 6] = [
 ];
 
 fn boundary(a: BoundaryArgs) -> Result<()> {
-    check_outputs(&[
+    check_extensions(&[
         (&a.output, "--output", &["json", "ply", "xyz"][..]),
         (&a.png, "--png", &["png"][..]),
     ])?;

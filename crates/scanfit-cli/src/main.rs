@@ -6,6 +6,7 @@
 mod cad;
 mod cloud;
 mod curve;
+mod outputs;
 mod progress;
 mod report;
 mod surface;

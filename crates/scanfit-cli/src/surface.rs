@@ -5,21 +5,19 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use scanfit::base::plane_parameters;
-use scanfit::bspline::{tessellate, Surface};
+use scanfit::bspline::Surface;
 use scanfit::fit::correction::{correct_parameters, CorrectionConfig, CorrectionRound};
 use scanfit::fit::surface::{fit_surface, KnotPlacement, SurfaceFitConfig};
 use scanfit::metrics::{
-    grid_rmse, nearest_points, orthogonal_errors, parameterization_quality, parametric_distances,
-    ErrorStats, ParamQuality,
+    grid_rmse, orthogonal_errors, parameterization_quality, parametric_distances, ErrorStats,
+    ParamQuality,
 };
 use scanfit::project::{InversionConfig, SurfaceInverter};
-use scanfit_io::gltf::mesh_glb;
 use scanfit_io::json::{Provenance, SurfaceDoc, SurfaceQualityDoc};
-use scanfit_io::ply::{mesh_obj, mesh_ply, points_ply, points_xyz, PlyFormat};
-use scanfit_io::render::{render_png, viridis, Colouring, RenderOptions};
-use scanfit_io::step::CadItem;
+use scanfit_io::ply::{points_ply, points_xyz, PlyFormat};
 use scanfit_io::{read_points, write_all_atomic};
 
+use crate::outputs::{check_extensions, extension, print_written, Deviation};
 use crate::progress::Progress;
 use crate::table::{num, Table};
 
@@ -66,33 +64,11 @@ pub struct FitArgs {
     /// Rounds of parameter correction (Hoschek: re-project, refit).
     #[arg(long, default_value_t = 0, value_name = "N")]
     pub correct: usize,
-    /// Write the surface as JSON (schema scanfit/1).
-    #[arg(short, long, value_name = "SURFACE.json")]
-    pub output: Option<PathBuf>,
-    /// Write the surface as a STEP file (AP214; a face in an open shell).
-    #[arg(long, value_name = "OUT.stp")]
-    pub step: Option<PathBuf>,
-    /// Write the same as an IGES 5.3 file (entity 126 or 128).
-    #[arg(long, value_name = "OUT.igs")]
-    pub iges: Option<PathBuf>,
-    /// Write a triangle mesh of the surface (.obj, .ply or .glb; PLY and glb
-    /// carry the local fit error, the orthogonal distance of each vertex's
-    /// nearest input point, as a colour, PLY also as the property `deviation`).
-    #[arg(long, value_name = "OUT")]
-    pub mesh: Option<PathBuf>,
-    /// Write a shaded, height-coloured picture with the input points.
-    #[arg(long, value_name = "OUT.png")]
-    pub png: Option<PathBuf>,
-    /// Write a picture of the surface coloured by the local fit error (the
-    /// orthogonal distance of the nearest input point), with a colour bar and
-    /// the error figures.
-    #[arg(long, value_name = "OUT.png")]
-    pub deviation_png: Option<PathBuf>,
+    #[command(flatten)]
+    pub out: crate::outputs::SurfaceOutputArgs,
     /// Write the points with u, v, residual and orthogonal distance (.ply or .xyz).
     #[arg(long, value_name = "POINTS")]
     pub points_out: Option<PathBuf>,
-    #[command(flatten)]
-    pub view: crate::view::ViewArgs,
     /// Print the report as JSON on stdout instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -116,12 +92,6 @@ fn pair(s: &str, what: &str) -> Result<(usize, usize)> {
     }
 }
 
-fn extension(p: &Path) -> String {
-    p.extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default()
-}
-
 /// Runs `scanfit fit`.
 pub fn run(a: FitArgs) -> Result<()> {
     let degree = pair(&a.degree, "--degree")?;
@@ -131,24 +101,8 @@ pub fn run(a: FitArgs) -> Result<()> {
         "uniform" => KnotPlacement::Uniform,
         k => bail!("unknown knot placement '{k}'; use distribution or uniform"),
     };
-    for (p, what, allowed) in [
-        (&a.mesh, "--mesh", &["obj", "ply", "glb"][..]),
-        (&a.deviation_png, "--deviation-png", &["png"][..]),
-        (&a.points_out, "--points-out", &["ply", "xyz"][..]),
-        (&a.png, "--png", &["png"][..]),
-        (&a.step, "--step", &["stp", "step"][..]),
-        (&a.iges, "--iges", &["igs", "iges"][..]),
-    ] {
-        if let Some(p) = p {
-            if !allowed.contains(&extension(p).as_str()) {
-                bail!(
-                    "{what} {}: the file name must end in .{}",
-                    p.display(),
-                    allowed.join(" or .")
-                );
-            }
-        }
-    }
+    a.out.check()?;
+    check_extensions(&[(&a.points_out, "--points-out", &["ply", "xyz"][..])])?;
     let progress = Progress::spinner(a.quiet);
     progress.stage(format!("reading {}", a.input.display()));
     let table = read_points(&a.input)?;
@@ -256,92 +210,21 @@ pub fn run(a: FitArgs) -> Result<()> {
         settings,
     });
     doc.quality = Some(quality.clone());
-    let mut files: Vec<(&Path, Vec<u8>)> = Vec::new();
-    if let Some(o) = &a.output {
-        files.push((o, doc.to_json().into_bytes()));
-    }
-    files.extend(crate::cad::cad_files(
-        &a.step,
-        &a.iges,
-        CadItem::Surface(&surface),
+    let dist: Vec<f64> = inv.iter().map(|r| r.distance).collect();
+    let (mut files, exaggeration) = a.out.files(
+        &surface,
+        &doc,
+        pts,
+        &Deviation {
+            per_point: &dist,
+            stats: orth,
+            name: "orthogonal distance",
+        },
         &a.input,
-    )?);
-    let (cu, cv) = surface.counts();
-    let mesh = tessellate(&surface, (cu * 4).clamp(32, 400), (cv * 4).clamp(32, 400));
-    // fit error on the surface: each mesh vertex shows the orthogonal distance
-    // of its nearest input point (the local residual), on the same scale as
-    // the error table
-    let deviation =
-        if a.deviation_png.is_some() || a.mesh.as_deref().is_some_and(|m| extension(m) != "obj") {
-            let near = nearest_points(pts, &mesh.vertices)?;
-            Some(
-                near.iter()
-                    .map(|&(i, _)| inv[i].distance)
-                    .collect::<Vec<f64>>(),
-            )
-        } else {
-            None
-        };
-    let dmax = orth.max;
-    let colours: Option<Vec<[u8; 3]>> = deviation.as_ref().map(|d| {
-        d.iter()
-            .map(|&x| {
-                viridis(if dmax > 0.0 { x / dmax } else { 0.0 }).map(|c| (c * 255.0).round() as u8)
-            })
-            .collect()
-    });
-    if let Some(m) = &a.mesh {
-        let name = a
-            .input
-            .file_stem()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        let bytes = match extension(m).as_str() {
-            "obj" => mesh_obj(
-                &mesh,
-                &format!("scanfit surface fitted to {}", a.input.display()),
-            ),
-            "glb" => mesh_glb(&mesh, colours.as_deref(), &name),
-            _ => mesh_ply(
-                &mesh,
-                deviation.as_deref().map(|d| ("deviation", d)),
-                colours.as_deref(),
-                PlyFormat::Binary,
-            ),
-        };
-        files.push((m, bytes));
-    }
-    if let (Some(dp), Some(d)) = (&a.deviation_png, &deviation) {
-        let opts = RenderOptions {
-            legend: vec![
-                format!(
-                    "{}: colour = orthogonal distance of the nearest input point to the surface [data units]",
-                    a.input.display()
-                ),
-                format!(
-                    "input points to surface (orthogonal): mean {}  max {}  RMSE {}  [data units]",
-                    num(orth.mean),
-                    num(orth.max),
-                    num(orth.rmse)
-                ),
-            ],
-            ..a.view.options(pts)?
-        };
-        let bytes = render_png(
-            &mesh,
-            None,
-            Colouring::Scalar {
-                values: d,
-                range: (0.0, dmax),
-            },
-            &opts,
-        )?;
-        files.push((dp, bytes));
-    }
+    )?;
     if let Some(pout) = &a.points_out {
         let u: Vec<f64> = uv.iter().map(|t| t[0]).collect();
         let v: Vec<f64> = uv.iter().map(|t| t[1]).collect();
-        let dist: Vec<f64> = inv.iter().map(|r| r.distance).collect();
         let attrs: [(&str, &[f64]); 4] = [
             ("u", &u),
             ("v", &v),
@@ -353,19 +236,12 @@ pub fn run(a: FitArgs) -> Result<()> {
         } else {
             points_xyz(pts, &attrs)
         };
-        files.push((pout, bytes));
+        files.push((pout.clone(), bytes));
     }
-    let mut exaggeration = 1.0;
-    if let Some(png) = &a.png {
-        // at most 5,000 points drawn, evenly picked; flat data (terrain) exaggerated
-        let step = (pts.len() / 5_000).max(1);
-        let shown: Vec<_> = pts.iter().step_by(step).copied().collect();
-        let opts = a.view.options(pts)?;
-        exaggeration = opts.z_scale;
-        let bytes = render_png(&mesh, Some(&shown), Colouring::Height, &opts)?;
-        files.push((png, bytes));
-    }
-    let refs: Vec<(&Path, &[u8])> = files.iter().map(|(p, b)| (*p, b.as_slice())).collect();
+    let refs: Vec<(&Path, &[u8])> = files
+        .iter()
+        .map(|(p, b)| (p.as_path(), b.as_slice()))
+        .collect();
     write_all_atomic(&refs)?;
     progress.finish();
     if a.json {
@@ -373,7 +249,7 @@ pub fn run(a: FitArgs) -> Result<()> {
             "input": a.input.display().to_string(),
             "point_count": pts.len(),
             "degree": [degree.0, degree.1],
-            "control_points": [cu, cv],
+            "control_points": [surface.counts().0, surface.counts().1],
             "parameters": a.params,
             "quality": quality,
             "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
@@ -382,16 +258,7 @@ pub fn run(a: FitArgs) -> Result<()> {
         return Ok(());
     }
     print_report(&a, &surface, &par, &orth, unconverged, grid, &pq, &rounds);
-    for (p, _) in &files {
-        if a.png.as_deref() == Some(*p) && exaggeration != 1.0 {
-            println!(
-                "wrote {} (vertical exaggeration {exaggeration}x)",
-                p.display()
-            );
-        } else {
-            println!("wrote {}", p.display());
-        }
-    }
+    print_written(&files, a.out.png.as_deref(), exaggeration);
     Ok(())
 }
 

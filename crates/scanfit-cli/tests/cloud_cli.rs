@@ -312,7 +312,7 @@ fn cloud_commands_reject_bad_input_without_writing() {
                 "-o",
                 stl.to_str().unwrap(),
             ],
-            "unsupported extension",
+            "must end in .json or .ply or .xyz",
         ),
         (
             vec!["boundary", blob.to_str().unwrap(), "--criterion", "pointy"],

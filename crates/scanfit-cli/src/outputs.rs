@@ -1,0 +1,223 @@
+//! The outputs every surface pipeline writes, one way for all of them
+//! (`fit`, `mba`, ...): the surface as JSON, STEP and IGES, a mesh (OBJ, PLY
+//! or glb) carrying the local fit error, a shaded picture with the points
+//! and a picture coloured by the fit error.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Result};
+use clap::Args;
+use scanfit::bspline::{tessellate, Surface};
+use scanfit::metrics::{nearest_points, ErrorStats};
+use scanfit::Point3;
+use scanfit_io::gltf::mesh_glb;
+use scanfit_io::json::SurfaceDoc;
+use scanfit_io::ply::{mesh_obj, mesh_ply, PlyFormat};
+use scanfit_io::render::{render_png, viridis, Colouring, RenderOptions};
+use scanfit_io::step::CadItem;
+
+use crate::table::num;
+
+/// `-o`, `--step`, `--iges`, `--mesh`, `--png`, `--deviation-png` and the camera.
+#[derive(Args, Debug)]
+pub struct SurfaceOutputArgs {
+    /// Write the surface as JSON (schema scanfit/1).
+    #[arg(short, long, value_name = "SURFACE.json")]
+    pub output: Option<PathBuf>,
+    /// Write the surface as a STEP file (AP214; a face in an open shell).
+    #[arg(long, value_name = "OUT.stp")]
+    pub step: Option<PathBuf>,
+    /// Write the same as an IGES 5.3 file (entity 126 or 128).
+    #[arg(long, value_name = "OUT.igs")]
+    pub iges: Option<PathBuf>,
+    /// Write a triangle mesh of the surface (.obj, .ply or .glb; PLY and glb
+    /// carry the local fit error, the deviation of each vertex's nearest
+    /// input point, as a colour, PLY also as the property `deviation`).
+    #[arg(long, value_name = "OUT")]
+    pub mesh: Option<PathBuf>,
+    /// Write a shaded, height-coloured picture with the input points.
+    #[arg(long, value_name = "OUT.png")]
+    pub png: Option<PathBuf>,
+    /// Write a picture of the surface coloured by the local fit error (the
+    /// deviation of the nearest input point), with a colour bar and the
+    /// error figures.
+    #[arg(long, value_name = "OUT.png")]
+    pub deviation_png: Option<PathBuf>,
+    #[command(flatten)]
+    pub view: crate::view::ViewArgs,
+}
+
+/// The lower-case extension of `p`.
+pub fn extension(p: &Path) -> String {
+    p.extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default()
+}
+
+/// Fails unless each given path ends in one of its allowed extensions.
+pub fn check_extensions(outputs: &[(&Option<PathBuf>, &str, &[&str])]) -> Result<()> {
+    for (p, what, allowed) in outputs {
+        if let Some(p) = p {
+            if !allowed.contains(&extension(p).as_str()) {
+                bail!(
+                    "{what} {}: the file name must end in .{}",
+                    p.display(),
+                    allowed.join(" or .")
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Output files: path and content, written together at the end.
+pub type Files = Vec<(PathBuf, Vec<u8>)>;
+
+/// How far the input points are from the surface, as the pictures and the
+/// mesh colours show it.
+pub struct Deviation<'a> {
+    /// One value per input point (orthogonal or vertical distance, >= 0).
+    pub per_point: &'a [f64],
+    /// Its statistics, printed in the picture's legend.
+    pub stats: ErrorStats,
+    /// What it is, e.g. "orthogonal distance" or "vertical distance |z - f(x, y)|".
+    pub name: &'a str,
+}
+
+impl SurfaceOutputArgs {
+    /// Checks the output file names before any work is done.
+    pub fn check(&self) -> Result<()> {
+        check_extensions(&[
+            (&self.output, "--output", &["json"][..]),
+            (&self.mesh, "--mesh", &["obj", "ply", "glb"][..]),
+            (&self.deviation_png, "--deviation-png", &["png"][..]),
+            (&self.png, "--png", &["png"][..]),
+            (&self.step, "--step", &["stp", "step"][..]),
+            (&self.iges, "--iges", &["igs", "iges"][..]),
+        ])
+    }
+
+    /// The bytes of every requested output of `surface` fitted to `points`
+    /// from `input`, and the vertical exaggeration of the shaded picture.
+    pub fn files(
+        &self,
+        surface: &Surface,
+        doc: &SurfaceDoc,
+        points: &[Point3],
+        deviation: &Deviation,
+        input: &Path,
+    ) -> Result<(Files, f64)> {
+        let mut files: Files = Vec::new();
+        if let Some(o) = &self.output {
+            files.push((o.clone(), doc.to_json().into_bytes()));
+        }
+        files.extend(
+            crate::cad::cad_files(&self.step, &self.iges, CadItem::Surface(surface), input)?
+                .into_iter()
+                .map(|(p, b)| (p.to_path_buf(), b)),
+        );
+        let wants_mesh = self.mesh.is_some() || self.png.is_some() || self.deviation_png.is_some();
+        if !wants_mesh {
+            return Ok((files, 1.0));
+        }
+        let (cu, cv) = surface.counts();
+        let mesh = tessellate(surface, (cu * 4).clamp(32, 400), (cv * 4).clamp(32, 400));
+        // the local fit error on the surface: each mesh vertex shows the
+        // deviation of its nearest input point, on the scale of the error table
+        let vertex_dev = if self.deviation_png.is_some()
+            || self.mesh.as_deref().is_some_and(|m| extension(m) != "obj")
+        {
+            let near = nearest_points(points, &mesh.vertices)?;
+            Some(
+                near.iter()
+                    .map(|&(i, _)| deviation.per_point[i])
+                    .collect::<Vec<f64>>(),
+            )
+        } else {
+            None
+        };
+        let dmax = deviation.stats.max;
+        let colours: Option<Vec<[u8; 3]>> = vertex_dev.as_ref().map(|d| {
+            d.iter()
+                .map(|&x| {
+                    viridis(if dmax > 0.0 { x / dmax } else { 0.0 })
+                        .map(|c| (c * 255.0).round() as u8)
+                })
+                .collect()
+        });
+        if let Some(m) = &self.mesh {
+            let name = input
+                .file_stem()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            let bytes = match extension(m).as_str() {
+                "obj" => mesh_obj(
+                    &mesh,
+                    &format!("scanfit surface fitted to {}", input.display()),
+                ),
+                "glb" => mesh_glb(&mesh, colours.as_deref(), &name),
+                _ => mesh_ply(
+                    &mesh,
+                    vertex_dev.as_deref().map(|d| ("deviation", d)),
+                    colours.as_deref(),
+                    PlyFormat::Binary,
+                ),
+            };
+            files.push((m.clone(), bytes));
+        }
+        if let (Some(dp), Some(d)) = (&self.deviation_png, &vertex_dev) {
+            let opts = RenderOptions {
+                legend: vec![
+                    format!(
+                        "{}: colour = {} of the nearest input point [data units]",
+                        input.display(),
+                        deviation.name
+                    ),
+                    format!(
+                        "input points to surface ({}): mean {}  max {}  RMSE {}  [data units]",
+                        deviation.name,
+                        num(deviation.stats.mean),
+                        num(deviation.stats.max),
+                        num(deviation.stats.rmse)
+                    ),
+                ],
+                ..self.view.options(points)?
+            };
+            let bytes = render_png(
+                &mesh,
+                None,
+                Colouring::Scalar {
+                    values: d,
+                    range: (0.0, dmax),
+                },
+                &opts,
+            )?;
+            files.push((dp.clone(), bytes));
+        }
+        let mut exaggeration = 1.0;
+        if let Some(png) = &self.png {
+            // at most 5,000 points drawn, evenly picked; flat data (terrain) exaggerated
+            let step = (points.len() / 5_000).max(1);
+            let shown: Vec<_> = points.iter().step_by(step).copied().collect();
+            let opts = self.view.options(points)?;
+            exaggeration = opts.z_scale;
+            let bytes = render_png(&mesh, Some(&shown), Colouring::Height, &opts)?;
+            files.push((png.clone(), bytes));
+        }
+        Ok((files, exaggeration))
+    }
+}
+
+/// Prints `wrote FILE` for each file, naming the exaggeration of `png`.
+pub fn print_written(files: &Files, png: Option<&Path>, exaggeration: f64) {
+    for (p, _) in files {
+        if png == Some(p.as_path()) && exaggeration != 1.0 {
+            println!(
+                "wrote {} (vertical exaggeration {exaggeration}x)",
+                p.display()
+            );
+        } else {
+            println!("wrote {}", p.display());
+        }
+    }
+}
