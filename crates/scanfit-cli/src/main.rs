@@ -6,6 +6,7 @@
 mod cad;
 mod cloud;
 mod curve;
+mod mba;
 mod outputs;
 mod progress;
 mod report;
@@ -36,6 +37,8 @@ enum Command {
     Curve(curve::CurveCommand),
     /// Least-squares B-spline surface through scattered points, with an error table.
     Fit(surface::FitArgs),
+    /// Bicubic surface z = f(x, y) by multilevel B-spline approximation (MBA).
+    Mba(mba::MbaArgs),
     /// Deviation of points from a fitted surface: statistics and an HTML report.
     Report(report::ReportArgs),
 }
@@ -61,6 +64,7 @@ fn main() {
         Command::Cloud(c) => cloud::run(c),
         Command::Curve(c) => curve::run(c),
         Command::Fit(a) => surface::run(a),
+        Command::Mba(a) => mba::run(a),
         Command::Report(a) => report::run(a),
     };
     if let Err(e) = result {
