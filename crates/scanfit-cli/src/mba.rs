@@ -48,7 +48,7 @@ pub struct MbaArgs {
     #[arg(long, default_value_t = 6, value_name = "L")]
     pub levels: usize,
     /// Stop once the vertical RMSE (or, with --adjust, the eq. 17 RMSE) is at most E [data units].
-    #[arg(long, value_name = "E")]
+    #[arg(long, value_name = "E", allow_negative_numbers = true)]
     pub tolerance: Option<f64>,
     /// Hjelle's control-value formula (turntable paper eq. 6) instead of eq. 4.
     #[arg(long)]
@@ -57,7 +57,12 @@ pub struct MbaArgs {
     #[arg(long)]
     pub adjust: bool,
     /// Step factor of the adjustment.
-    #[arg(long, default_value_t = 1.49, value_name = "A")]
+    #[arg(
+        long,
+        default_value_t = 1.49,
+        value_name = "A",
+        allow_negative_numbers = true
+    )]
     pub alpha: f64,
     /// Weight factor of the projection: aza04 (eq. 13), as05 (eq. 14), axis4 (eq. 15), moon (turntable eq. 19).
     #[arg(long, default_value = "moon", value_name = "W")]

@@ -437,6 +437,24 @@ mod tests {
             .collect();
         let r = mba(&diag, &MbaConfig::default()).unwrap();
         assert!(r.reports.last().unwrap().residual.max < 0.05);
+        // 10^8-sized coordinates: the same fit as at the origin
+        let near = random_points(2000, franke, [0.0, 0.0]);
+        let far: Vec<Point3> = near
+            .iter()
+            .map(|q| Point3::new(q.x + 1e8, q.y - 3e8, q.z + 1e8))
+            .collect();
+        let (a, b) = (
+            mba(&near, &MbaConfig::default()).unwrap(),
+            mba(&far, &MbaConfig::default()).unwrap(),
+        );
+        for (ra, rb) in a.reports.iter().zip(&b.reports) {
+            assert!(
+                (ra.residual.rmse - rb.residual.rmse).abs() < 1e-6,
+                "{ra:?} {rb:?}"
+            );
+        }
+        let s = b.surface().unwrap();
+        assert!(s.control_points().iter().all(|c| c.z.is_finite()));
         let bad = MbaConfig {
             base: Some((0, 2)),
             ..Default::default()

@@ -1,0 +1,193 @@
+//! End-to-end tests of `scanfit mba`: the per-level report, the surface
+//! written and read back, the adjusted route, and bad input.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn examples() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/data")
+}
+
+fn tmpdir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("scanfit-mba-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_scanfit"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn ok(o: &Output) -> String {
+    assert!(
+        o.status.success(),
+        "failed: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+#[test]
+fn mba_levels_improve_and_the_surface_reads_back() {
+    let d = tmpdir("levels");
+    let (json, mesh, png, step) = (
+        d.join("t.json"),
+        d.join("t.ply"),
+        d.join("t.png"),
+        d.join("t.stp"),
+    );
+    let input = examples().join("terrain_50k.xyz");
+    let out = ok(&run(&[
+        "mba",
+        input.to_str().unwrap(),
+        "--levels",
+        "5",
+        "-o",
+        json.to_str().unwrap(),
+        "--mesh",
+        mesh.to_str().unwrap(),
+        "--png",
+        png.to_str().unwrap(),
+        "--step",
+        step.to_str().unwrap(),
+        "--json",
+    ]));
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let levels = v["levels"].as_array().unwrap();
+    assert_eq!(levels.len(), 5);
+    assert_eq!(v["control_points"][0], 19);
+    for w in levels.windows(2) {
+        assert!(w[1]["vertical_rmse"].as_f64() < w[0]["vertical_rmse"].as_f64());
+    }
+    // the written surface evaluates to the reported vertical errors
+    let (doc, surface) = scanfit_io::json::read_surface(&json).unwrap();
+    let q = doc.quality.unwrap();
+    assert_eq!(q.rmse, v["quality"]["rmse"].as_f64().unwrap());
+    let table = scanfit_io::read_points(&input).unwrap();
+    let (x0, x1, y0, y1) = table.points.iter().fold(
+        (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ),
+        |(a, b, c, e), p| (a.min(p.x), b.max(p.x), c.min(p.y), e.max(p.y)),
+    );
+    let sum2: f64 = table
+        .points
+        .iter()
+        .map(|p| {
+            let s = surface.point((p.x - x0) / (x1 - x0), (p.y - y0) / (y1 - y0));
+            assert!((s.x - p.x).abs() < 1e-6 && (s.y - p.y).abs() < 1e-6);
+            (p.z - s.z).powi(2)
+        })
+        .sum();
+    let rmse = (sum2 / table.points.len() as f64).sqrt();
+    assert!(
+        (rmse - q.rmse).abs() < 1e-9 * q.rmse,
+        "{rmse} vs {}",
+        q.rmse
+    );
+    for f in [&mesh, &png, &step] {
+        assert!(
+            std::fs::metadata(f).unwrap().len() > 1000,
+            "{}",
+            f.display()
+        );
+    }
+}
+
+#[test]
+fn adjusted_mba_never_raises_eq17() {
+    let input = examples().join("terrain_50k.xyz");
+    for weight in ["moon", "aza04", "as05"] {
+        let out = ok(&run(&[
+            "mba",
+            input.to_str().unwrap(),
+            "--levels",
+            "4",
+            "--adjust",
+            "--weight",
+            weight,
+            "--json",
+        ]));
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        for l in v["levels"].as_array().unwrap() {
+            let (a, b) = (
+                l["grid_rmse"].as_f64().unwrap(),
+                l["adjusted_grid_rmse"].as_f64().unwrap(),
+            );
+            assert!(b <= a, "{weight}: {l}");
+        }
+    }
+    // the table on a terminal names its columns
+    let out = ok(&run(&[
+        "mba",
+        input.to_str().unwrap(),
+        "--levels",
+        "2",
+        "--adjust",
+    ]));
+    assert!(
+        out.contains("adjusted eq. 17 RMSE") && out.contains("data units"),
+        "{out}"
+    );
+}
+
+#[test]
+fn mba_bad_input_is_reported_without_output() {
+    let d = tmpdir("bad");
+    let out = d.join("o.json");
+    let line = d.join("line.xyz");
+    std::fs::write(&line, "1 0 0\n1 1 1\n1 2 0\n1 3 1\n").unwrap();
+    let one = d.join("one.xyz");
+    std::fs::write(&one, "1 2 3\n").unwrap();
+    let input = examples().join("terrain_50k.xyz");
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec![line.to_str().unwrap()], "all points have the same x"),
+        (vec![one.to_str().unwrap()], "1 points given"),
+        (
+            vec![input.to_str().unwrap(), "--base", "0x2"],
+            "at least 1 x 1 cells",
+        ),
+        (
+            vec![input.to_str().unwrap(), "--base", "ax2"],
+            "--base 'ax2'",
+        ),
+        (
+            vec![input.to_str().unwrap(), "--levels", "40"],
+            "cannot be stored",
+        ),
+        (
+            vec![input.to_str().unwrap(), "--adjust", "--weight", "heavy"],
+            "unknown --weight",
+        ),
+        (
+            vec![input.to_str().unwrap(), "--adjust", "--alpha", "-1"],
+            "alpha",
+        ),
+        (
+            vec![input.to_str().unwrap(), "--mesh", "x.stl"],
+            "must end in",
+        ),
+    ];
+    for (args, needle) in cases {
+        let mut full = vec!["mba"];
+        full.extend(&args);
+        full.extend(["-o", out.to_str().unwrap()]);
+        let o = run(&full);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: '{needle}' not in {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert!(!out.exists(), "{args:?} wrote output");
+    }
+    let o = run(&["mba", "--help"]);
+    assert!(ok(&o).contains("Examples:"));
+}
