@@ -6,6 +6,7 @@
 mod cad;
 mod cloud;
 mod curve;
+mod export;
 mod mba;
 mod outputs;
 mod progress;
@@ -35,6 +36,8 @@ enum Command {
     /// B-spline curves through or near a sequence of points.
     #[command(subcommand)]
     Curve(curve::CurveCommand),
+    /// Several curves and surfaces (JSON) into one STEP and/or IGES file.
+    Export(export::ExportArgs),
     /// Least-squares B-spline surface through scattered points, with an error table.
     Fit(surface::FitArgs),
     /// Bicubic surface z = f(x, y) by multilevel B-spline approximation (MBA).
@@ -63,6 +66,7 @@ fn main() {
     let result = match cli.command {
         Command::Cloud(c) => cloud::run(c),
         Command::Curve(c) => curve::run(c),
+        Command::Export(a) => export::run(a),
         Command::Fit(a) => surface::run(a),
         Command::Mba(a) => mba::run(a),
         Command::Report(a) => report::run(a),

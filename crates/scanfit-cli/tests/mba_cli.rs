@@ -191,3 +191,73 @@ fn mba_bad_input_is_reported_without_output() {
     let o = run(&["mba", "--help"]);
     assert!(ok(&o).contains("Examples:"));
 }
+
+#[test]
+fn export_writes_several_patches_into_one_cad_file() {
+    let d = tmpdir("export");
+    let (a, b, c) = (d.join("a.json"), d.join("b.json"), d.join("c.json"));
+    let input = examples().join("terrain_50k.xyz");
+    ok(&run(&[
+        "mba",
+        input.to_str().unwrap(),
+        "--levels",
+        "3",
+        "-o",
+        a.to_str().unwrap(),
+        "-q",
+    ]));
+    ok(&run(&[
+        "fit",
+        input.to_str().unwrap(),
+        "--ctrl",
+        "8x8",
+        "-o",
+        b.to_str().unwrap(),
+        "-q",
+    ]));
+    let curve = examples().join("dataset1.csv");
+    ok(&run(&[
+        "curve",
+        "fit",
+        curve.to_str().unwrap(),
+        "-o",
+        c.to_str().unwrap(),
+    ]));
+    let (stp, igs) = (d.join("all.stp"), d.join("all.igs"));
+    let out = ok(&run(&[
+        "export",
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        c.to_str().unwrap(),
+        "--step",
+        stp.to_str().unwrap(),
+        "--iges",
+        igs.to_str().unwrap(),
+    ]));
+    assert!(out.contains("1 curves, 2 surfaces"), "{out}");
+    let step = std::fs::read_to_string(&stp).unwrap();
+    assert_eq!(step.matches("B_SPLINE_SURFACE_WITH_KNOTS(").count(), 2);
+    assert_eq!(step.matches("ADVANCED_FACE(").count(), 2);
+    let iges = std::fs::read_to_string(&igs).unwrap();
+    // two surface entities and one curve in the directory section (plus the
+    // boundary curves of nothing: IGES surfaces are written untrimmed)
+    let de: Vec<&str> = iges
+        .lines()
+        .filter(|l| l.get(72..73) == Some("D"))
+        .collect();
+    assert_eq!(de.iter().filter(|l| l.starts_with("     128")).count(), 4);
+    assert_eq!(de.iter().filter(|l| l.starts_with("     126")).count(), 2);
+    // a document that is neither: a clear error, nothing written
+    let bad = d.join("bad.json");
+    std::fs::write(&bad, "{\"schema\":\"scanfit/1\",\"type\":\"mesh\"}").unwrap();
+    let stp2 = d.join("x.stp");
+    let o = run(&[
+        "export",
+        bad.to_str().unwrap(),
+        "--step",
+        stp2.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("bad.json"));
+    assert!(!stp2.exists());
+}
