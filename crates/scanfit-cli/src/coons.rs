@@ -429,7 +429,7 @@ pub fn run(a: CoonsArgs) -> Result<()> {
             opts.legend = vec![
                 format!("{input}: {} points; {route}", pts.len()),
                 format!(
-                    "colour = orthogonal distance of the nearest input point [data units]: mean {}  max {}; red dots = points, lines = boundary curves, C0.. = corners",
+                    "colour = distance of nearest point [data units] (mean {}, max {}); dots = points, lines = boundary curves",
                     num(orth.mean),
                     num(orth.max)
                 ),
