@@ -165,7 +165,10 @@ pub fn run(a: CoonsArgs) -> Result<()> {
         (&a.points_out, "--points-out", &["ply", "xyz"][..]),
     ])?;
     if a.sides != 3 && a.sides != 4 {
-        bail!("--sides {}: a Coons patch has 4 sides, or 3 with one degenerate", a.sides);
+        bail!(
+            "--sides {}: a Coons patch has 4 sides, or 3 with one degenerate",
+            a.sides
+        );
     }
     let pde_terms = match (a.fit.as_deref(), &a.pde) {
         (Some("bspline"), Some(_)) => {
@@ -189,7 +192,9 @@ pub fn run(a: CoonsArgs) -> Result<()> {
                 .map(|x| x.trim().parse::<usize>())
                 .collect::<std::result::Result<_, _>>()
                 .with_context(|| {
-                    format!("--corners '{s}' must be `auto` or loop positions I,J,K,L (whole numbers)")
+                    format!(
+                        "--corners '{s}' must be `auto` or loop positions I,J,K,L (whole numbers)"
+                    )
                 })?;
             if c.len() != a.sides {
                 bail!(
@@ -208,10 +213,14 @@ pub fn run(a: CoonsArgs) -> Result<()> {
         "interpolate" => BoundaryFit::Interpolation,
         c => bail!("unknown --curves '{c}'; use lsq or interpolate"),
     };
-    let params_how = a
-        .params
-        .clone()
-        .unwrap_or_else(|| if pde_terms.is_some() { "closest" } else { "grid" }.into());
+    let params_how = a.params.clone().unwrap_or_else(|| {
+        if pde_terms.is_some() {
+            "closest"
+        } else {
+            "grid"
+        }
+        .into()
+    });
     let projection = match params_how.as_str() {
         "grid" => CoonsProjection::GridIteration(GridIterationConfig {
             h: a.h,
@@ -263,7 +272,10 @@ pub fn run(a: CoonsArgs) -> Result<()> {
     let diag = cloud.diagonal();
     let (surface, fit_err, export_dev, route) = match pde_terms {
         None => {
-            progress.stage(format!("least-squares surface, {} x {} control points", ctrl.0, ctrl.1));
+            progress.stage(format!(
+                "least-squares surface, {} x {} control points",
+                ctrl.0, ctrl.1
+            ));
             let s = fit_surface(
                 pts,
                 &par.uv,
@@ -274,7 +286,15 @@ pub fn run(a: CoonsArgs) -> Result<()> {
                 },
             )?;
             let e = ErrorStats::of(&parametric_distances(&s, pts, &par.uv));
-            (s, e, None, format!("least-squares B-spline surface, {} x {} control points (Coons paper)", ctrl.0, ctrl.1))
+            (
+                s,
+                e,
+                None,
+                format!(
+                    "least-squares B-spline surface, {} x {} control points (Coons paper)",
+                    ctrl.0, ctrl.1
+                ),
+            )
         }
         Some((m, n)) => {
             progress.stage(format!("PDE deformation, {m} x {n} terms"));
@@ -385,7 +405,12 @@ pub fn run(a: CoonsArgs) -> Result<()> {
                             .map(|c| (c * 255.0).round() as u8)
                     })
                     .collect();
-                mesh_ply(&mesh, Some(("deviation", &dev)), Some(&colours), PlyFormat::Binary)
+                mesh_ply(
+                    &mesh,
+                    Some(("deviation", &dev)),
+                    Some(&colours),
+                    PlyFormat::Binary,
+                )
             };
             files.push((m, bytes));
         }
@@ -458,7 +483,11 @@ pub fn run(a: CoonsArgs) -> Result<()> {
             resid
         };
         let dist: Vec<f64> = inv.iter().map(|r| r.distance).collect();
-        let outside: Vec<f64> = par.outside.iter().map(|&o| f64::from(u8::from(o))).collect();
+        let outside: Vec<f64> = par
+            .outside
+            .iter()
+            .map(|&o| f64::from(u8::from(o)))
+            .collect();
         let attrs: [(&str, &[f64]); 6] = [
             ("u", &u),
             ("v", &v),
@@ -467,7 +496,10 @@ pub fn run(a: CoonsArgs) -> Result<()> {
             ("distance", &dist),
             ("outside", &outside),
         ];
-        let bytes = if pout.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply")) {
+        let bytes = if pout
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("ply"))
+        {
             points_ply(pts, &attrs, PlyFormat::Binary)
         } else {
             points_xyz(pts, &attrs)
@@ -527,7 +559,11 @@ pub fn run(a: CoonsArgs) -> Result<()> {
     let mut t = Table::new(&["step", "result"], &[true, true]);
     t.row(vec![
         "boundary".into(),
-        format!("outer loop of {} points, alpha {}", outer.len(), num(base.boundary.alpha)),
+        format!(
+            "outer loop of {} points, alpha {}",
+            outer.len(),
+            num(base.boundary.alpha)
+        ),
     ]);
     t.row(vec![
         "corners (loop position: angle)".into(),
@@ -544,8 +580,16 @@ pub fn run(a: CoonsArgs) -> Result<()> {
         format!("boundary curves ({})", a.curves),
         format!(
             "{} control points, max error {}",
-            curve_ctrl.iter().map(usize::to_string).collect::<Vec<_>>().join("/"),
-            curve_err.iter().map(|&e| num(e)).collect::<Vec<_>>().join("/")
+            curve_ctrl
+                .iter()
+                .map(usize::to_string)
+                .collect::<Vec<_>>()
+                .join("/"),
+            curve_err
+                .iter()
+                .map(|&e| num(e))
+                .collect::<Vec<_>>()
+                .join("/")
         ),
     ]);
     t.row(vec![
@@ -588,7 +632,11 @@ pub fn run(a: CoonsArgs) -> Result<()> {
     t.row(vec![
         format!(
             "{} |P - S(u,v)| (eq. 15)",
-            if pde_terms.is_some() { "PDE surface" } else { "B-spline surface" }
+            if pde_terms.is_some() {
+                "PDE surface"
+            } else {
+                "B-spline surface"
+            }
         ),
         num(fit_err.mean),
         num(fit_err.max),

@@ -91,8 +91,15 @@ fn pde_route_on_the_panel() {
     assert_eq!(surface.degrees(), (3, 3));
     let cloud = read_cloud(&pts, &ReadOptions::default()).unwrap();
     let outside_col = cloud.column("outside").unwrap();
-    assert_eq!(outside_col.iter().filter(|&&o| o == 1.0).count() as u64, outside);
-    assert!(cloud.column("u").unwrap().iter().all(|u| (0.0..=1.0).contains(u)));
+    assert_eq!(
+        outside_col.iter().filter(|&&o| o == 1.0).count() as u64,
+        outside
+    );
+    assert!(cloud
+        .column("u")
+        .unwrap()
+        .iter()
+        .all(|u| (0.0..=1.0).contains(u)));
     assert!(std::fs::metadata(&png).unwrap().len() > 20_000);
 }
 
@@ -149,7 +156,13 @@ fn three_sided_patch() {
     let input = d.join("tri.xyz");
     std::fs::write(&input, text).unwrap();
     let out = ok(&run(&[
-        "coons", s(&input), "--sides", "3", "--pde", "4x4", "--json",
+        "coons",
+        s(&input),
+        "--sides",
+        "3",
+        "--pde",
+        "4x4",
+        "--json",
     ]));
     let r: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(r["corners"].as_array().unwrap().len(), 3);
@@ -174,7 +187,10 @@ fn clear_errors_and_no_output() {
     let o = run(&["coons", s(&disk), "-o", s(&json)]);
     assert!(!o.status.success());
     let e = String::from_utf8_lossy(&o.stderr);
-    assert!(e.contains("corner(s) sharper than") && e.contains("4 were asked"), "{e}");
+    assert!(
+        e.contains("corner(s) sharper than") && e.contains("4 were asked"),
+        "{e}"
+    );
     assert!(!json.exists());
     let o = run(&["coons", s(&patch()), "--fit", "bspline", "--pde", "5x5"]);
     assert!(String::from_utf8_lossy(&o.stderr).contains("exclude each other"));

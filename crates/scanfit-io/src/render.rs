@@ -569,7 +569,12 @@ fn render_rgb_with(
         for dy in -6..=6isize {
             for dx in -6..=6isize {
                 let edge = dx.abs() == 6 || dy.abs() == 6;
-                put(px + dx, py + dy, if edge { [0, 0, 0] } else { m.rgb }, &mut img);
+                put(
+                    px + dx,
+                    py + dy,
+                    if edge { [0, 0, 0] } else { m.rgb },
+                    &mut img,
+                );
             }
         }
         if !m.label.is_empty() {

@@ -102,8 +102,7 @@ impl PdeDeformation {
 
     /// The lateral force coefficient `q_wmn` (eq. 5) of term `(m, n)`.
     pub fn q_coefficient(&self, m: usize, n: usize) -> Option<Vector3> {
-        self.w_coefficient(m, n)
-            .map(|w| w * factor(self.d, m, n))
+        self.w_coefficient(m, n).map(|w| w * factor(self.d, m, n))
     }
 
     /// `S_PDE(u, v)` (eq. 11), zero on the boundary of `[0, 1]^2`.
@@ -462,7 +461,8 @@ mod tests {
     fn recovers_a_sine_bump_and_converts_to_bspline() {
         let coons = flat_square();
         let f = |u: f64, v: f64| {
-            0.3 * (PI * u).sin() * (PI * v).sin() - 0.05 * (2.0 * PI * u).sin() * (3.0 * PI * v).sin()
+            0.3 * (PI * u).sin() * (PI * v).sin()
+                - 0.05 * (2.0 * PI * u).sin() * (3.0 * PI * v).sin()
         };
         let mut pts = Vec::new();
         let mut uv = Vec::new();

@@ -68,7 +68,17 @@ fn pde_deformation_reduces_the_coons_error_section_5_1() {
     let coons = exact_coons(&s);
     let (pts, uv) = structured(&s, 50, 0.0);
     let f5 = fit_pde(&coons, &pts, &uv, &PdeConfig::default()).unwrap();
-    let f10 = fit_pde(&coons, &pts, &uv, &PdeConfig { m: 10, n: 10, d: 1.0 }).unwrap();
+    let f10 = fit_pde(
+        &coons,
+        &pts,
+        &uv,
+        &PdeConfig {
+            m: 10,
+            n: 10,
+            d: 1.0,
+        },
+    )
+    .unwrap();
     println!(
         "6a: Coons mean {:.4} max {:.4}; PDE 5x5 mean {:.6} max {:.6} (x{:.0}); PDE 10x10 mean {:.2e} max {:.2e} (x{:.0})",
         f5.coons_errors.mean,
@@ -80,7 +90,11 @@ fn pde_deformation_reduces_the_coons_error_section_5_1() {
         f10.errors.max,
         f5.coons_errors.mean / f10.errors.mean
     );
-    assert!((f5.coons_errors.mean - 0.2519).abs() < 1e-4, "{:?}", f5.coons_errors);
+    assert!(
+        (f5.coons_errors.mean - 0.2519).abs() < 1e-4,
+        "{:?}",
+        f5.coons_errors
+    );
     assert!(f5.coons_errors.mean / f5.errors.mean >= 50.0);
     assert!(f10.errors.mean < 0.2 * f5.errors.mean);
     assert!(f10.errors.max < f5.errors.max);
@@ -100,7 +114,11 @@ fn mn_equal_to_the_point_count_interpolates() {
     for n in [5, 6, 8] {
         let (pts, uv) = structured(&s, n, 0.5);
         let f = fit_pde(&coons, &pts, &uv, &PdeConfig { m: n, n, d: 1.0 }).unwrap();
-        println!("6b: {} points, M = N = {n}: max error {:.2e}", pts.len(), f.errors.max);
+        println!(
+            "6b: {} points, M = N = {n}: max error {:.2e}",
+            pts.len(),
+            f.errors.max
+        );
         assert!(f.errors.max < 1e-13, "{n}: {:?}", f.errors);
         assert!(f.coons_errors.mean > 0.1);
     }
@@ -126,7 +144,10 @@ fn the_rigidity_d_does_not_change_the_surface() {
         for (m, n) in [(1, 1), (3, 2), (5, 5)] {
             let q = f.surface.deformation.q_coefficient(m, n).unwrap() / d;
             let q0 = fits[0].surface.deformation.q_coefficient(m, n).unwrap() / d0;
-            assert!((q - q0).norm() <= 1e-12 * q0.norm(), "q/D differs at {m},{n}");
+            assert!(
+                (q - q0).norm() <= 1e-12 * q0.norm(),
+                "q/D differs at {m},{n}"
+            );
         }
     }
     println!(
@@ -169,7 +190,10 @@ fn noisy_data_section_5_4() {
     let s = bezier();
     let (clean, _) = structured(&s, 60, 0.0);
     let (lo, hi) = clean.iter().fold(
-        (Vector3::repeat(f64::INFINITY), Vector3::repeat(f64::NEG_INFINITY)),
+        (
+            Vector3::repeat(f64::INFINITY),
+            Vector3::repeat(f64::NEG_INFINITY),
+        ),
         |(lo, hi), p| (lo.inf(&p.coords), hi.sup(&p.coords)),
     );
     let d = (hi - lo).norm();
@@ -195,12 +219,25 @@ fn noisy_data_section_5_4() {
             },
         )
         .unwrap();
-        let fit = fit_pde(&base.patch, &noisy, &par.uv, &PdeConfig { m: 10, n: 10, d: 1.0 }).unwrap();
+        let fit = fit_pde(
+            &base.patch,
+            &noisy,
+            &par.uv,
+            &PdeConfig {
+                m: 10,
+                n: 10,
+                d: 1.0,
+            },
+        )
+        .unwrap();
         let b = fit
             .surface
             .to_bspline(&BsplineConversionConfig::new(1e-5 * d))
             .unwrap();
-        let (ec, ep) = (distance_to(&coons_b, &clean), distance_to(&b.surface, &clean));
+        let (ec, ep) = (
+            distance_to(&coons_b, &clean),
+            distance_to(&b.surface, &clean),
+        );
         println!(
             "| {l} | {sigma:.4} | {} | {:.4} | {:.4} | {:.4} | {:.4} |",
             par.outside_count, ec.mean, ec.max, ep.mean, ep.max

@@ -311,7 +311,11 @@ impl CoonsPatch {
             top: with_ends(&t, p01, p11)?,
             left: with_ends(&l, p00, p01)?,
             right: with_ends(&r, p10, p11)?,
-            sides: if degenerate { Sides::Three } else { Sides::Four },
+            sides: if degenerate {
+                Sides::Three
+            } else {
+                Sides::Four
+            },
         })
     }
 
@@ -348,7 +352,10 @@ impl CoonsPatch {
             let mut gaps = Vec::new();
             for k in 1..fwd.len() {
                 let prev = end(&out[k - 1]);
-                let (gf, gr) = ((start(&fwd[k]) - prev).norm(), (start(&rev[k]) - prev).norm());
+                let (gf, gr) = (
+                    (start(&fwd[k]) - prev).norm(),
+                    (start(&rev[k]) - prev).norm(),
+                );
                 if gf <= gr {
                     out.push(fwd[k].clone());
                     gaps.push(gf);
@@ -477,10 +484,8 @@ impl CoonsPatch {
         let ((b, db), (t, dt)) = (d(&self.bottom, u), d(&self.top, u));
         let ((l, dl), (r, dr)) = (d(&self.left, v), d(&self.right, v));
         let s = self.point(u, v);
-        let su = db * (1.0 - v) + dt * v - l + r
-            - ((p10 - p00) * (1.0 - v) + (p11 - p01) * v);
-        let sv = t - b + dl * (1.0 - u) + dr * u
-            - ((p01 - p00) * (1.0 - u) + (p11 - p10) * u);
+        let su = db * (1.0 - v) + dt * v - l + r - ((p10 - p00) * (1.0 - v) + (p11 - p01) * v);
+        let sv = t - b + dl * (1.0 - u) + dr * u - ((p01 - p00) * (1.0 - u) + (p11 - p10) * u);
         (s, su, sv)
     }
 
@@ -579,7 +584,12 @@ mod tests {
 
     fn patch() -> CoonsPatch {
         // a saddle-like frame with curved sides
-        let bottom = line_curve(&[[0., 0., 0.], [0.3, -0.2, 0.4], [0.7, 0.1, -0.2], [1., 0., 0.]]);
+        let bottom = line_curve(&[
+            [0., 0., 0.],
+            [0.3, -0.2, 0.4],
+            [0.7, 0.1, -0.2],
+            [1., 0., 0.],
+        ]);
         let right = line_curve(&[
             [1., 0., 0.],
             [1.2, 0.3, 0.5],
@@ -587,8 +597,18 @@ mod tests {
             [1.1, 0.8, 0.2],
             [1., 1., 0.3],
         ]);
-        let top = line_curve(&[[0., 1., 0.5], [0.5, 1.3, 0.0], [0.8, 1.1, 0.2], [1., 1., 0.3]]);
-        let left = line_curve(&[[0., 0., 0.], [-0.2, 0.4, 0.1], [0.1, 0.7, 0.3], [0., 1., 0.5]]);
+        let top = line_curve(&[
+            [0., 1., 0.5],
+            [0.5, 1.3, 0.0],
+            [0.8, 1.1, 0.2],
+            [1., 1., 0.3],
+        ]);
+        let left = line_curve(&[
+            [0., 0., 0.],
+            [-0.2, 0.4, 0.1],
+            [0.1, 0.7, 0.3],
+            [0., 1., 0.5],
+        ]);
         CoonsPatch::new(&bottom, &top, &left, &right).unwrap()
     }
 
@@ -605,10 +625,30 @@ mod tests {
         // straight, uniformly parameterized sides: the patch is the bilinear map
         let third = 1.0 / 3.0;
         let sq = CoonsPatch::from_loop(&[
-            line_curve(&[[0., 0., 0.], [third, 0., 0.], [2. * third, 0., 0.], [1., 0., 0.]]),
-            line_curve(&[[1., 0., 0.], [1., 2. * third, 0.], [1., 4. * third, 0.], [1., 2., 0.]]),
-            line_curve(&[[1., 2., 0.], [2. * third, 2., 0.], [third, 2., 0.], [0., 2., 0.]]),
-            line_curve(&[[0., 2., 0.], [0., 4. * third, 0.], [0., 2. * third, 0.], [0., 0., 0.]]),
+            line_curve(&[
+                [0., 0., 0.],
+                [third, 0., 0.],
+                [2. * third, 0., 0.],
+                [1., 0., 0.],
+            ]),
+            line_curve(&[
+                [1., 0., 0.],
+                [1., 2. * third, 0.],
+                [1., 4. * third, 0.],
+                [1., 2., 0.],
+            ]),
+            line_curve(&[
+                [1., 2., 0.],
+                [2. * third, 2., 0.],
+                [third, 2., 0.],
+                [0., 2., 0.],
+            ]),
+            line_curve(&[
+                [0., 2., 0.],
+                [0., 4. * third, 0.],
+                [0., 2. * third, 0.],
+                [0., 0., 0.],
+            ]),
         ])
         .unwrap();
         assert!((sq.point(0.3, 0.6) - Point3::new(0.3, 1.2, 0.0)).norm() < 1e-14);
@@ -641,9 +681,19 @@ mod tests {
     #[test]
     fn loop_orientation_is_fixed_and_three_sides_degenerate() {
         let a = line_curve(&[[0., 0., 0.], [0.3, -0.1, 0.], [0.6, -0.1, 0.], [1., 0., 0.]]);
-        let b = line_curve(&[[1., 0., 0.], [0.9, 0.3, 0.1], [0.7, 0.7, 0.1], [0.5, 1., 0.]]);
+        let b = line_curve(&[
+            [1., 0., 0.],
+            [0.9, 0.3, 0.1],
+            [0.7, 0.7, 0.1],
+            [0.5, 1., 0.],
+        ]);
         // the third curve given backwards (A <- C)
-        let c = line_curve(&[[0., 0., 0.], [0.1, 0.3, 0.2], [0.3, 0.7, 0.2], [0.5, 1., 0.]]);
+        let c = line_curve(&[
+            [0., 0., 0.],
+            [0.1, 0.3, 0.2],
+            [0.3, 0.7, 0.2],
+            [0.5, 1., 0.],
+        ]);
         let s = CoonsPatch::from_loop(&[a, b, c]).unwrap();
         assert_eq!(s.sides(), Sides::Three);
         for k in 0..=10 {

@@ -208,6 +208,9 @@ mod tests {
         pts.push(Point3::origin());
         let e = coons_from_cloud(&pts, &CoonsFromCloudConfig::default()).unwrap_err();
         let m = e.to_string();
-        assert!(m.contains("sharper than 160 degrees") && m.contains("4 were asked"), "{m}");
+        assert!(
+            m.contains("sharper than 160 degrees") && m.contains("4 were asked"),
+            "{m}"
+        );
     }
 }

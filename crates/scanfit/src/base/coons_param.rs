@@ -116,8 +116,7 @@ pub fn coons_parameters(
             || (BasisWorkspace::new(p, 1), BasisWorkspace::new(q, 1)),
             |(wu, wv), (pt, r)| {
                 let [u, v] = r.uv;
-                let on_edge =
-                    u - u0 <= edge || u1 - u <= edge || v - v0 <= edge || v1 - v <= edge;
+                let on_edge = u - u0 <= edge || u1 - u <= edge || v - v0 <= edge || v1 - v <= edge;
                 if !on_edge {
                     return false;
                 }
