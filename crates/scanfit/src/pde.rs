@@ -380,7 +380,7 @@ pub fn fit_pde(
         .iter()
         .fold((f64::INFINITY, 0.0f64), |(a, b), &x| (a.min(x), b.max(x)));
     let condition = (hi / lo).powi(2);
-    if !(condition <= crate::fit::CONDITION_LIMIT) {
+    if condition.is_nan() || condition > crate::fit::CONDITION_LIMIT {
         return Err(Error::Singular {
             what: format!("PDE deformation least squares (eq. 13, {mm} x {nn} terms)"),
             condition,

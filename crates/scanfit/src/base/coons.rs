@@ -250,7 +250,7 @@ fn point_curve(a: Point3, p: usize) -> Result<Curve> {
     Curve::new(KnotVector::uniform_clamped(p, p + 1)?, vec![a; p + 1])
 }
 
-/// Which side of a three-sided patch is the degenerate one.
+/// Four sides, or three with one degenerate side.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Sides {
     /// Four boundary curves.
