@@ -5,6 +5,7 @@
 
 mod cad;
 mod cloud;
+mod coons;
 mod curve;
 mod export;
 mod mba;
@@ -33,6 +34,8 @@ enum Command {
     /// Point clouds: statistics, normals, hidden point removal, boundary and corners.
     #[command(subcommand)]
     Cloud(cloud::CloudCommand),
+    /// Coons base surface of a patch (boundary, corners, curves), then a B-spline or PDE surface.
+    Coons(coons::CoonsArgs),
     /// B-spline curves through or near a sequence of points.
     #[command(subcommand)]
     Curve(curve::CurveCommand),
@@ -65,6 +68,7 @@ fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Cloud(c) => cloud::run(c),
+        Command::Coons(a) => coons::run(a),
         Command::Curve(c) => curve::run(c),
         Command::Export(a) => export::run(a),
         Command::Fit(a) => surface::run(a),

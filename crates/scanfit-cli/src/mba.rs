@@ -15,7 +15,7 @@ use scanfit::project::{DirectedConfig, InversionConfig, SurfaceInverter, WeightF
 use scanfit_io::json::{Provenance, SurfaceDoc, SurfaceQualityDoc};
 use scanfit_io::write_all_atomic;
 
-use crate::outputs::{print_written, Deviation, SurfaceOutputArgs};
+use crate::outputs::{print_written, Deviation, Picture, SurfaceOutputArgs};
 use crate::progress::Progress;
 use crate::table::{num, Table};
 
@@ -279,6 +279,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
             name: "vertical distance |z - f(x, y)|",
         },
         &input,
+        &Picture::default(),
     )?;
     let refs: Vec<(&Path, &[u8])> = files
         .iter()

@@ -13,7 +13,9 @@ use scanfit::Point3;
 use scanfit_io::gltf::mesh_glb;
 use scanfit_io::json::SurfaceDoc;
 use scanfit_io::ply::{mesh_obj, mesh_ply, PlyFormat};
-use scanfit_io::render::{render_png, viridis, Colouring, RenderOptions};
+use scanfit_io::render::{
+    render_surface_scene_png, viridis, Colouring, Marker, Polyline, RenderOptions,
+};
 use scanfit_io::step::CadItem;
 
 use crate::table::num;
@@ -73,6 +75,30 @@ pub fn check_extensions(outputs: &[(&Option<PathBuf>, &str, &[&str])]) -> Result
 /// Output files: path and content, written together at the end.
 pub type Files = Vec<(PathBuf, Vec<u8>)>;
 
+/// How the `--png` picture colours the surface.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum PngStyle {
+    /// Shaded and coloured by height (fit, mba).
+    #[default]
+    Height,
+    /// Coloured by the local fit error, with a colour bar (coons).
+    Deviation,
+}
+
+/// What a pipeline adds to its pictures: its style of `--png`, lines
+/// (boundary curves) and markers (corners) drawn on top, and legend lines.
+#[derive(Debug, Clone, Default)]
+pub struct Picture {
+    /// Colouring of `--png`.
+    pub style: PngStyle,
+    /// Curves over the surface.
+    pub lines: Vec<Polyline>,
+    /// Labelled markers over the curves.
+    pub markers: Vec<Marker>,
+    /// Legend lines of `--png` (the deviation picture has its own).
+    pub legend: Vec<String>,
+}
+
 /// How far the input points are from the surface, as the pictures and the
 /// mesh colours show it.
 pub struct Deviation<'a> {
@@ -106,6 +132,7 @@ impl SurfaceOutputArgs {
         points: &[Point3],
         deviation: &Deviation,
         input: &Path,
+        picture: &Picture,
     ) -> Result<(Files, f64)> {
         let mut files: Files = Vec::new();
         if let Some(o) = &self.output {
@@ -125,6 +152,7 @@ impl SurfaceOutputArgs {
         // the local fit error on the surface: each mesh vertex shows the
         // deviation of its nearest input point, on the scale of the error table
         let vertex_dev = if self.deviation_png.is_some()
+            || (self.png.is_some() && picture.style == PngStyle::Deviation)
             || self.mesh.as_deref().is_some_and(|m| extension(m) != "obj")
         {
             let near = nearest_points(points, &mesh.vertices)?;
@@ -165,31 +193,34 @@ impl SurfaceOutputArgs {
             };
             files.push((m.clone(), bytes));
         }
+        let deviation_legend = vec![
+            format!(
+                "{}: colour = {} of the nearest input point [data units]",
+                input.display(),
+                deviation.name
+            ),
+            format!(
+                "input points to surface ({}): mean {}  max {}  RMSE {}  [data units]",
+                deviation.name,
+                num(deviation.stats.mean),
+                num(deviation.stats.max),
+                num(deviation.stats.rmse)
+            ),
+        ];
         if let (Some(dp), Some(d)) = (&self.deviation_png, &vertex_dev) {
             let opts = RenderOptions {
-                legend: vec![
-                    format!(
-                        "{}: colour = {} of the nearest input point [data units]",
-                        input.display(),
-                        deviation.name
-                    ),
-                    format!(
-                        "input points to surface ({}): mean {}  max {}  RMSE {}  [data units]",
-                        deviation.name,
-                        num(deviation.stats.mean),
-                        num(deviation.stats.max),
-                        num(deviation.stats.rmse)
-                    ),
-                ],
+                legend: deviation_legend.clone(),
                 ..self.view.options(points)?
             };
-            let bytes = render_png(
+            let bytes = render_surface_scene_png(
                 &mesh,
                 None,
                 Colouring::Scalar {
                     values: d,
                     range: (0.0, dmax),
                 },
+                &picture.lines,
+                &picture.markers,
                 &opts,
             )?;
             files.push((dp.clone(), bytes));
@@ -199,9 +230,27 @@ impl SurfaceOutputArgs {
             // at most 5,000 points drawn, evenly picked; flat data (terrain) exaggerated
             let step = (points.len() / 5_000).max(1);
             let shown: Vec<_> = points.iter().step_by(step).copied().collect();
-            let opts = self.view.options(points)?;
+            let mut opts = self.view.options(points)?;
             exaggeration = opts.z_scale;
-            let bytes = render_png(&mesh, Some(&shown), Colouring::Height, &opts)?;
+            let colouring = match (picture.style, &vertex_dev) {
+                (PngStyle::Deviation, Some(d)) => {
+                    opts.legend = deviation_legend;
+                    Colouring::Scalar {
+                        values: d,
+                        range: (0.0, dmax),
+                    }
+                }
+                _ => Colouring::Height,
+            };
+            opts.legend.extend(picture.legend.iter().cloned());
+            let bytes = render_surface_scene_png(
+                &mesh,
+                Some(&shown),
+                colouring,
+                &picture.lines,
+                &picture.markers,
+                &opts,
+            )?;
             files.push((png.clone(), bytes));
         }
         Ok((files, exaggeration))

@@ -17,7 +17,7 @@ use scanfit_io::json::{Provenance, SurfaceDoc, SurfaceQualityDoc};
 use scanfit_io::ply::{points_ply, points_xyz, PlyFormat};
 use scanfit_io::{read_points, write_all_atomic};
 
-use crate::outputs::{check_extensions, extension, print_written, Deviation};
+use crate::outputs::{check_extensions, extension, print_written, Deviation, Picture};
 use crate::progress::Progress;
 use crate::table::{num, Table};
 
@@ -221,6 +221,7 @@ pub fn run(a: FitArgs) -> Result<()> {
             name: "orthogonal distance",
         },
         &a.input,
+        &Picture::default(),
     )?;
     if let Some(pout) = &a.points_out {
         let u: Vec<f64> = uv.iter().map(|t| t[0]).collect();

@@ -355,11 +355,37 @@ pub fn encode_png(rgb: &[u8], width: u32, height: u32) -> Result<Vec<u8>> {
     Ok(out)
 }
 
+/// Renders `mesh` coloured by `colouring`, `points` (red dots where not
+/// hidden), then `lines` and `markers` on top (boundary curves, corners), and
+/// returns the PNG bytes.
+pub fn render_surface_scene_png(
+    mesh: &Mesh,
+    points: Option<&[Point3]>,
+    colouring: Colouring,
+    lines: &[Polyline],
+    markers: &[Marker],
+    opts: &RenderOptions,
+) -> Result<Vec<u8>> {
+    let img = render_rgb_with(mesh, points, colouring, lines, markers, opts);
+    encode_png(&img, opts.width, opts.height)
+}
+
 /// Renders into an RGB8 buffer of `width x height` (row-major, top row first).
 pub fn render_rgb(
     mesh: &Mesh,
     points: Option<&[Point3]>,
     colouring: Colouring,
+    opts: &RenderOptions,
+) -> Vec<u8> {
+    render_rgb_with(mesh, points, colouring, &[], &[], opts)
+}
+
+fn render_rgb_with(
+    mesh: &Mesh,
+    points: Option<&[Point3]>,
+    colouring: Colouring,
+    lines: &[Polyline],
+    markers: &[Marker],
     opts: &RenderOptions,
 ) -> Vec<u8> {
     let (w, h) = (opts.width.max(16) as usize, opts.height.max(16) as usize);
@@ -380,6 +406,12 @@ pub fn render_rgb(
     };
     let sv: Vec<(f64, f64, f64)> = mesh.vertices.iter().map(proj).collect();
     let sp: Vec<(f64, f64, f64)> = points.unwrap_or(&[]).iter().map(proj).collect();
+    let overlay: Vec<(f64, f64, f64)> = lines
+        .iter()
+        .flat_map(|l| l.points.iter())
+        .chain(markers.iter().map(|m| &m.at))
+        .map(proj)
+        .collect();
     let (mut x0, mut x1, mut y0, mut y1) = (
         f64::INFINITY,
         f64::NEG_INFINITY,
@@ -387,7 +419,7 @@ pub fn render_rgb(
         f64::NEG_INFINITY,
     );
     let (mut z0, mut z1) = (f64::INFINITY, f64::NEG_INFINITY);
-    for &(x, y, z) in sv.iter().chain(&sp) {
+    for &(x, y, z) in sv.iter().chain(&sp).chain(&overlay) {
         x0 = x0.min(x);
         x1 = x1.max(x);
         y0 = y0.min(y);
@@ -504,6 +536,61 @@ pub fn render_rgb(
             if z + tol >= depth[k] {
                 img[k * 3..k * 3 + 3].copy_from_slice(&[200, 30, 30]);
             }
+        }
+    }
+    let put = |x: isize, y: isize, rgb: [u8; 3], img: &mut [u8]| {
+        if x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h {
+            let k = (y as usize * w + x as usize) * 3;
+            img[k..k + 3].copy_from_slice(&rgb);
+        }
+    };
+    for line in lines {
+        let n = line.points.len();
+        let segments = if line.closed { n } else { n.saturating_sub(1) };
+        for s in 0..segments {
+            let (ax, ay, _) = proj(&line.points[s]);
+            let (bx, by, _) = proj(&line.points[(s + 1) % n]);
+            let (pa, pb) = (to_px(ax, ay), to_px(bx, by));
+            let steps = ((pb.0 - pa.0).abs().max((pb.1 - pa.1).abs()).ceil() as usize).max(1);
+            for t in 0..=steps {
+                let f = t as f64 / steps as f64;
+                let x = (pa.0 + f * (pb.0 - pa.0)).round() as isize;
+                let y = (pa.1 + f * (pb.1 - pa.1)).round() as isize;
+                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1), (-1, 0), (0, -1)] {
+                    put(x + dx, y + dy, line.rgb, &mut img);
+                }
+            }
+        }
+    }
+    for m in markers {
+        let (x, y, _) = proj(&m.at);
+        let (px, py) = to_px(x, y);
+        let (px, py) = (px as isize, py as isize);
+        for dy in -6..=6isize {
+            for dx in -6..=6isize {
+                let edge = dx.abs() == 6 || dy.abs() == 6;
+                put(
+                    px + dx,
+                    py + dy,
+                    if edge { [0, 0, 0] } else { m.rgb },
+                    &mut img,
+                );
+            }
+        }
+        if !m.label.is_empty() {
+            let mut canvas = Canvas {
+                rgb: &mut img,
+                width: w,
+                height: h,
+            };
+            draw_text(
+                &mut canvas,
+                (px + 10).max(0) as usize,
+                (py - 16).max(0) as usize,
+                &m.label,
+                2,
+                [0, 0, 0],
+            );
         }
     }
     if let Colouring::Scalar { range, .. } = colouring {

@@ -9,7 +9,9 @@
 //!
 //! * [`bspline`]: knot vectors, basis functions and derivatives, curves and
 //!   tensor-product surfaces (rational weights carried), knot insertion/refinement.
-//! * [`base`]: base surfaces that give points their parameters (best-fit plane).
+//! * [`base`]: base surfaces that give points their parameters (best-fit plane,
+//!   bilinearly blended Coons patches from boundary curves).
+//! * [`pde`]: thin-plate PDE deformation surfaces on a Coons patch (PDE paper).
 //! * [`param`]: the seven curve parameterization methods of the curve paper and
 //!   knot placement.
 //! * [`fit`]: curve interpolation (open, with end tangents, closed/periodic) and
@@ -32,6 +34,7 @@ mod geom;
 pub mod mba;
 pub mod metrics;
 pub mod param;
+pub mod pde;
 pub mod project;
 pub mod quality;
 

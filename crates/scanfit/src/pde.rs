@@ -1,0 +1,514 @@
+//! PDE deformation surfaces on a Coons patch (PDE paper,
+//! `pde-coons-surface-reconstruction`, §4.5).
+//!
+//! The thin-plate equation `D (w_uuuu + 2 w_uuvv + w_vvvv) = q_w` (eq. 4,
+//! `w = x, y, z`) with the lateral force a sine series
+//! `q_w = sum_{m<=M, n<=N} q_wmn sin(m pi u) sin(n pi v)` (eq. 5) has the
+//! particular solution (eqs. 6-11)
+//!
+//! ```text
+//! w(u, v) = 1/(D pi^4) sum_{m=1}^{M} sum_{n=1}^{N} q_wmn / (m^2 + n^2)^2 sin(m pi u) sin(n pi v)
+//! ```
+//!
+//! (the paper writes `m^4 + 2 m^2 n^2 + n^4` = `(m^2 + n^2)^2`). It vanishes on
+//! the boundary of `[0, 1]^2`, so `S = S_c + S_PDE` (eq. 14) keeps the Coons
+//! patch's boundary curves and patches that share boundaries join without gaps.
+//! The `q_wmn` minimise `E_w = sum_i [wbar_i - w(u_i, v_i)]^2` (eq. 12) with
+//! `wbar_i` the offset of point `i` from `S_c(u_i, v_i)`; the normal equations
+//! are eq. 13. We solve them for `w_mn = q_wmn / (D pi^4 (m^2+n^2)^2)` (eq. 10)
+//! — a column scaling that leaves the minimiser unchanged and keeps the system
+//! as well conditioned as the sine basis itself — and report
+//! `q_wmn = D pi^4 (m^2+n^2)^2 w_mn`. As the paper notes (§5.3), `D` then only
+//! scales `q`: the surface does not depend on it.
+//!
+//! Errors are eq. 15: mean and maximum of `|P_i - S(u_i, v_i)|`.
+
+use std::f64::consts::PI;
+
+use faer::linalg::solvers::Solve;
+use faer::{Mat, Side};
+use rayon::prelude::*;
+
+use crate::base::coons::{missing_knots, refine_to};
+use crate::base::CoonsPatch;
+use crate::bspline::{KnotVector, Surface};
+use crate::fit::interpolate_with;
+use crate::metrics::ErrorStats;
+use crate::{Error, Point3, Result, Vector3};
+
+/// Settings of [`fit_pde`] (the paper's defaults).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PdeConfig {
+    /// Terms in `u`, `M` (paper: 5; 10 in Table 2 and §5.4).
+    pub m: usize,
+    /// Terms in `v`, `N` (paper: 5).
+    pub n: usize,
+    /// Flexural rigidity `D` (eq. 3; the paper sets 1). Must be positive; it
+    /// does not change the fitted surface.
+    pub d: f64,
+}
+
+impl Default for PdeConfig {
+    fn default() -> Self {
+        Self { m: 5, n: 5, d: 1.0 }
+    }
+}
+
+/// The deformation `S_PDE(u, v)` of eq. 11, one coefficient vector per term.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PdeDeformation {
+    m: usize,
+    n: usize,
+    d: f64,
+    /// `w_mn` (eq. 10) at `(m - 1) * n + (n - 1)`, for x, y, z at once.
+    w: Vec<Vector3>,
+}
+
+/// `sin(k pi t)`, exactly 0 at `t = 0` and `t = 1` (so the deformation is
+/// exactly zero on the boundary, not `1e-16`).
+fn sin_k_pi(k: usize, t: f64) -> f64 {
+    if t <= 0.0 || t >= 1.0 {
+        0.0
+    } else {
+        (k as f64 * PI * t).sin()
+    }
+}
+
+/// `D pi^4 (m^2 + n^2)^2`, the factor between `q_wmn` and `w_mn` (eq. 10).
+fn factor(d: f64, m: usize, n: usize) -> f64 {
+    let s = (m * m + n * n) as f64;
+    d * PI.powi(4) * s * s
+}
+
+impl PdeDeformation {
+    /// `(M, N)`.
+    pub fn terms(&self) -> (usize, usize) {
+        (self.m, self.n)
+    }
+
+    /// The flexural rigidity `D`.
+    pub fn rigidity(&self) -> f64 {
+        self.d
+    }
+
+    /// `w_mn = q_wmn / (D pi^4 (m^2 + n^2)^2)` (eq. 10), `1 <= m <= M`, `1 <= n <= N`.
+    pub fn w_coefficient(&self, m: usize, n: usize) -> Option<Vector3> {
+        (1..=self.m)
+            .contains(&m)
+            .then_some(())
+            .filter(|_| (1..=self.n).contains(&n))
+            .map(|_| self.w[(m - 1) * self.n + (n - 1)])
+    }
+
+    /// The lateral force coefficient `q_wmn` (eq. 5) of term `(m, n)`.
+    pub fn q_coefficient(&self, m: usize, n: usize) -> Option<Vector3> {
+        self.w_coefficient(m, n).map(|w| w * factor(self.d, m, n))
+    }
+
+    /// `S_PDE(u, v)` (eq. 11), zero on the boundary of `[0, 1]^2`.
+    pub fn displacement(&self, u: f64, v: f64) -> Vector3 {
+        let su: Vec<f64> = (1..=self.m).map(|m| sin_k_pi(m, u)).collect();
+        let sv: Vec<f64> = (1..=self.n).map(|n| sin_k_pi(n, v)).collect();
+        let mut out = Vector3::zeros();
+        for (a, &x) in su.iter().enumerate() {
+            for (b, &y) in sv.iter().enumerate() {
+                out += self.w[a * self.n + b] * (x * y);
+            }
+        }
+        out
+    }
+}
+
+/// `S(u, v) = S_c(u, v) + S_PDE(u, v)` (eq. 14).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PdeSurface {
+    /// The Coons patch `S_c`.
+    pub coons: CoonsPatch,
+    /// The deformation `S_PDE`.
+    pub deformation: PdeDeformation,
+}
+
+/// Settings of [`PdeSurface::to_bspline`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BsplineConversionConfig {
+    /// Largest allowed distance between `S` and its B-spline form, in data
+    /// units, checked on a grid twice as fine as the interpolation grid.
+    pub tolerance: f64,
+    /// Most knot spans per direction before giving up (default 512).
+    pub max_spans: usize,
+}
+
+impl BsplineConversionConfig {
+    /// A conversion to within `tolerance` data units.
+    pub fn new(tolerance: f64) -> Self {
+        Self {
+            tolerance,
+            max_spans: 512,
+        }
+    }
+}
+
+/// The B-spline form of a PDE surface.
+#[derive(Debug, Clone)]
+pub struct PdeBspline {
+    /// The surface: the exact Coons B-spline plus an interpolant of `S_PDE`.
+    pub surface: Surface,
+    /// Largest `|S_B - S|` on the check grid (data units).
+    pub max_deviation: f64,
+    /// Uniform interpolation spans per direction used for `S_PDE`.
+    pub spans: usize,
+}
+
+impl PdeSurface {
+    /// `S(u, v)` (eq. 14).
+    pub fn point(&self, u: f64, v: f64) -> Point3 {
+        self.coons.point(u, v) + self.deformation.displacement(u, v)
+    }
+
+    /// A B-spline surface within `cfg.tolerance` of `S`: the Coons patch is
+    /// converted exactly ([`CoonsPatch::to_bspline`]); `S_PDE` is interpolated
+    /// on a uniform `(k+1) x (k+1)` grid (tensor-product interpolation, NURBS
+    /// Book A9.4, degrees of the Coons B-spline, averaging knots), `k` doubling
+    /// from `max(8, 2 max(M, N))` until the deviation on the grid of midpoints
+    /// is within tolerance. The interpolant is exactly zero on the boundary,
+    /// so the boundary curves stay those of the Coons patch. Both parts are
+    /// refined to common knots and added.
+    pub fn to_bspline(&self, cfg: &BsplineConversionConfig) -> Result<PdeBspline> {
+        if !(cfg.tolerance.is_finite() && cfg.tolerance > 0.0) {
+            return Err(Error::InvalidInput(format!(
+                "B-spline conversion tolerance {} must be a positive number of data units",
+                cfg.tolerance
+            )));
+        }
+        let base = self.coons.to_bspline()?;
+        let (p, q) = base.degrees();
+        let (m, n) = self.deformation.terms();
+        let mut k = (2 * m.max(n)).max(8).max(p.max(q) + 1);
+        loop {
+            let w = self.interpolate_deformation(k, p, q)?;
+            // check on midpoints and the grid of quarter points between them
+            let check = 2 * k;
+            let dev = (0..check)
+                .into_par_iter()
+                .map(|i| {
+                    let u = (i as f64 + 0.5) / check as f64;
+                    (0..check)
+                        .map(|j| {
+                            let v = (j as f64 + 0.5) / check as f64;
+                            (w.point(u, v).coords - self.deformation.displacement(u, v)).norm()
+                        })
+                        .fold(0.0, f64::max)
+                })
+                .reduce(|| 0.0, f64::max);
+            if dev <= cfg.tolerance {
+                let (ku, kv) = (
+                    union(base.knots_u(), w.knots_u())?,
+                    union(base.knots_v(), w.knots_v())?,
+                );
+                let (a, b) = (refine_to(&base, &ku, &kv)?, refine_to(&w, &ku, &kv)?);
+                let ctrl = a
+                    .control_points()
+                    .iter()
+                    .zip(b.control_points())
+                    .map(|(x, y)| x + y.coords)
+                    .collect();
+                return Ok(PdeBspline {
+                    surface: Surface::new(ku, kv, ctrl)?,
+                    max_deviation: dev,
+                    spans: k,
+                });
+            }
+            if 2 * k > cfg.max_spans {
+                return Err(Error::InvalidInput(format!(
+                    "the B-spline form of the PDE surface deviates by {dev:e} with {k} x {k} spans, more than the tolerance {:e}; allow a larger tolerance or fewer PDE terms",
+                    cfg.tolerance
+                )));
+            }
+            k *= 2;
+        }
+    }
+
+    /// Tensor-product interpolant of `S_PDE` on the uniform `(k+1)^2` grid.
+    fn interpolate_deformation(&self, k: usize, p: usize, q: usize) -> Result<Surface> {
+        let t: Vec<f64> = (0..=k).map(|i| i as f64 / k as f64).collect();
+        let ku = crate::param::knots::averaging(&t, p)?;
+        let kv = crate::param::knots::averaging(&t, q)?;
+        // along u for every column v_j, then along v through the results
+        let cols: Vec<Vec<Point3>> = t
+            .par_iter()
+            .map(|&v| {
+                let pts: Vec<Point3> = t
+                    .iter()
+                    .map(|&u| Point3::from(self.deformation.displacement(u, v)))
+                    .collect();
+                interpolate_with(&pts, &t, ku.clone(), None)
+                    .map(|(c, _)| c.control_points().to_vec())
+            })
+            .collect::<Result<_>>()?;
+        let rows: Vec<Vec<Point3>> = (0..=k)
+            .into_par_iter()
+            .map(|i| {
+                let pts: Vec<Point3> = cols.iter().map(|c| c[i]).collect();
+                interpolate_with(&pts, &t, kv.clone(), None)
+                    .map(|(c, _)| c.control_points().to_vec())
+            })
+            .collect::<Result<_>>()?;
+        Surface::new(ku, kv, rows.concat())
+    }
+}
+
+/// The union of two clamped knot vectors of one degree on `[0, 1]`.
+fn union(a: &KnotVector, b: &KnotVector) -> Result<KnotVector> {
+    let mut k = a.as_slice().to_vec();
+    k.extend(missing_knots(a, b));
+    k.sort_by(f64::total_cmp);
+    KnotVector::new(k, a.degree())
+}
+
+/// A fitted PDE surface with its errors.
+#[derive(Debug, Clone)]
+pub struct PdeFit {
+    /// `S = S_c + S_PDE`.
+    pub surface: PdeSurface,
+    /// Eq. 15 errors of the Coons patch alone, `|P_i - S_c(u_i, v_i)|`.
+    pub coons_errors: ErrorStats,
+    /// Eq. 15 errors of `S`, `|P_i - S(u_i, v_i)|`.
+    pub errors: ErrorStats,
+    /// `|P_i - S(u_i, v_i)|` per point.
+    pub residuals: Vec<f64>,
+}
+
+/// Points per block of the normal-equation assembly.
+const BLOCK: usize = 1024;
+
+/// Fits the deformation of `coons` to `points` with parameters `uv` (eqs.
+/// 12-13, see the module docs) and returns `S` with its eq. 15 errors.
+///
+/// Errors: fewer points than `M x N`; `M` or `N` zero; `D` not positive;
+/// parameters outside `[0, 1]^2`; a singular system (the points do not
+/// determine `M x N` terms: lower `M`, `N`).
+pub fn fit_pde(
+    coons: &CoonsPatch,
+    points: &[Point3],
+    uv: &[[f64; 2]],
+    cfg: &PdeConfig,
+) -> Result<PdeFit> {
+    let (mm, nn) = (cfg.m, cfg.n);
+    if mm == 0 || nn == 0 {
+        return Err(Error::InvalidInput(format!(
+            "PDE terms M x N = {mm} x {nn}; both must be at least 1 (paper: 5 x 5)"
+        )));
+    }
+    if !(cfg.d.is_finite() && cfg.d > 0.0) {
+        return Err(Error::InvalidInput(format!(
+            "flexural rigidity D = {} must be positive (paper: 1)",
+            cfg.d
+        )));
+    }
+    crate::validate_points(points)?;
+    if uv.len() != points.len() {
+        return Err(Error::InvalidInput(format!(
+            "{} parameter pairs for {} points",
+            uv.len(),
+            points.len()
+        )));
+    }
+    if let Some(i) = uv
+        .iter()
+        .position(|t| !t.iter().all(|x| (0.0..=1.0).contains(x)))
+    {
+        return Err(Error::InvalidInput(format!(
+            "point {i} has parameters ({}, {}) outside [0, 1]^2",
+            uv[i][0], uv[i][1]
+        )));
+    }
+    let kk = mm * nn;
+    if points.len() < kk {
+        return Err(Error::TooFewPoints {
+            got: points.len(),
+            needed: kk,
+            what: format!("a PDE deformation with M x N = {mm} x {nn} terms (lower M, N)"),
+        });
+    }
+    // offsets wbar_i = P_i - S_c(u_i, v_i) (eq. 12)
+    let base: Vec<Point3> = uv.par_iter().map(|t| coons.point(t[0], t[1])).collect();
+    // normal equations (eq. 13) for w_mn, assembled block by block (blocks in
+    // parallel, summed in order: the result does not depend on the threads)
+    let blocks: Vec<(Mat<f64>, Mat<f64>)> = (0..points.len().div_ceil(BLOCK))
+        .into_par_iter()
+        .map(|b| {
+            let r = b * BLOCK..((b + 1) * BLOCK).min(points.len());
+            let rows = r.len();
+            let mut a = Mat::<f64>::zeros(rows, kk);
+            let mut rhs = Mat::<f64>::zeros(rows, 3);
+            for (row, i) in r.enumerate() {
+                let [u, v] = uv[i];
+                let sv: Vec<f64> = (1..=nn).map(|n| sin_k_pi(n, v)).collect();
+                for m in 1..=mm {
+                    let su = sin_k_pi(m, u);
+                    for (n0, &s) in sv.iter().enumerate() {
+                        a[(row, (m - 1) * nn + n0)] = su * s;
+                    }
+                }
+                let off = points[i] - base[i];
+                for c in 0..3 {
+                    rhs[(row, c)] = off[c];
+                }
+            }
+            let at = a.as_ref().transpose();
+            (at * a.as_ref(), at * rhs.as_ref())
+        })
+        .collect();
+    let mut g = Mat::<f64>::zeros(kk, kk);
+    let mut rhs = Mat::<f64>::zeros(kk, 3);
+    for (bg, br) in &blocks {
+        g += bg;
+        rhs += br;
+    }
+    let llt = g.llt(Side::Lower).map_err(|_| Error::Singular {
+        what: format!("PDE deformation least squares (eq. 13, {mm} x {nn} terms)"),
+        condition: f64::INFINITY,
+        hint: format!(
+            "the {} points' parameters do not determine {mm} x {nn} sine terms; lower M and N",
+            points.len()
+        ),
+    })?;
+    // cond(G) >= (max L_ii / min L_ii)^2: a cheap lower bound that catches
+    // the rank deficiency Cholesky lets through as tiny positive pivots
+    let diag: Vec<f64> = (0..kk).map(|k| llt.L()[(k, k)].abs()).collect();
+    let (lo, hi) = diag
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(a, b), &x| (a.min(x), b.max(x)));
+    let condition = (hi / lo).powi(2);
+    if condition.is_nan() || condition > crate::fit::CONDITION_LIMIT {
+        return Err(Error::Singular {
+            what: format!("PDE deformation least squares (eq. 13, {mm} x {nn} terms)"),
+            condition,
+            hint: format!(
+                "the {} points' parameters do not determine {mm} x {nn} sine terms; lower M and N",
+                points.len()
+            ),
+        });
+    }
+    let sol = llt.solve(&rhs);
+    let w: Vec<Vector3> = (0..kk)
+        .map(|k| Vector3::new(sol[(k, 0)], sol[(k, 1)], sol[(k, 2)]))
+        .collect();
+    if let Some(k) = w.iter().position(|x| !x.iter().all(|c| c.is_finite())) {
+        return Err(Error::Singular {
+            what: format!("PDE deformation least squares (eq. 13, {mm} x {nn} terms)"),
+            condition: f64::INFINITY,
+            hint: format!(
+                "coefficient of term ({}, {}) is not finite; lower M and N",
+                k / nn + 1,
+                k % nn + 1
+            ),
+        });
+    }
+    let surface = PdeSurface {
+        coons: coons.clone(),
+        deformation: PdeDeformation {
+            m: mm,
+            n: nn,
+            d: cfg.d,
+            w,
+        },
+    };
+    let coons_d: Vec<f64> = points
+        .par_iter()
+        .zip(&base)
+        .map(|(p, b)| (p - b).norm())
+        .collect();
+    let residuals: Vec<f64> = points
+        .par_iter()
+        .zip(uv)
+        .zip(&base)
+        .map(|((p, t), b)| (p - (b + surface.deformation.displacement(t[0], t[1]))).norm())
+        .collect();
+    Ok(PdeFit {
+        surface,
+        coons_errors: ErrorStats::of(&coons_d),
+        errors: ErrorStats::of(&residuals),
+        residuals,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bspline::Curve;
+
+    fn flat_square() -> CoonsPatch {
+        let c = |a: [f64; 2], b: [f64; 2]| {
+            let ctrl = (0..4)
+                .map(|k| {
+                    let t = k as f64 / 3.0;
+                    Point3::new(a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), 0.0)
+                })
+                .collect();
+            Curve::new(KnotVector::uniform_clamped(3, 4).unwrap(), ctrl).unwrap()
+        };
+        CoonsPatch::from_loop(&[
+            c([0., 0.], [1., 0.]),
+            c([1., 0.], [1., 1.]),
+            c([1., 1.], [0., 1.]),
+            c([0., 1.], [0., 0.]),
+        ])
+        .unwrap()
+    }
+
+    #[test]
+    fn recovers_a_sine_bump_and_converts_to_bspline() {
+        let coons = flat_square();
+        let f = |u: f64, v: f64| {
+            0.3 * (PI * u).sin() * (PI * v).sin()
+                - 0.05 * (2.0 * PI * u).sin() * (3.0 * PI * v).sin()
+        };
+        let mut pts = Vec::new();
+        let mut uv = Vec::new();
+        for i in 0..=20 {
+            for j in 0..=20 {
+                let (u, v) = (i as f64 / 20.0, j as f64 / 20.0);
+                pts.push(Point3::new(u, v, f(u, v)));
+                uv.push([u, v]);
+            }
+        }
+        let fit = fit_pde(&coons, &pts, &uv, &PdeConfig::default()).unwrap();
+        assert!(fit.errors.max < 1e-13, "{:?}", fit.errors);
+        assert!((fit.coons_errors.max - 0.3).abs() < 0.05);
+        let d = &fit.surface.deformation;
+        // w_11 = 0.3, w_23 = -0.05 (eq. 10), q = D pi^4 (m^2+n^2)^2 w
+        assert!((d.w_coefficient(1, 1).unwrap().z - 0.3).abs() < 1e-13);
+        assert!((d.w_coefficient(2, 3).unwrap().z + 0.05).abs() < 1e-13);
+        assert!((d.q_coefficient(1, 1).unwrap().z - 0.3 * 4.0 * PI.powi(4)).abs() < 1e-10);
+        assert!(d.w_coefficient(6, 1).is_none());
+        let b = fit
+            .surface
+            .to_bspline(&BsplineConversionConfig::new(1e-5))
+            .unwrap();
+        assert!(b.max_deviation <= 1e-5);
+        for (u, v) in [(0.5, 0.5), (0.13, 0.77), (0.91, 0.31)] {
+            assert!((b.surface.point(u, v) - fit.surface.point(u, v)).norm() < 1.2e-5);
+        }
+        // the boundary is the Coons patch's, exactly
+        for k in 0..=10 {
+            let t = k as f64 / 10.0;
+            assert!(b.surface.point(t, 0.0).z.abs() < 1e-15);
+            assert!(b.surface.point(1.0, t).z.abs() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn refuses_bad_input() {
+        let coons = flat_square();
+        let pts = vec![Point3::new(0.5, 0.5, 0.1); 10];
+        let uv = vec![[0.5, 0.5]; 10];
+        let e = fit_pde(&coons, &pts, &uv, &PdeConfig::default()).unwrap_err();
+        assert!(e.to_string().contains("lower M, N"), "{e}");
+        let cfg = PdeConfig { m: 2, n: 2, d: 1.0 };
+        let e = fit_pde(&coons, &pts, &uv, &cfg).unwrap_err();
+        assert!(e.to_string().contains("lower M and N"), "{e}");
+        let e = fit_pde(&coons, &pts, &uv, &PdeConfig { d: 0.0, ..cfg }).unwrap_err();
+        assert!(e.to_string().contains("D = 0"), "{e}");
+    }
+}
