@@ -22,7 +22,7 @@ use clap::{Parser, Subcommand};
 #[derive(Parser, Debug)]
 #[command(name = "scanfit", version, about, long_about = None)]
 #[command(
-    after_help = "Examples:\n  scanfit curve compare examples/data/dataset5.csv\n  scanfit curve fit examples/data/dataset6.csv --ctrl 20 -o curve.json\n  scanfit cloud info examples/data/terrain_50k.xyz"
+    after_help = "Examples:\n  scanfit curve compare examples/data/dataset5.csv\n  scanfit curve fit examples/data/dataset6.csv --ctrl 20 -o curve.json\n  scanfit cloud boundary examples/data/patch_20k.ply --png boundary.png\n  scanfit mba examples/data/terrain_50k.xyz --levels 6 --adjust -o terrain.json\n  scanfit coons examples/data/patch_20k.ply --pde 5x5 --png patch.png"
 )]
 struct Cli {
     #[command(subcommand)]

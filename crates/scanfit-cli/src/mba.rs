@@ -171,7 +171,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
                 adjusted_vertical_rmse: Some(l.adjusted_vertical.rmse),
                 adjusted_grid_rmse: Some(l.adjusted_rmse),
                 adjust_steps: Some(l.steps),
-                seconds: rep.seconds,
+                seconds: l.seconds,
             })
             .collect();
         (AdjustedOrPlain::Adjusted(r), rows)

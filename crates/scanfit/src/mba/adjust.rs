@@ -199,6 +199,8 @@ pub struct AdjustedLevel {
     pub mba_vertical: ErrorStats,
     /// Vertical residuals at the data points after the adjustment.
     pub adjusted_vertical: ErrorStats,
+    /// Wall time of the level (approximation and adjustment) in seconds.
+    pub seconds: f64,
 }
 
 /// The multilevel approximation with the projection adjustment at each
@@ -240,6 +242,7 @@ pub fn mba_adjusted(
     let mut levels = Vec::new();
     let mut steps = Vec::new();
     for _ in 0..config.max_levels.max(1) {
+        let t0 = std::time::Instant::now();
         run.level(&unit, &mut residual)?;
         let frame = run.frame();
         let Some(total) = run.total_mut() else {
@@ -263,6 +266,7 @@ pub fn mba_adjusted(
             adjusted_vertical: ErrorStats::of(
                 &residual.iter().map(|r| r.abs()).collect::<Vec<_>>(),
             ),
+            seconds: t0.elapsed().as_secs_f64(),
         });
         steps.extend(s);
         if config.tolerance.is_some_and(|t| adjusted_rmse <= t) {
