@@ -4,3 +4,4 @@
 mod plane;
 
 pub use plane::{plane_parameters, PlaneParameterization};
+pub mod turntable;
