@@ -42,7 +42,12 @@ pub struct ViewConfig {
     /// Multilevel B-splines on each view (default: 6 levels from the
     /// aspect-ratio base lattice, eq. 4 of Lee, Wolberg & Shin 1997).
     pub mba: MbaConfig,
-    /// Grid points per layer and view (`u` count; default 64).
+    /// Grid points per layer and view (`u` count; default 32). The base
+    /// surface gets about `0.7 V` times as many samples around the axis;
+    /// when their spacing falls below the cloud's, interpolating the
+    /// projected (noisy) samples makes a wavy base surface whose orthogonal
+    /// projection folds (on the blob sample: 0 fold-overs inside the layers
+    /// with 32, 10 with 40, 377 with 128).
     pub grid_u: usize,
 }
 
@@ -53,7 +58,7 @@ impl Default for ViewConfig {
             view_distance: 4.0,
             hpr: HprConfig::default(),
             mba: MbaConfig::default(),
-            grid_u: 64,
+            grid_u: 32,
         }
     }
 }
