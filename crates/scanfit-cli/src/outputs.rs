@@ -107,6 +107,21 @@ impl SurfaceOutputArgs {
         deviation: &Deviation,
         input: &Path,
     ) -> Result<(Files, f64)> {
+        self.files_with(surface, doc, points, deviation, input, false)
+    }
+
+    /// As [`files`](Self::files); with `png_by_deviation` the `--png`
+    /// picture colours the surface by the local fit error instead of height
+    /// (the input points still drawn), as `scanfit turntable` shows it.
+    pub fn files_with(
+        &self,
+        surface: &Surface,
+        doc: &SurfaceDoc,
+        points: &[Point3],
+        deviation: &Deviation,
+        input: &Path,
+        png_by_deviation: bool,
+    ) -> Result<(Files, f64)> {
         let mut files: Files = Vec::new();
         if let Some(o) = &self.output {
             files.push((o.clone(), doc.to_json().into_bytes()));
@@ -125,6 +140,7 @@ impl SurfaceOutputArgs {
         // the local fit error on the surface: each mesh vertex shows the
         // deviation of its nearest input point, on the scale of the error table
         let vertex_dev = if self.deviation_png.is_some()
+            || (png_by_deviation && self.png.is_some())
             || self.mesh.as_deref().is_some_and(|m| extension(m) != "obj")
         {
             let near = nearest_points(points, &mesh.vertices)?;
@@ -199,9 +215,31 @@ impl SurfaceOutputArgs {
             // at most 5,000 points drawn, evenly picked; flat data (terrain) exaggerated
             let step = (points.len() / 5_000).max(1);
             let shown: Vec<_> = points.iter().step_by(step).copied().collect();
-            let opts = self.view.options(points)?;
+            let mut opts = self.view.options(points)?;
             exaggeration = opts.z_scale;
-            let bytes = render_png(&mesh, Some(&shown), Colouring::Height, &opts)?;
+            let colouring = match (&vertex_dev, png_by_deviation) {
+                (Some(d), true) => {
+                    opts.legend = vec![
+                        format!(
+                            "{}: points and surface coloured by the {} of the nearest point",
+                            input.display(),
+                            deviation.name
+                        ),
+                        format!(
+                            "mean {}  max {}  RMSE {}  [data units]",
+                            num(deviation.stats.mean),
+                            num(deviation.stats.max),
+                            num(deviation.stats.rmse)
+                        ),
+                    ];
+                    Colouring::Scalar {
+                        values: d,
+                        range: (0.0, dmax),
+                    }
+                }
+                _ => Colouring::Height,
+            };
+            let bytes = render_png(&mesh, Some(&shown), colouring, &opts)?;
             files.push((png.clone(), bytes));
         }
         Ok((files, exaggeration))

@@ -86,7 +86,11 @@ impl CylinderFrame {
             points
                 .iter()
                 .map(flat)
-                .max_by(|a, b| (a - from).norm_squared().total_cmp(&(b - from).norm_squared()))
+                .max_by(|a, b| {
+                    (a - from)
+                        .norm_squared()
+                        .total_cmp(&(b - from).norm_squared())
+                })
                 .unwrap_or(from)
         };
         let y = farthest(flat(&points[0]));
@@ -144,7 +148,8 @@ impl CylinderFrame {
 
 /// The principal axis of `points` (largest covariance eigenvalue).
 pub fn principal_axis(points: &[Point3]) -> Result<Vector3> {
-    let pc = pca(points).ok_or_else(|| Error::InvalidInput("no points to find an axis of".into()))?;
+    let pc =
+        pca(points).ok_or_else(|| Error::InvalidInput("no points to find an axis of".into()))?;
     if !(pc.values[0] > 0.0) {
         return Err(Error::InvalidInput(
             "the points have no spread: no principal axis; give the axis".into(),
@@ -168,7 +173,10 @@ mod tests {
         let f = CylinderFrame::of(&pts, AxisChoice::Given(Vector3::y())).unwrap();
         assert_eq!(f.e1, Vector3::x());
         assert_eq!(f.e2, Vector3::z());
-        assert!((f.centre - Point3::new(3.0, 2.0, -1.0)).norm() < 0.01, "{f:?}");
+        assert!(
+            (f.centre - Point3::new(3.0, 2.0, -1.0)).norm() < 0.01,
+            "{f:?}"
+        );
         // Ritter's pair is the farthest pair only approximately
         assert!((f.radius - 2.0).abs() < 0.01);
         assert_eq!(f.height, (-2.0, 2.0));
@@ -203,7 +211,12 @@ mod tests {
 
     #[test]
     fn zero_axis_is_an_error() {
-        let pts = vec![Point3::origin(), Point3::new(1.0, 0.0, 0.0), Point3::new(0.0, 1.0, 0.0), Point3::new(0.0, 0.0, 1.0)];
+        let pts = vec![
+            Point3::origin(),
+            Point3::new(1.0, 0.0, 0.0),
+            Point3::new(0.0, 1.0, 0.0),
+            Point3::new(0.0, 0.0, 1.0),
+        ];
         let e = CylinderFrame::of(&pts, AxisChoice::Given(Vector3::zeros())).unwrap_err();
         assert!(e.to_string().contains("non-zero"));
     }

@@ -306,7 +306,10 @@ pub fn compare_weights(
         .map(|&w| {
             let mut c = *cfg;
             c.projection.weight = w;
-            Ok((w, project_layers(cloud, frame, loops, &c, Rounds::Exactly(rounds))?.rmse))
+            Ok((
+                w,
+                project_layers(cloud, frame, loops, &c, Rounds::Exactly(rounds))?.rmse,
+            ))
         })
         .collect()
 }

@@ -51,6 +51,27 @@ pub struct TurntableConfig {
     pub fit: SurfaceFitConfig,
     /// Orthogonal projection onto the base and fitted surfaces.
     pub inversion: InversionConfig,
+    /// What happens to the points beyond the end layers (default: left out of the fit).
+    pub ends: Ends,
+}
+
+/// The points beyond the first and last layer (the ends of the cloud: the
+/// rims of a tube, the closed top of a head). Their orthogonal projection
+/// lands on the base surface's `v` boundary; the paper does not say what to
+/// do with them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Ends {
+    /// Keep their boundary parameters (`v` = 0 or 1) but leave them out of
+    /// the least-squares fit (default): the surface spans the layers' range
+    /// and is faithful there; the ends stay open.
+    #[default]
+    Exclude,
+    /// Continue `v` beyond the boundary by the distance to the boundary
+    /// projection and fit every point. The surface then reaches over the
+    /// ends, but around a closed end (a pole) the rows beyond the data are
+    /// barely constrained: on the blob sample the fitted surface flares up to
+    /// 90 units away from the cloud, although every point is within 0.3 of it.
+    Extend,
 }
 
 impl Default for TurntableConfig {
@@ -66,6 +87,7 @@ impl Default for TurntableConfig {
                 ..Default::default()
             },
             inversion: InversionConfig::default(),
+            ends: Ends::Exclude,
         }
     }
 }
@@ -105,20 +127,32 @@ pub struct Turntable {
     /// Distances of the cloud points to the base surface.
     pub base_errors: ErrorStats,
     /// Parameters of every cloud point in `[0, 1]^2` (`u` periodic around
-    /// the axis; `v` of the base surface, continued beyond the end layers by
-    /// the height and rescaled).
+    /// the axis; `v` of the base surface, 0 or 1 beyond the end layers, or
+    /// continued there with [`Ends::Extend`]).
     pub uv: Vec<[f64; 2]>,
     /// Points whose projection lies on the `v` boundary of the base surface
-    /// (beyond the first or last layer: the ends of the cloud); their `v`
-    /// continues linearly with the height along the axis.
+    /// (beyond the first or last layer: the ends of the cloud).
     pub on_v_boundary: usize,
+    /// Per point: whether it entered the least-squares fit (all points with
+    /// [`Ends::Extend`], those inside the layers' range with [`Ends::Exclude`]).
+    pub fitted: Vec<bool>,
     /// The least-squares surface.
     pub surface: Surface,
     /// Orthogonal distance of every cloud point to the fitted surface.
     pub distances: Vec<f64>,
-    /// Their statistics.
+    /// Their statistics over the fitted points (with [`Ends::Exclude`], the
+    /// points inside the layers' range).
     pub errors: ErrorStats,
-    /// Fold-overs and stretch of the parameterization on the fitted surface.
+    /// Their statistics over every point (with [`Ends::Exclude`] the points
+    /// beyond the end layers, which no surface row covers, count too).
+    pub errors_all: ErrorStats,
+    /// Distance from the fitted surface to the cloud: from each sample of a
+    /// `4 n_u x 4 n_v` parameter grid to its nearest cloud point. The point
+    /// errors above cannot see a surface that wanders off where there are no
+    /// points; this can.
+    pub surface_to_cloud: ErrorStats,
+    /// Fold-overs and stretch of the parameterization of the fitted points
+    /// on the fitted surface.
     pub quality: ParamQuality,
     /// The same over the points inside the layers' range (whose projection
     /// onto the base surface is interior). A closed end (the top of a head,
@@ -141,7 +175,14 @@ pub fn turntable(
     let views = turntable_views(points, &frame, &cfg.views)?;
     stage(2);
     let heights = layer_heights(&frame, &cfg.layers)?;
-    let loops = layer_loops(cloud, &frame, &views, &heights, cfg.views.grid_u, &cfg.layers)?;
+    let loops = layer_loops(
+        cloud,
+        &frame,
+        &views,
+        &heights,
+        cfg.views.grid_u,
+        &cfg.layers,
+    )?;
     let layers = project_layers(cloud, &frame, &loops, &cfg.layers, Rounds::UntilThreshold)?;
     stage(3);
     let (mut fit, grid_u) = initial_base_surface(&layers.curves, &layers.counts, &frame)?;
@@ -159,56 +200,74 @@ pub fn turntable(
     let inv = inverter.invert_all(points);
     let base_errors = ErrorStats::of(&inv.iter().map(|r| r.distance).collect::<Vec<_>>());
     let ((u0, u1), (v0, v1)) = base.domain();
-    // Points beyond the first or last layer (the ends of the cloud) project
-    // onto the base surface's v boundary and would all share one v. The paper
-    // leaves them unspecified; we continue v beyond the boundary by the
-    // point's distance from its boundary projection, in units of the base
-    // surface's length along v, and rescale to [0, 1], so the fitted surface
-    // covers the ends too. (Distance rather than height: towards a closed
-    // end the height changes ever more slowly, which would crowd the points
-    // near the pole into a sliver of v that a polynomial cannot follow.)
-    let length_v = length_along_v(&base);
     let eps = 1e-9;
     let mut inside = vec![true; points.len()];
-    let raw: Vec<[f64; 2]> = inv
+    let mut raw: Vec<[f64; 2]> = inv
         .iter()
         .zip(inside.iter_mut())
         .map(|(r, inside)| {
-            let mut v = (r.uv[1] - v0) / (v1 - v0);
-            if v <= eps {
-                *inside = false;
-                v -= r.distance / length_v;
-            } else if v >= 1.0 - eps {
-                *inside = false;
-                v += r.distance / length_v;
-            }
-            [((r.uv[0] - u0) / (u1 - u0)).rem_euclid(1.0), v]
+            let v = (r.uv[1] - v0) / (v1 - v0);
+            *inside = (eps..=1.0 - eps).contains(&v);
+            [
+                ((r.uv[0] - u0) / (u1 - u0)).rem_euclid(1.0),
+                v.clamp(0.0, 1.0),
+            ]
         })
         .collect();
-    let vmin = raw.iter().map(|t| t[1]).fold(0.0, f64::min);
-    let vmax = raw.iter().map(|t| t[1]).fold(1.0, f64::max);
-    let uv: Vec<[f64; 2]> = raw
-        .iter()
-        .map(|t| [t[0], ((t[1] - vmin) / (vmax - vmin)).clamp(0.0, 1.0)])
-        .collect();
+    let on_v_boundary = inside.iter().filter(|&&i| !i).count();
+    if cfg.ends == Ends::Extend {
+        // continue v beyond the boundary by the point's distance from its
+        // boundary projection, in units of the base surface's length along
+        // v, then rescale to [0, 1]. (Distance rather than height: towards a
+        // closed end the height changes ever more slowly.)
+        let length_v = length_along_v(&base);
+        for ((t, r), &ins) in raw.iter_mut().zip(&inv).zip(&inside) {
+            if !ins {
+                t[1] += if t[1] < 0.5 { -1.0 } else { 1.0 } * r.distance / length_v;
+            }
+        }
+        let vmin = raw.iter().map(|t| t[1]).fold(0.0, f64::min);
+        let vmax = raw.iter().map(|t| t[1]).fold(1.0, f64::max);
+        for t in &mut raw {
+            t[1] = ((t[1] - vmin) / (vmax - vmin)).clamp(0.0, 1.0);
+        }
+    }
+    let uv = raw;
     stage(6);
-    let surface = fit_surface(points, &uv, &cfg.fit)?;
+    let fitted_points: Vec<bool> = match cfg.ends {
+        Ends::Exclude => inside.clone(),
+        Ends::Extend => vec![true; points.len()],
+    };
+    let subset = |mask: &[bool]| -> (Vec<Point3>, Vec<[f64; 2]>) {
+        points
+            .iter()
+            .zip(&uv)
+            .zip(mask)
+            .filter(|(_, &m)| m)
+            .map(|((p, t), _)| (*p, *t))
+            .unzip()
+    };
+    let (fp, fuv) = subset(&fitted_points);
+    let surface = fit_surface(&fp, &fuv, &cfg.fit)?;
     let fitted = SurfaceInverter::new(&surface, cfg.inversion)?;
     let distances: Vec<f64> = fitted
         .invert_all_from(points, &uv)
         .iter()
         .map(|r| r.distance)
         .collect();
-    let errors = ErrorStats::of(&distances);
-    let quality = parameterization_quality(&surface, points, &uv)?;
-    let on_v_boundary = inside.iter().filter(|&&i| !i).count();
-    let (pin, uvin): (Vec<Point3>, Vec<[f64; 2]>) = points
-        .iter()
-        .zip(&uv)
-        .zip(&inside)
-        .filter(|(_, &i)| i)
-        .map(|((p, t), _)| (*p, *t))
-        .unzip();
+    let pick = |mask: &[bool]| -> Vec<f64> {
+        distances
+            .iter()
+            .zip(mask)
+            .filter(|(_, &m)| m)
+            .map(|(d, _)| *d)
+            .collect()
+    };
+    let errors = ErrorStats::of(&pick(&fitted_points));
+    let errors_all = ErrorStats::of(&distances);
+    let surface_to_cloud = surface_to_cloud(cloud, &surface)?;
+    let quality = parameterization_quality(&surface, &fp, &fuv)?;
+    let (pin, uvin) = subset(&inside);
     let quality_inside = parameterization_quality(&surface, &pin, &uvin)?;
     Ok(Turntable {
         frame,
@@ -223,11 +282,14 @@ pub fn turntable(
         base_errors,
         uv,
         on_v_boundary,
+        fitted: fitted_points,
         surface,
         distances,
         errors,
+        errors_all,
         quality,
         quality_inside,
+        surface_to_cloud,
     })
 }
 
@@ -245,4 +307,27 @@ fn length_along_v(s: &Surface) -> f64 {
         }
     }
     (total / 8.0).max(f64::MIN_POSITIVE)
+}
+
+/// Nearest-cloud distances of a `4 n_u x 4 n_v` grid of surface samples.
+fn surface_to_cloud(cloud: &PointCloud, s: &Surface) -> Result<ErrorStats> {
+    let (cu, cv) = s.counts();
+    let (nu, nv) = (4 * cu, 4 * cv);
+    let ((u0, u1), (v0, v1)) = s.domain();
+    let grid: Vec<Point3> = (0..nu)
+        .flat_map(|i| {
+            (0..=nv).map(move |j| {
+                s.point(
+                    u0 + (u1 - u0) * i as f64 / nu as f64,
+                    v0 + (v1 - v0) * j as f64 / nv as f64,
+                )
+            })
+        })
+        .collect();
+    let d: Vec<f64> = cloud
+        .nearest_batch(&grid)?
+        .into_iter()
+        .map(|n| n.distance)
+        .collect();
+    Ok(ErrorStats::of(&d))
 }
