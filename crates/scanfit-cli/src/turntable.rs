@@ -287,6 +287,7 @@ pub fn run(a: TurntableArgs) -> Result<()> {
             "control_points": [cu, cv],
             "quality": doc.quality,
             "fold_overs_inside_layers": t.quality_inside.fold_overs,
+            "fold_overs_corrected": t.quality_fitted.fold_overs,
             "weight_comparison": comparison.as_ref().map(|c| c.iter().map(|(w, r)| serde_json::json!({"weight": w.name(), "rmse": r})).collect::<Vec<_>>()),
             "seconds": seconds,
             "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
@@ -400,6 +401,10 @@ pub fn run(a: TurntableArgs) -> Result<()> {
         t.quality_inside.fold_overs,
         t.quality_inside.triangles,
         num(t.quality.l2_stretch)
+    );
+    println!(
+        "fold-overs after projecting the points onto the fitted surface (parameter correction): {} of {}",
+        t.quality_fitted.fold_overs, t.quality_fitted.triangles
     );
     if let Some(cmp) = &comparison {
         println!("\nRMSE of the layer samples' nearest-point distances by projection round:");

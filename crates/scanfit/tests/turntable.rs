@@ -113,6 +113,7 @@ fn tube_along_a_tilted_axis() {
     assert!(t.frame.axis.dot(&axis.normalize()).abs() > 0.999);
     assert_closes(&t);
     assert_eq!(t.quality.fold_overs, 0);
+    assert_eq!(t.quality_fitted.fold_overs, 0);
     assert_eq!(t.quality_inside.fold_overs, 0);
     // exact data: the 40 x 40 fit is within 1e-4 of the tube (measured RMSE 7.8e-6, max 5.0e-5)
     assert!(t.errors.rmse < 1e-4, "{:?}", t.errors);
@@ -135,6 +136,7 @@ fn ellipsoid_around_y() {
     let (_, t) = run(ellipsoid(15_000), &cfg);
     assert_closes(&t);
     assert_eq!(t.quality.fold_overs, 0);
+    assert_eq!(t.quality_fitted.fold_overs, 0);
     // exact data (measured RMSE 1.0e-4, max 1.1e-3)
     assert!(t.errors.rmse < 5e-4, "{:?}", t.errors);
     assert!(t.errors.max < 5e-3, "{:?}", t.errors);
@@ -157,6 +159,7 @@ fn ellipsoid_with_the_ends_fitted_too() {
     // no fold inside the layers; the poles are the singular rows (measured 3 folds there)
     assert_eq!(t.quality_inside.fold_overs, 0);
     assert!(t.quality.fold_overs <= 10, "{:?}", t.quality);
+    assert!(t.quality_fitted.fold_overs <= 10, "{:?}", t.quality_fitted);
     assert!(t.surface_to_cloud.max < 1.2, "{:?}", t.surface_to_cloud);
 }
 
@@ -166,6 +169,7 @@ fn blob_sample() {
     assert!(t.frame.axis.y.abs() > 0.99);
     assert_closes(&t);
     assert_eq!(t.quality.fold_overs, 0);
+    assert_eq!(t.quality_fitted.fold_overs, 0);
     // the blob carries Gaussian noise of 0.05: the fit reaches it (measured 0.0486, max 0.21)
     assert!(t.errors.rmse < 0.06, "{:?}", t.errors);
     assert!(t.errors.max < 0.4, "{:?}", t.errors);

@@ -150,7 +150,7 @@ impl CylinderFrame {
 pub fn principal_axis(points: &[Point3]) -> Result<Vector3> {
     let pc =
         pca(points).ok_or_else(|| Error::InvalidInput("no points to find an axis of".into()))?;
-    if !(pc.values[0] > 0.0) {
+    if pc.values[0].is_nan() || pc.values[0] <= 0.0 {
         return Err(Error::InvalidInput(
             "the points have no spread: no principal axis; give the axis".into(),
         ));
