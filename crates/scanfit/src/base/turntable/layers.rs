@@ -313,3 +313,98 @@ pub fn compare_weights(
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::axis::AxisChoice;
+    use super::*;
+    use std::f64::consts::PI;
+
+    /// A cylinder of radius 1 around y, heights in [-2, 2], on a lattice.
+    fn cylinder() -> PointCloud {
+        let mut pts = Vec::new();
+        for j in 0..41 {
+            for i in 0..120 {
+                let t = 2.0 * PI * (i as f64 + 0.5 * (j % 2) as f64) / 120.0;
+                pts.push(Point3::new(t.sin(), -2.0 + 0.1 * j as f64, t.cos()));
+            }
+        }
+        PointCloud::new(pts).unwrap()
+    }
+
+    fn ring(r: f64, h: f64, n: usize) -> Vec<Point3> {
+        (0..n)
+            .map(|i| {
+                let t = 2.0 * PI * i as f64 / n as f64;
+                Point3::new(r * t.sin(), h, r * t.cos())
+            })
+            .collect()
+    }
+
+    #[test]
+    fn closed_curve_samples_and_in_plane_normals() {
+        let c = closed_curve(&ring(2.0, 0.5, 24)).unwrap();
+        let (p, n) = uniform_samples(&c, 48, &Vector3::y());
+        for (q, d) in p.iter().zip(&n) {
+            let r = q.x.hypot(q.z);
+            assert!((r - 2.0).abs() < 1e-3, "radius {r}");
+            assert!((q.y - 0.5).abs() < 1e-12);
+            // the normal lies in the layer plane and points along the radius
+            assert!(d.y.abs() < 1e-12);
+            let radial = Vector3::new(q.x, 0.0, q.z) / r;
+            assert!(d.normalize().dot(&radial).abs() > 0.999);
+        }
+    }
+
+    #[test]
+    fn projection_rounds_pull_a_loose_ring_onto_the_cylinder() {
+        let cloud = cylinder();
+        let frame = CylinderFrame::of(cloud.points(), AxisChoice::Given(Vector3::y())).unwrap();
+        // rings 20% too wide at three heights (centre height 0)
+        let loops: Vec<Vec<Point3>> = [-1.0, 0.0, 1.0].iter().map(|&h| ring(1.2, h, 40)).collect();
+        let cfg = LayerConfig::default();
+        let r = project_layers(&cloud, &frame, &loops, &cfg, Rounds::UntilThreshold).unwrap();
+        assert_eq!(r.counts, vec![40, 40, 40]);
+        // 0.2 before; on the cylinder after the rounds
+        assert!((r.rmse[0] - 0.2).abs() < 0.01, "{:?}", r.rmse);
+        assert!(r.rmse.last().unwrap() < &0.03, "{:?}", r.rmse);
+        assert!(r.rmse.len() <= cfg.max_rounds + 1);
+        for c in &r.curves {
+            let (p, _) = uniform_samples(c, 40, &Vector3::y());
+            for q in p {
+                assert!((q.x.hypot(q.z) - 1.0).abs() < 0.03);
+            }
+        }
+        // exactly N rounds when asked
+        let r = project_layers(&cloud, &frame, &loops, &cfg, Rounds::Exactly(3)).unwrap();
+        assert_eq!(r.rmse.len(), 4);
+    }
+
+    #[test]
+    fn heights_and_bad_settings() {
+        let cloud = cylinder();
+        let frame = CylinderFrame::of(cloud.points(), AxisChoice::Given(Vector3::y())).unwrap();
+        let cfg = LayerConfig {
+            layers: 5,
+            margin: 0.25,
+            ..Default::default()
+        };
+        assert_eq!(
+            layer_heights(&frame, &cfg).unwrap(),
+            vec![-1.0, -0.5, 0.0, 0.5, 1.0]
+        );
+        let bad = LayerConfig {
+            layers: 3,
+            ..Default::default()
+        };
+        assert!(layer_heights(&frame, &bad)
+            .unwrap_err()
+            .to_string()
+            .contains("at least 4"));
+        let bad = LayerConfig {
+            margin: 0.5,
+            ..Default::default()
+        };
+        assert!(layer_heights(&frame, &bad).is_err());
+    }
+}
