@@ -102,6 +102,11 @@ impl CylinderFrame {
             hmin = hmin.min(h);
             hmax = hmax.max(h);
         }
+        if hmax - hmin <= 1e-9 * (hmax.abs().max(hmin.abs()).max(1.0)) {
+            return Err(Error::InvalidInput(format!(
+                "the points have no extent along the turntable axis {axis:?}: a flat ring has no layers; give the axis of the cylinder (--axis)"
+            )));
+        }
         let hmid = 0.5 * (hmin + hmax);
         let centre = origin + mid.x * e1 + mid.y * e2 + hmid * axis;
         let radius = points
@@ -207,6 +212,18 @@ mod tests {
         assert!(f.axis.dot(&a).abs() > 1.0 - 1e-4);
         assert!((f.radius - 1.0).abs() < 0.03, "{f:?}");
         assert!((f.e1.dot(&f.axis)).abs() < 1e-12 && (f.e2.dot(&f.axis)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_flat_ring_across_the_axis_is_an_error() {
+        let pts: Vec<Point3> = (0..20)
+            .map(|i| {
+                let t = i as f64 * 0.3;
+                Point3::new(t.cos(), 0.0, t.sin())
+            })
+            .collect();
+        let e = CylinderFrame::of(&pts, AxisChoice::Given(Vector3::y())).unwrap_err();
+        assert!(e.to_string().contains("no extent along"), "{e}");
     }
 
     #[test]

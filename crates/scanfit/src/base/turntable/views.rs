@@ -77,8 +77,7 @@ pub struct View {
 impl View {
     /// `(u_k, w_k)`: the turned `x'` and `z'` directions in world space.
     pub fn directions(&self, frame: &CylinderFrame) -> (Vector3, Vector3) {
-        let (s, c) = self.angle.sin_cos();
-        (c * frame.e1 - s * frame.e2, c * frame.e2 + s * frame.e1)
+        turn_directions(frame, self.angle)
     }
 
     /// Eq. 17: turned coordinates `(x', y', z')` of `p`.
@@ -105,6 +104,12 @@ impl View {
             })
             .collect()
     }
+}
+
+/// `(u, w)` of the turn by `angle`: `u = cos(a) e1 - sin(a) e2`, `w = cos(a) e2 + sin(a) e1`.
+fn turn_directions(frame: &CylinderFrame, angle: f64) -> (Vector3, Vector3) {
+    let (s, c) = angle.sin_cos();
+    (c * frame.e1 - s * frame.e2, c * frame.e2 + s * frame.e1)
 }
 
 /// Section 3.2-3.3 up to the MBA surfaces: the `V` turns, their visible
@@ -135,48 +140,32 @@ pub fn turntable_views(
     (0..cfg.views)
         .map(|k| {
             let angle = 2.0 * PI * k as f64 / cfg.views as f64;
-            let mut view = View {
-                angle,
-                visible: Vec::new(),
-                mba: placeholder(),
-            };
-            let (_, w) = view.directions(frame);
+            let (u, w) = turn_directions(frame, angle);
             let eye = frame.centre + cfg.view_distance * frame.radius * w;
-            view.visible = hidden_point_removal(points, &eye, &cfg.hpr)?;
-            let turned: Vec<Point3> = view
-                .visible
+            let visible = hidden_point_removal(points, &eye, &cfg.hpr)?;
+            // eq. 17: turned coordinates of the visible points
+            let turned: Vec<Point3> = visible
                 .iter()
-                .map(|&i| view.turn(frame, &points[i]))
+                .map(|&i| {
+                    let d = points[i] - frame.centre;
+                    Point3::new(d.dot(&u), d.dot(&frame.axis), d.dot(&w))
+                })
                 .collect();
-            view.mba = mba(&turned, &cfg.mba).map_err(|e| {
+            let surface = mba(&turned, &cfg.mba).map_err(|e| {
                 Error::InvalidInput(format!(
                     "turntable view {k} ({:.0} degrees, {} visible points): {e}",
                     angle.to_degrees(),
                     turned.len()
                 ))
             })?;
+            let view = View {
+                angle,
+                visible,
+                mba: surface,
+            };
             Ok(view)
         })
         .collect()
-}
-
-fn placeholder() -> Mba {
-    // replaced before use; a one-cell lattice over the unit square
-    let pts = [
-        Point3::new(0.0, 0.0, 0.0),
-        Point3::new(1.0, 0.0, 0.0),
-        Point3::new(0.0, 1.0, 0.0),
-        Point3::new(1.0, 1.0, 0.0),
-    ];
-    #[allow(clippy::expect_used)]
-    mba(
-        &pts,
-        &MbaConfig {
-            max_levels: 1,
-            ..Default::default()
-        },
-    )
-    .expect("four corners of the unit square are valid MBA input")
 }
 
 /// Wraps an angle into `(-pi, pi]`.
