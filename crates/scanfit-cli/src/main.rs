@@ -14,6 +14,7 @@ mod progress;
 mod report;
 mod surface;
 mod table;
+mod turntable;
 mod view;
 
 use clap::{Parser, Subcommand};
@@ -47,6 +48,8 @@ enum Command {
     Mba(mba::MbaArgs),
     /// Deviation of points from a fitted surface: statistics and an HTML report.
     Report(report::ReportArgs),
+    /// Cylinder-like clouds (heads, bottles, arms): virtual turntable parameterization and a surface closed around the axis.
+    Turntable(turntable::TurntableArgs),
 }
 
 fn main() {
@@ -74,6 +77,7 @@ fn main() {
         Command::Fit(a) => surface::run(a),
         Command::Mba(a) => mba::run(a),
         Command::Report(a) => report::run(a),
+        Command::Turntable(a) => turntable::run(a),
     };
     if let Err(e) = result {
         eprintln!("error: {e:#}");

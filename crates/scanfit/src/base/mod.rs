@@ -13,3 +13,4 @@ pub use coons::{
 pub use coons_cloud::{coons_from_cloud, CoonsFromCloud, CoonsFromCloudConfig};
 pub use coons_param::{coons_parameters, CoonsParamConfig, CoonsParameters, CoonsProjection};
 pub use plane::{plane_parameters, PlaneParameterization};
+pub mod turntable;
