@@ -162,7 +162,21 @@ fn mba_bad_input_is_reported_without_output() {
         ),
         (
             vec![input.to_str().unwrap(), "--levels", "40"],
-            "cannot be stored",
+            "doubles per level",
+        ),
+        (
+            vec![input.to_str().unwrap(), "--base", "18446744073709551615x1"],
+            "doubles per level",
+        ),
+        (
+            vec![
+                input.to_str().unwrap(),
+                "--base",
+                "60000x60000",
+                "--levels",
+                "1",
+            ],
+            "doubles per level",
         ),
         (
             vec![input.to_str().unwrap(), "--adjust", "--weight", "heavy"],

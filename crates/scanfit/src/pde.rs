@@ -169,8 +169,8 @@ impl PdeSurface {
     /// converted exactly ([`CoonsPatch::to_bspline`]); `S_PDE` is interpolated
     /// on a uniform `(k+1) x (k+1)` grid (tensor-product interpolation, NURBS
     /// Book A9.4, degrees of the Coons B-spline, averaging knots), `k` doubling
-    /// from `max(8, 2 max(M, N))` until the deviation on the grid of midpoints
-    /// is within tolerance. The interpolant is exactly zero on the boundary,
+    /// from `max(8, 2 max(M, N))` until the deviation sampled at every quarter
+    /// of every cell, with a 20% margin, is within tolerance. The interpolant is exactly zero on the boundary,
     /// so the boundary curves stay those of the Coons patch. Both parts are
     /// refined to common knots and added.
     pub fn to_bspline(&self, cfg: &BsplineConversionConfig) -> Result<PdeBspline> {
@@ -185,22 +185,30 @@ impl PdeSurface {
         let (m, n) = self.deformation.terms();
         let mut k = (2 * m.max(n)).max(8).max(p.max(q) + 1);
         loop {
+            if k > cfg.max_spans {
+                return Err(Error::InvalidInput(format!(
+                    "the B-spline form of the PDE surface would need more than {} x {} spans for {m} x {n} terms; allow more spans or use fewer PDE terms",
+                    cfg.max_spans, cfg.max_spans
+                )));
+            }
             let w = self.interpolate_deformation(k, p, q)?;
-            // check on midpoints and the grid of quarter points between them
-            let check = 2 * k;
-            let dev = (0..check)
+            // check every quarter of every cell (nodes, quarter points and
+            // midpoints, boundary cells included), and keep a margin of 20%
+            // for the maximum between the samples
+            let check = 4 * k;
+            let dev = (0..=check)
                 .into_par_iter()
                 .map(|i| {
-                    let u = (i as f64 + 0.5) / check as f64;
-                    (0..check)
+                    let u = i as f64 / check as f64;
+                    (0..=check)
                         .map(|j| {
-                            let v = (j as f64 + 0.5) / check as f64;
+                            let v = j as f64 / check as f64;
                             (w.point(u, v).coords - self.deformation.displacement(u, v)).norm()
                         })
                         .fold(0.0, f64::max)
                 })
                 .reduce(|| 0.0, f64::max);
-            if dev <= cfg.tolerance {
+            if dev * 1.2 <= cfg.tolerance {
                 let (ku, kv) = (
                     union(base.knots_u(), w.knots_u())?,
                     union(base.knots_v(), w.knots_v())?,
@@ -286,6 +294,11 @@ const BLOCK: usize = 1024;
 ///
 /// Errors: fewer points than `M x N`; `M` or `N` zero; `D` not positive;
 /// parameters outside `[0, 1]^2`; a singular system (the points do not
+
+/// Most sine terms `M x N` of a PDE deformation: the normal equations hold
+/// `(M N)^2` doubles (4096 terms: 134 MB).
+pub const MAX_PDE_TERMS: usize = 4096;
+
 /// determine `M x N` terms: lower `M`, `N`).
 pub fn fit_pde(
     coons: &CoonsPatch,
@@ -322,7 +335,14 @@ pub fn fit_pde(
             uv[i][0], uv[i][1]
         )));
     }
-    let kk = mm * nn;
+    let kk = mm
+        .checked_mul(nn)
+        .filter(|&k| k <= MAX_PDE_TERMS)
+        .ok_or_else(|| {
+            Error::InvalidInput(format!(
+                "PDE terms M x N = {mm} x {nn} exceed the limit of {MAX_PDE_TERMS} terms (the normal equations would need (M N)^2 doubles); the paper uses 5 x 5 to 10 x 10"
+            ))
+        })?;
     if points.len() < kk {
         return Err(Error::TooFewPoints {
             got: points.len(),
@@ -334,36 +354,46 @@ pub fn fit_pde(
     let base: Vec<Point3> = uv.par_iter().map(|t| coons.point(t[0], t[1])).collect();
     // normal equations (eq. 13) for w_mn, assembled block by block (blocks in
     // parallel, summed in order: the result does not depend on the threads)
-    let blocks: Vec<(Mat<f64>, Mat<f64>)> = (0..points.len().div_ceil(BLOCK))
-        .into_par_iter()
-        .map(|b| {
-            let r = b * BLOCK..((b + 1) * BLOCK).min(points.len());
-            let rows = r.len();
-            let mut a = Mat::<f64>::zeros(rows, kk);
-            let mut rhs = Mat::<f64>::zeros(rows, 3);
-            for (row, i) in r.enumerate() {
-                let [u, v] = uv[i];
-                let sv: Vec<f64> = (1..=nn).map(|n| sin_k_pi(n, v)).collect();
-                for m in 1..=mm {
-                    let su = sin_k_pi(m, u);
-                    for (n0, &s) in sv.iter().enumerate() {
-                        a[(row, (m - 1) * nn + n0)] = su * s;
-                    }
-                }
-                let off = points[i] - base[i];
-                for c in 0..3 {
-                    rhs[(row, c)] = off[c];
+    // a group of as many blocks as threads at a time, so that memory stays at
+    // (threads) Gram matrices however many points there are
+    let block = |b: usize| {
+        let r = b * BLOCK..((b + 1) * BLOCK).min(points.len());
+        let rows = r.len();
+        let mut a = Mat::<f64>::zeros(rows, kk);
+        let mut rhs = Mat::<f64>::zeros(rows, 3);
+        let mut sv = vec![0.0; nn];
+        for (row, i) in r.enumerate() {
+            let [u, v] = uv[i];
+            for (n0, s) in sv.iter_mut().enumerate() {
+                *s = sin_k_pi(n0 + 1, v);
+            }
+            for m in 1..=mm {
+                let su = sin_k_pi(m, u);
+                for (n0, &s) in sv.iter().enumerate() {
+                    a[(row, (m - 1) * nn + n0)] = su * s;
                 }
             }
-            let at = a.as_ref().transpose();
-            (at * a.as_ref(), at * rhs.as_ref())
-        })
-        .collect();
+            let off = points[i] - base[i];
+            for c in 0..3 {
+                rhs[(row, c)] = off[c];
+            }
+        }
+        let at = a.as_ref().transpose();
+        (at * a.as_ref(), at * rhs.as_ref())
+    };
+    let nblocks = points.len().div_ceil(BLOCK);
+    let group = rayon::current_num_threads().max(1);
     let mut g = Mat::<f64>::zeros(kk, kk);
     let mut rhs = Mat::<f64>::zeros(kk, 3);
-    for (bg, br) in &blocks {
-        g += bg;
-        rhs += br;
+    for start in (0..nblocks).step_by(group) {
+        let blocks: Vec<(Mat<f64>, Mat<f64>)> = (start..(start + group).min(nblocks))
+            .into_par_iter()
+            .map(block)
+            .collect();
+        for (bg, br) in &blocks {
+            g += bg;
+            rhs += br;
+        }
     }
     let llt = g.llt(Side::Lower).map_err(|_| Error::Singular {
         what: format!("PDE deformation least squares (eq. 13, {mm} x {nn} terms)"),
@@ -486,10 +516,16 @@ mod tests {
             .surface
             .to_bspline(&BsplineConversionConfig::new(1e-5))
             .unwrap();
-        assert!(b.max_deviation <= 1e-5);
-        for (u, v) in [(0.5, 0.5), (0.13, 0.77), (0.91, 0.31)] {
-            assert!((b.surface.point(u, v) - fit.surface.point(u, v)).norm() < 1.2e-5);
+        assert!(b.max_deviation * 1.2 <= 1e-5);
+        // the promise holds on a dense independent grid (1/397 steps, all cells)
+        let mut worst: f64 = 0.0;
+        for i in 0..=397 {
+            for j in 0..=397 {
+                let (u, v) = (i as f64 / 397.0, j as f64 / 397.0);
+                worst = worst.max((b.surface.point(u, v) - fit.surface.point(u, v)).norm());
+            }
         }
+        assert!(worst <= 1e-5, "{worst}");
         // the boundary is the Coons patch's, exactly
         for k in 0..=10 {
             let t = k as f64 / 10.0;

@@ -27,6 +27,11 @@ pub fn uniform_cubic_basis(s: f64) -> [f64; 4] {
     ]
 }
 
+/// Most control values of one lattice (2^24: 128 MiB of f64, a 4096 x 4096
+/// net), so that a level count or base lattice from the command line cannot
+/// exhaust memory.
+pub const MAX_LATTICE_VALUES: usize = 1 << 24;
+
 /// How a control value is chosen from the candidates `phi_c` of the points
 /// in its 4 x 4 neighbourhood.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -73,12 +78,14 @@ impl Lattice {
                 "a control lattice needs at least 1 x 1 cells, got {m} x {n}"
             )));
         }
-        let len = (m + 3)
-            .checked_mul(n + 3)
-            .filter(|&l| l <= 1 << 32)
+        let len = m
+            .checked_add(3)
+            .zip(n.checked_add(3))
+            .and_then(|(a, b)| a.checked_mul(b))
+            .filter(|&l| l <= MAX_LATTICE_VALUES)
             .ok_or_else(|| {
                 Error::InvalidInput(format!(
-                    "a lattice of {m} x {n} cells is too large; lower the level count"
+                    "a lattice of {m} x {n} cells exceeds the limit of {MAX_LATTICE_VALUES} control values (about 4093 x 4093 cells); lower the level count or the base lattice"
                 ))
             })?;
         Ok(Self {
@@ -134,9 +141,15 @@ impl Lattice {
         let len = lattice.phi.len();
         let st = lattice.stride();
         // (numerator, denominator) per control value, summed in parallel
+        // one pair of accumulators per thread's share, not per rayon split
+        let share = xy
+            .len()
+            .div_ceil(rayon::current_num_threads().max(1))
+            .max(1024);
         let (num, den) = xy
             .par_iter()
             .zip(z.par_iter())
+            .with_min_len(share)
             .fold(
                 || (vec![0.0; len], vec![0.0; len]),
                 |(mut num, mut den), (p, &zc)| {

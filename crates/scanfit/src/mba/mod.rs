@@ -201,10 +201,21 @@ impl MbaRun {
                 )));
             }
         }
-        if config.max_levels > 16 {
+        // the last level's lattice must fit (it doubles per level)
+        let last = config.max_levels.max(1) - 1;
+        let fits = u32::try_from(last)
+            .ok()
+            .and_then(|k| 1usize.checked_shl(k))
+            .and_then(|f| base.0.checked_mul(f).zip(base.1.checked_mul(f)))
+            .and_then(|(m, n)| (m.checked_add(3)?).checked_mul(n.checked_add(3)?))
+            .is_some_and(|len| len <= lattice::MAX_LATTICE_VALUES);
+        if !fits {
             return Err(Error::InvalidInput(format!(
-                "{} levels asked for; a lattice doubles per level, so more than 16 cannot be stored",
-                config.max_levels
+                "{} levels on a {} x {} base lattice would need more than {} control values at the last level (a lattice doubles per level); lower --levels or --base",
+                config.max_levels,
+                base.0,
+                base.1,
+                lattice::MAX_LATTICE_VALUES
             )));
         }
         Ok(Self {
