@@ -289,17 +289,16 @@ pub struct PdeFit {
 /// Points per block of the normal-equation assembly.
 const BLOCK: usize = 1024;
 
-/// Fits the deformation of `coons` to `points` with parameters `uv` (eqs.
-/// 12-13, see the module docs) and returns `S` with its eq. 15 errors.
-///
-/// Errors: fewer points than `M x N`; `M` or `N` zero; `D` not positive;
-/// parameters outside `[0, 1]^2`; a singular system (the points do not
-
 /// Most sine terms `M x N` of a PDE deformation: the normal equations hold
 /// `(M N)^2` doubles (4096 terms: 134 MB).
 pub const MAX_PDE_TERMS: usize = 4096;
 
-/// determine `M x N` terms: lower `M`, `N`).
+/// Fits the deformation of `coons` to `points` with parameters `uv` (eqs.
+/// 12-13, see the module docs) and returns `S` with its eq. 15 errors.
+///
+/// Errors: fewer points than `M x N`, or more than [`MAX_PDE_TERMS`] terms;
+/// `M` or `N` zero; `D` not positive; parameters outside `[0, 1]^2`; a
+/// singular system (the points do not determine `M x N` terms: lower `M`, `N`).
 pub fn fit_pde(
     coons: &CoonsPatch,
     points: &[Point3],
