@@ -44,7 +44,9 @@ curvature, PDE paper 4.1; --corners gives loop positions as listed by
 `scanfit cloud boundary`), one B-spline per side (end-pinned least squares on
 chord-length parameters with uniform knots, PDE paper 4.2), the bilinearly
 blended Coons patch (Coons paper eq. 16, PDE paper eq. 1; with --sides 3 the
-side from the last corner to the first degenerates to a point), parameters on
+three sides are C0->C1, C1->C2, C2->C0 and the fourth side collapses to the
+first corner C0, the apex: list the corner you want as apex first in
+--corners), parameters on
 it (--params grid: the Coons paper's nearest grid vertex at step h plus the
 iteration of eqs. 17-22; closest: exact closest point), then
   --fit bspline: least-squares B-spline surface on those parameters (Coons paper);

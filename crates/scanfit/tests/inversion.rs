@@ -160,3 +160,37 @@ fn coons_grid_iteration_is_within_its_tolerance() {
     // the foot point is found to about epsilon (the paper's claim), not to rounding
     assert!(max_err < 2.0 * cfg.epsilon, "{max_err}");
 }
+
+#[test]
+fn coons_grid_iteration_converges_on_a_skewed_patch() {
+    // a flat parallelogram whose tangents meet at 60 degrees: eq. 19 as
+    // printed (divided by |Q_u| |Q_w|) has length sin 60 and would never
+    // reach |Q' - Q| <= epsilon at distance 0.1; the unit normal does
+    let k = KnotVector::new(vec![0.0, 0.0, 1.0, 1.0], 1).unwrap();
+    let (a, b) = (
+        nalgebra::Vector3::new(1.0, 0.0, 0.0),
+        nalgebra::Vector3::new(0.5, 3f64.sqrt() / 2.0, 0.0),
+    );
+    let o = Point3::origin();
+    let s = Surface::new(k.clone(), k, vec![o, o + b, o + a, o + a + b]).unwrap();
+    let truth = [[0.3, 0.4], [0.6, 0.5], [0.45, 0.7]];
+    let pts: Vec<Point3> = truth
+        .iter()
+        .map(|t| s.point(t[0], t[1]) + nalgebra::Vector3::new(0.0, 0.0, 0.1))
+        .collect();
+    let res = grid_iteration(&s, &pts, &GridIterationConfig::default()).unwrap();
+    for (r, t) in res.iter().zip(&truth) {
+        assert!(r.converged, "{r:?}");
+        assert!(
+            (r.uv[0] - t[0]).abs() < 0.01 && (r.uv[1] - t[1]).abs() < 0.01,
+            "{r:?} vs {t:?}"
+        );
+        assert!((r.distance - 0.1).abs() < 1e-3, "{}", r.distance);
+    }
+    // a grid step that would build more than 10^7 vertices is refused
+    let tiny = GridIterationConfig {
+        h: 1e-6,
+        ..Default::default()
+    };
+    assert!(grid_iteration(&s, &pts, &tiny).is_err());
+}

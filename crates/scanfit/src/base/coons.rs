@@ -519,6 +519,13 @@ impl CoonsPatch {
                 ctrl.push(Point3::from(c));
             }
         }
+        if self.sides() == Sides::Three {
+            // the collapsed side P(0, v) is the apex exactly, not up to rounding
+            let apex = Point3::from(p00);
+            for c in ctrl.iter_mut().take(eta.len()) {
+                *c = apex;
+            }
+        }
         Surface::new(ku, kv, ctrl)
     }
 }

@@ -88,7 +88,7 @@ pub fn coons_from_cloud(points: &[Point3], cfg: &CoonsFromCloudConfig) -> Result
                 return Err(Error::InvalidInput(format!(
                     "corner position {bad} is beyond the outer loop, which has {} points (positions 0..{})",
                     outer.len(),
-                    outer.len() - 1
+                    outer.len().saturating_sub(1)
                 )));
             }
             let sides = split_at_corners(outer.len(), c)?;

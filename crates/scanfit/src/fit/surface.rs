@@ -75,6 +75,9 @@ pub struct SurfaceLsqOptions<'a> {
     pub periodic_u: bool,
 }
 
+/// Most control points of a fitted surface (2^22, a 2048 x 2048 net).
+pub const MAX_SURFACE_CONTROL_POINTS: usize = 1 << 22;
+
 /// Fits a surface to `points` with parameters `uv` in `[0, 1]^2`.
 pub fn fit_surface(points: &[Point3], uv: &[[f64; 2]], cfg: &SurfaceFitConfig) -> Result<Surface> {
     let (p, q) = cfg.degree;
@@ -87,6 +90,17 @@ pub fn fit_surface(points: &[Point3], uv: &[[f64; 2]], cfg: &SurfaceFitConfig) -
             "a {nu} x {nv} control net is too small for degrees {p} x {q} (need at least {} x {})",
             if cfg.periodic_u { 2 * p + 1 } else { p + 1 },
             q + 1
+        )));
+    }
+    // the normal equations hold nu nv unknowns; degrees above 10 and nets
+    // beyond 2^22 (a 2048 x 2048 net) are not what a CAD surface needs, and
+    // would exhaust memory before any error could be reported
+    let unknowns = nu
+        .checked_mul(nv)
+        .filter(|&n| n <= MAX_SURFACE_CONTROL_POINTS);
+    if unknowns.is_none() || p > 10 || q > 10 {
+        return Err(Error::InvalidInput(format!(
+            "a {nu} x {nv} control net of degrees {p} x {q} is beyond the limits ({MAX_SURFACE_CONTROL_POINTS} control points, degree 10); choose a smaller net"
         )));
     }
     let ku = if cfg.periodic_u {

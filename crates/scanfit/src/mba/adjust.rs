@@ -331,6 +331,60 @@ mod tests {
     }
 
     #[test]
+    fn a_grid_point_error_moves_the_control_value_over_it() {
+        // data z = 0 on a dense grid over [0, 4]^2, except a plateau z = 1
+        // of half-width 0.6 around x = 2, y = 1 (only knot grid point (2, 1)
+        // is over it): that grid point projects onto it, and control value
+        // (2 + 1, 1 + 1) moves by alpha * dd
+        let mut p = Vec::new();
+        for i in 0..=80 {
+            for j in 0..=80 {
+                let (x, y) = (i as f64 * 0.05, j as f64 * 0.05);
+                let z = if (x - 2.0).abs() < 0.6 && (y - 1.0).abs() < 0.6 {
+                    1.0
+                } else {
+                    0.0
+                };
+                p.push(Point3::new(x, y, z));
+            }
+        }
+        let cloud = PointCloud::new(p.clone()).unwrap();
+        let frame = Frame::of(&p).unwrap();
+        let mut lattice = Lattice::zeros(4, 4).unwrap();
+        // the zero lattice is at height z0 (the mean); start at z = 0 instead
+        for v in lattice.phi.iter_mut() {
+            *v = -frame.z0;
+        }
+        let before = lattice.clone();
+        // all points enter the sums: the plateau is 1 above the grid point,
+        // farther than its 32 nearest points on the ground
+        let cfg = AdjustConfig {
+            max_steps: 1,
+            projection: DirectedConfig {
+                neighbourhood: crate::project::Neighbourhood::All,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let steps = adjust_lattice(&cloud, &frame, &mut lattice, &cfg).unwrap();
+        assert!(steps[0].accepted, "{steps:?}");
+        let moved: Vec<(usize, f64)> = lattice
+            .phi
+            .iter()
+            .zip(&before.phi)
+            .map(|(a, b)| a - b)
+            .enumerate()
+            .collect();
+        let (at, by) = moved
+            .iter()
+            .copied()
+            .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+            .unwrap();
+        assert_eq!((at / 7, at % 7), (3, 2), "moved {by}");
+        assert!(by > 0.5 * steps[0].alpha, "{by}");
+    }
+
+    #[test]
     fn adjusted_loop_stops_at_the_tolerance() {
         let p = terrain(4000);
         let r = mba_adjusted(

@@ -64,6 +64,14 @@ pub fn grid_iteration(
         ((v1 - v0) / cfg.h).round() as usize,
     );
     let (nu, nv) = (nu.max(1), nv.max(1));
+    if (nu + 1).saturating_mul(nv + 1) > 10_000_000 {
+        return Err(Error::InvalidInput(format!(
+            "grid step h = {} makes a {} x {} grid, more than 10^7 vertices; use a larger h (the Coons paper: 0.001)",
+            cfg.h,
+            nu + 1,
+            nv + 1
+        )));
+    }
     let uv: Vec<[f64; 2]> = (0..=nu)
         .flat_map(|i| {
             (0..=nv).map(move |j| {
@@ -108,7 +116,16 @@ pub fn grid_iteration(
                 if lu == 0.0 || lw == 0.0 {
                     break;
                 }
-                let mut n = qu.cross(&qw) / (lu * lw); // (19)
+                // (19) divides by |Q_u| |Q_w|, a unit vector only when the
+                // tangents are orthogonal (then |Q' - Q| would not vanish at
+                // the foot point, and skewed patches would never converge);
+                // the unit normal it intends is Q_u x Q_w / |Q_u x Q_w|
+                let c = qu.cross(&qw);
+                let lc = c.norm();
+                if lc <= 1e-300 * lu * lw {
+                    break;
+                }
+                let mut n = c / lc; // (19), normalised
                 if (q - p).dot(&n) < 0.0 {
                     n = -n;
                 }
