@@ -102,7 +102,9 @@ impl CylinderFrame {
             hmin = hmin.min(h);
             hmax = hmax.max(h);
         }
-        if hmax - hmin <= 1e-9 * (hmax.abs().max(hmin.abs()).max(1.0)) {
+        // relative to the cloud's size (not to 1: tiny clouds are clouds too)
+        let size = crate::geom::bbox_diagonal(points).max(f64::MIN_POSITIVE);
+        if hmax - hmin <= 1e-9 * size {
             return Err(Error::InvalidInput(format!(
                 "the points have no extent along the turntable axis {axis:?}: a flat ring has no layers; give the axis of the cylinder (--axis)"
             )));
@@ -116,7 +118,7 @@ impl CylinderFrame {
                 (d - d.dot(&axis) * axis).norm()
             })
             .fold(0.0, f64::max);
-        if radius <= 1e-12 * (hmax - hmin).abs().max(1.0) {
+        if radius <= 1e-9 * size {
             return Err(Error::InvalidInput(
                 "all points lie on the turntable axis: there is nothing to turn; check the axis"
                     .into(),

@@ -4,11 +4,17 @@
 //! intersection pairs ([`super::views::layer_polygon`]), without its
 //! outliers, is interpolated by a closed cubic B-spline (global
 //! interpolation, *The NURBS Book* section 9.2.1, closed form) with chord
-//! length parameters. The paper names the averaging knots of Ma & Kruth; for
-//! a closed curve of odd degree the periodic knot vector whose domain knots
-//! are the parameters themselves ([`crate::param::knots::periodic`]) is the
-//! closed form of averaging (the mean of `p = 3` consecutive parameters is a
-//! shifted parameter up to the spacing), which is what is used.
+//! length parameters.
+//!
+//! Two departures from section 3.4, stated: (1) the paper interpolates an
+//! *open* curve per layer, from and to the column grid points close to the
+//! cloud; a closed curve is used here, since the layer of a cylinder-like
+//! cloud goes all the way round and the base surface is periodic in u
+//! anyway. (2) The paper names the averaging knots of Ma & Kruth; for a
+//! closed curve the periodic knot vector whose domain knots are the
+//! parameters themselves ([`crate::param::knots::periodic`]) is used. It
+//! equals the averaged knots for uniform parameters and differs from them by
+//! a fraction of the local spacing for chord-length parameters.
 //!
 //! The curve is then sampled uniformly in its parameter with as many samples
 //! as the layer kept points, and every sample is moved by directed
@@ -74,10 +80,16 @@ impl Default for LayerConfig {
 
 impl LayerConfig {
     fn validate(&self) -> Result<()> {
-        if self.layers < 4 {
+        if !(4..=4096).contains(&self.layers) {
             return Err(Error::InvalidInput(format!(
-                "{} layers are too few for a bicubic base surface; use at least 4",
+                "{} layers: use between 4 (a bicubic base surface) and 4096",
                 self.layers
+            )));
+        }
+        if self.max_rounds > 1000 {
+            return Err(Error::InvalidInput(format!(
+                "{} projection rounds: use at most 1000 (the rounds stop at the threshold long before)",
+                self.max_rounds
             )));
         }
         if !(0.0..0.5).contains(&self.margin) {
@@ -130,7 +142,14 @@ pub fn layer_loops(
         .iter()
         .enumerate()
         .map(|(l, &h)| {
-            let (poly, _) = layer_polygon(frame, views, h, grid_u)?;
+            let (poly, per_view) = layer_polygon(frame, views, h, grid_u)?;
+            // a view that keeps no grid point would let the layer curve cut
+            // straight across its sector, through the object
+            if let Some(k) = per_view.iter().position(|&n| n == 0) {
+                return Err(Error::InvalidInput(format!(
+                    "layer {l} (height {h:.4}): view {k} keeps no grid point between its neighbours' intersection pairs, so the layer curve would cut across its sector; check the axis (--axis), or use fewer --views or a finer --grid"
+                )));
+            }
             let d: Vec<f64> = cloud
                 .nearest_batch(&poly)?
                 .into_iter()
@@ -252,6 +271,10 @@ pub fn project_layers(
         let r = crate::metrics::rmse_to_cloud(cloud, &projected)?;
         let previous = rmse[rmse.len() - 1];
         rmse.push(r);
+        // a round that made the layer samples worse is not taken
+        if rounds == Rounds::UntilThreshold && r > previous {
+            break;
+        }
         // re-interpolate each layer through its projected samples
         let mut offset = 0;
         let layers: Vec<&[Point3]> = counts
@@ -400,7 +423,15 @@ mod tests {
         assert!(layer_heights(&frame, &bad)
             .unwrap_err()
             .to_string()
-            .contains("at least 4"));
+            .contains("between 4"));
+        let huge = LayerConfig {
+            layers: 1 << 62,
+            ..Default::default()
+        };
+        assert!(layer_heights(&frame, &huge)
+            .unwrap_err()
+            .to_string()
+            .contains("and 4096"));
         let bad = LayerConfig {
             margin: 0.5,
             ..Default::default()

@@ -34,7 +34,7 @@ use crate::cloud::PointCloud;
 use crate::fit::surface::{fit_surface, SurfaceFitConfig};
 use crate::metrics::{parameterization_quality, ErrorStats, ParamQuality};
 use crate::project::{InversionConfig, SurfaceInverter};
-use crate::{Point3, Result};
+use crate::{Error, Point3, Result};
 
 /// Everything the pipeline needs, with the paper's defaults.
 #[derive(Debug, Clone, PartialEq)]
@@ -202,7 +202,13 @@ pub fn turntable(
     let (mut fit, grid_u) = initial_base_surface(&layers.curves, &layers.counts, &frame)?;
     let initial_base = fit.surface.clone();
     stage(4);
-    let mut refine_rmse = Vec::with_capacity(cfg.refine.rounds);
+    if cfg.refine.rounds > 100 {
+        return Err(Error::InvalidInput(format!(
+            "{} refinement rounds: use at most 100 (the paper's refinement converges in a few)",
+            cfg.refine.rounds
+        )));
+    }
+    let mut refine_rmse = Vec::new();
     for _ in 0..cfg.refine.rounds {
         let (next, r) = refine_round(cloud, &fit, &cfg.refine)?;
         fit = next;
@@ -342,10 +348,16 @@ fn length_along_v(s: &Surface) -> f64 {
     (total / 8.0).max(f64::MIN_POSITIVE)
 }
 
-/// Nearest-cloud distances of a `4 n_u x 4 n_v` grid of surface samples.
+/// Nearest-cloud distances of a `4 n_u x 4 n_v` grid of surface samples
+/// (fewer for nets beyond 250 x 250, at most about 10^6 samples).
 fn surface_to_cloud(cloud: &PointCloud, s: &Surface) -> Result<ErrorStats> {
     let (cu, cv) = s.counts();
-    let (nu, nv) = (4 * cu, 4 * cv);
+    // 4 samples per control point in each direction, at most ~10^6 in all
+    let scale = (1.0e6 / (16.0 * cu as f64 * cv as f64)).sqrt().min(1.0);
+    let (nu, nv) = (
+        ((4.0 * cu as f64 * scale) as usize).max(8),
+        ((4.0 * cv as f64 * scale) as usize).max(8),
+    );
     let ((u0, u1), (v0, v1)) = s.domain();
     let grid: Vec<Point3> = (0..nu)
         .flat_map(|i| {

@@ -119,16 +119,29 @@ pub fn turntable_views(
     frame: &CylinderFrame,
     cfg: &ViewConfig,
 ) -> Result<Vec<View>> {
-    if cfg.views < 3 {
+    if !(3..=64).contains(&cfg.views) {
         return Err(Error::InvalidInput(format!(
-            "{} turntable views cannot surround the cloud; use at least 3 (the paper uses 4)",
+            "{} turntable views: use between 3 (to surround the cloud) and 64 (the paper uses 4)",
             cfg.views
         )));
     }
-    if cfg.grid_u < 8 {
+    if !(8..=4096).contains(&cfg.grid_u) {
         return Err(Error::InvalidInput(format!(
-            "{} grid points per view and layer are too few; use at least 8",
+            "{} grid points per view and layer: use between 8 and 4096",
             cfg.grid_u
+        )));
+    }
+    // each view's sector must hold grid points of its MBA surface: the first
+    // grid point off the centre is at about asin(2 / grid) from it
+    let sector = std::f64::consts::PI / cfg.views as f64;
+    let step = (2.0 / cfg.grid_u as f64).min(1.0).asin();
+    if sector < 2.0 * step {
+        return Err(Error::InvalidInput(format!(
+            "{} views of {} grid points: a view's half-sector ({:.2} degrees) holds no grid points (their angular step is {:.2} degrees); use fewer --views or a larger --grid",
+            cfg.views,
+            cfg.grid_u,
+            sector.to_degrees(),
+            step.to_degrees()
         )));
     }
     if !(cfg.view_distance.is_finite() && cfg.view_distance > 1.0) {
@@ -324,6 +337,20 @@ mod tests {
             ..Default::default()
         };
         let e = turntable_views(&pts, &frame, &cfg).unwrap_err();
-        assert!(e.to_string().contains("at least 3"));
+        assert!(e.to_string().contains("between 3"), "{e}");
+        // and too many views, too fine or too coarse a grid for them
+        for (views, grid_u, needle) in [
+            (1_000_000, 32, "and 64"),
+            (4, 1 << 40, "and 4096"),
+            (60, 16, "holds no grid points"),
+        ] {
+            let cfg = ViewConfig {
+                views,
+                grid_u,
+                ..Default::default()
+            };
+            let e = turntable_views(&pts, &frame, &cfg).unwrap_err();
+            assert!(e.to_string().contains(needle), "{e}");
+        }
     }
 }
