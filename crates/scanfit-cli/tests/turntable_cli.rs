@@ -133,7 +133,10 @@ fn bad_input_writes_nothing() {
         (vec!["--axis", "0,0,0"], "non-zero"),
         (vec!["--weight", "heavy"], "unknown --weight"),
         (vec!["--ctrl", "ax4"], "--ctrl"),
-        (vec!["--views", "2"], "at least 3"),
+        (vec!["--views", "2"], "between 3"),
+        (vec!["--views", "1000000"], "and 64"),
+        (vec!["--layers", "4611686018427387904"], "and 4096"),
+        (vec!["--refine", "18446744073709551615"], "at most 100"),
         (vec!["--ends", "cap"], "unknown --ends"),
     ] {
         let mut all = vec![
