@@ -25,6 +25,7 @@ use scanfit_io::ply::{points_ply, points_xyz, PlyFormat};
 use scanfit_io::render::{Marker, Polyline};
 use scanfit_io::write_all_atomic;
 
+use crate::args::pair;
 use crate::cloud::InputArgs;
 use crate::outputs::{
     check_extensions, print_written, Deviation, Picture, PngStyle, SurfaceOutputArgs,
@@ -125,21 +126,6 @@ pub struct CoonsArgs {
     /// No progress display.
     #[arg(short, long)]
     pub quiet: bool,
-}
-
-fn pair(s: &str, what: &str) -> Result<(usize, usize)> {
-    let parse = |x: &str| {
-        x.trim()
-            .parse::<usize>()
-            .with_context(|| format!("{what} '{s}' must be N or NxM with whole numbers"))
-    };
-    match s.split_once(['x', 'X']) {
-        Some((a, b)) => Ok((parse(a)?, parse(b)?)),
-        None => {
-            let n = parse(s)?;
-            Ok((n, n))
-        }
-    }
 }
 
 const SIDE_COLOURS: [[u8; 3]; 4] = [[220, 30, 30], [30, 110, 220], [230, 140, 0], [150, 40, 190]];

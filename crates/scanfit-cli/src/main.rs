@@ -3,6 +3,7 @@
 //! A thin layer over the `scanfit` library and `scanfit-io`: parse arguments,
 //! read files, call the library, print tables, write outputs.
 
+mod args;
 mod cad;
 mod cloud;
 mod coons;

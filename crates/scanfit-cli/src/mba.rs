@@ -15,6 +15,7 @@ use scanfit::project::{DirectedConfig, InversionConfig, SurfaceInverter, WeightF
 use scanfit_io::json::{Provenance, SurfaceDoc, SurfaceQualityDoc};
 use scanfit_io::write_all_atomic;
 
+use crate::args::pair;
 use crate::outputs::{print_written, Deviation, Picture, SurfaceOutputArgs};
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -95,21 +96,6 @@ struct Row {
     seconds: f64,
 }
 
-fn pair(s: &str) -> Result<(usize, usize)> {
-    let parse = |x: &str| {
-        x.trim()
-            .parse::<usize>()
-            .with_context(|| format!("--base '{s}' must be MxN with whole numbers, e.g. 2x1"))
-    };
-    match s.split_once(['x', 'X']) {
-        Some((a, b)) => Ok((parse(a)?, parse(b)?)),
-        None => {
-            let n = parse(s)?;
-            Ok((n, n))
-        }
-    }
-}
-
 /// Runs `scanfit mba`.
 pub fn run(a: MbaArgs) -> Result<()> {
     a.out.check()?;
@@ -123,7 +109,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
         bail!("--levels must be at least 1");
     }
     let config = MbaConfig {
-        base: a.base.as_deref().map(pair).transpose()?,
+        base: a.base.as_deref().map(|b| pair(b, "--base")).transpose()?,
         max_levels: a.levels,
         tolerance: a.tolerance,
         formula: if a.hjelle {

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use clap::Args;
 use scanfit::base::plane_parameters;
 use scanfit::bspline::Surface;
@@ -17,6 +17,7 @@ use scanfit_io::json::{Provenance, SurfaceDoc, SurfaceQualityDoc};
 use scanfit_io::ply::{points_ply, points_xyz, PlyFormat};
 use scanfit_io::{read_points, write_all_atomic};
 
+use crate::args::pair;
 use crate::outputs::{check_extensions, extension, print_written, Deviation, Picture};
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -75,21 +76,6 @@ pub struct FitArgs {
     /// No progress display.
     #[arg(short, long)]
     pub quiet: bool,
-}
-
-fn pair(s: &str, what: &str) -> Result<(usize, usize)> {
-    let parse = |x: &str| {
-        x.trim()
-            .parse::<usize>()
-            .with_context(|| format!("{what} '{s}' must be N or NxM with whole numbers"))
-    };
-    match s.split_once(['x', 'X']) {
-        Some((a, b)) => Ok((parse(a)?, parse(b)?)),
-        None => {
-            let n = parse(s)?;
-            Ok((n, n))
-        }
-    }
 }
 
 /// Runs `scanfit fit`.

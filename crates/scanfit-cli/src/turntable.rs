@@ -17,6 +17,7 @@ use scanfit::{PointCloud, Vector3};
 use scanfit_io::json::{Provenance, SurfaceDoc, SurfaceQualityDoc};
 use scanfit_io::write_all_atomic;
 
+use crate::args::pair;
 use crate::outputs::{
     check_extensions, print_written, Deviation, Picture, PngStyle, SurfaceOutputArgs,
 };
@@ -114,21 +115,6 @@ fn parse_axis(s: &str) -> Result<AxisChoice> {
     })
 }
 
-fn ctrl_pair(s: &str) -> Result<(usize, usize)> {
-    let parse = |x: &str| {
-        x.trim()
-            .parse::<usize>()
-            .with_context(|| format!("--ctrl '{s}' must be NUxNV with whole numbers, e.g. 40x40"))
-    };
-    match s.split_once(['x', 'X']) {
-        Some((a, b)) => Ok((parse(a)?, parse(b)?)),
-        None => {
-            let n = parse(s)?;
-            Ok((n, n))
-        }
-    }
-}
-
 /// Runs `scanfit turntable`.
 pub fn run(a: TurntableArgs) -> Result<()> {
     a.out.check()?;
@@ -156,7 +142,7 @@ pub fn run(a: TurntableArgs) -> Result<()> {
         other => bail!("unknown --ends '{other}'; use exclude or extend"),
     };
     cfg.refine.projection.weight = weight;
-    cfg.fit.ctrl = ctrl_pair(&a.ctrl)?;
+    cfg.fit.ctrl = pair(&a.ctrl, "--ctrl")?;
     if a.compare_weights && a.compare_rounds == 0 {
         bail!("--compare-rounds must be at least 1");
     }

@@ -4,38 +4,14 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+
+use common::{examples, ok, run, tmpdir};
+
+use std::path::Path;
 
 use scanfit::Vector3;
 use scanfit_io::{read_cloud, ReadOptions};
-
-fn examples() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/data")
-}
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("scanfit-cloud-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_scanfit"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn ok(o: &Output) -> String {
-    assert!(
-        o.status.success(),
-        "failed: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
 
 /// Fraction of non-white pixels and whether any touches the image border.
 fn png_coverage(path: &Path) -> (f64, bool) {
@@ -83,7 +59,7 @@ fn info_reports_counts_bbox_and_spacing_as_json() {
 
 #[test]
 fn normals_of_a_closed_body_point_outwards() {
-    let d = tmpdir("normals");
+    let d = tmpdir("cloud", "normals");
     let (out, png) = (d.join("n.ply"), d.join("n.png"));
     let input = examples().join("blob_30k.ply");
     let o = run(&[
@@ -129,7 +105,7 @@ fn normals_of_a_closed_body_point_outwards() {
 
 #[test]
 fn hpr_keeps_the_near_side() {
-    let d = tmpdir("hpr");
+    let d = tmpdir("cloud", "hpr");
     let (out, png) = (d.join("v.xyz"), d.join("v.png"));
     let input = examples().join("blob_30k.ply");
     let o = run(&[
@@ -165,7 +141,7 @@ fn hpr_keeps_the_near_side() {
 
 #[test]
 fn boundary_finds_the_four_corners_of_the_panel() {
-    let d = tmpdir("boundary");
+    let d = tmpdir("cloud", "boundary");
     let (json, ply, png) = (d.join("b.json"), d.join("b.ply"), d.join("b.png"));
     let input = examples().join("patch_20k.ply");
     for (out, crit) in [(&json, "angle"), (&ply, "curvature")] {
@@ -243,7 +219,7 @@ fn boundary_finds_the_four_corners_of_the_panel() {
 
 #[test]
 fn cloud_commands_reject_bad_input_without_writing() {
-    let d = tmpdir("bad");
+    let d = tmpdir("cloud", "bad");
     let out = d.join("o.ply");
     let nan = d.join("nan.xyz");
     std::fs::write(&nan, "0 0 0\n1 0 0\nnan 1 0\n0 1 1\n1 1 1\n").unwrap();

@@ -4,9 +4,12 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+mod common;
+
+use common::{ok, run, tmpdir};
+
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use scanfit_io::json::read_surface;
 use scanfit_io::{read_cloud, ReadOptions};
@@ -15,36 +18,13 @@ fn patch() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/data/patch_20k.ply")
 }
 
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("scanfit-coons-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_scanfit"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn ok(o: &Output) -> String {
-    assert!(
-        o.status.success(),
-        "failed: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
 #[test]
 fn pde_route_on_the_panel() {
-    let d = tmpdir("pde");
+    let d = tmpdir("coons", "pde");
     let (json, png, pts) = (d.join("s.json"), d.join("s.png"), d.join("p.ply"));
     let out = ok(&run(&[
         "coons",
@@ -105,7 +85,7 @@ fn pde_route_on_the_panel() {
 
 #[test]
 fn bspline_route_with_given_corners_and_table() {
-    let d = tmpdir("bspline");
+    let d = tmpdir("coons", "bspline");
     let first = ok(&run(&["coons", s(&patch()), "--json", "--quiet"]));
     let r: serde_json::Value = serde_json::from_str(&first).unwrap();
     let pos: Vec<String> = r["corners"]
@@ -144,7 +124,7 @@ fn bspline_route_with_given_corners_and_table() {
 
 #[test]
 fn three_sided_patch() {
-    let d = tmpdir("three");
+    let d = tmpdir("coons", "three");
     // a curved triangle: corners (0,0), (10,0), (0,10), sampled on a grid
     let mut text = String::from("x y z\n");
     for i in 0..=60 {
@@ -171,7 +151,7 @@ fn three_sided_patch() {
 
 #[test]
 fn clear_errors_and_no_output() {
-    let d = tmpdir("errors");
+    let d = tmpdir("coons", "errors");
     // a disk has no corners
     let mut text = String::new();
     for r in 1..=15 {

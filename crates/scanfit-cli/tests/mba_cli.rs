@@ -3,39 +3,13 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn examples() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/data")
-}
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("scanfit-mba-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_scanfit"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn ok(o: &Output) -> String {
-    assert!(
-        o.status.success(),
-        "failed: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
+use common::{examples, ok, run, tmpdir};
 
 #[test]
 fn mba_levels_improve_and_the_surface_reads_back() {
-    let d = tmpdir("levels");
+    let d = tmpdir("mba", "levels");
     let (json, mesh, png, step) = (
         d.join("t.json"),
         d.join("t.ply"),
@@ -142,7 +116,7 @@ fn adjusted_mba_never_raises_eq17() {
 
 #[test]
 fn mba_bad_input_is_reported_without_output() {
-    let d = tmpdir("bad");
+    let d = tmpdir("mba", "bad");
     let out = d.join("o.json");
     let line = d.join("line.xyz");
     std::fs::write(&line, "1 0 0\n1 1 1\n1 2 0\n1 3 1\n").unwrap();
@@ -208,7 +182,7 @@ fn mba_bad_input_is_reported_without_output() {
 
 #[test]
 fn export_writes_several_patches_into_one_cad_file() {
-    let d = tmpdir("export");
+    let d = tmpdir("mba", "export");
     let (a, b, c) = (d.join("a.json"), d.join("b.json"), d.join("c.json"));
     let input = examples().join("terrain_50k.xyz");
     ok(&run(&[

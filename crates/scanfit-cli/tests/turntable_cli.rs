@@ -4,39 +4,13 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn examples() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/data")
-}
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("scanfit-turntable-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_scanfit"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn ok(o: &Output) -> String {
-    assert!(
-        o.status.success(),
-        "failed: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
+use common::{examples, ok, run, tmpdir};
 
 #[test]
 fn bottle_with_a_tilted_axis_reads_back() {
-    let d = tmpdir("bottle");
+    let d = tmpdir("turntable", "bottle");
     let (json, png, pts) = (d.join("b.json"), d.join("b.png"), d.join("b.ply"));
     let input = examples().join("bottle_12k.ply");
     let out = ok(&run(&[
@@ -126,7 +100,7 @@ fn weight_comparison_table_on_the_blob() {
 
 #[test]
 fn bad_input_writes_nothing() {
-    let d = tmpdir("bad");
+    let d = tmpdir("turntable", "bad");
     let json = d.join("x.json");
     let input = examples().join("bottle_12k.ply");
     for (args, msg) in [

@@ -250,52 +250,69 @@ pub fn render_scene_png(scene: &PointScene, opts: &RenderOptions) -> Result<Vec<
             }
         }
     }
+    draw_overlay(&mut img, w, h, &scene.polylines, &scene.markers, |p| {
+        let (x, y, _) = view(p);
+        let (px, py) = pixel(x, y);
+        (px as f64, py as f64)
+    });
+    let mut canvas = Canvas {
+        rgb: &mut img,
+        width: w,
+        height: h,
+    };
+    for (k, line) in opts.legend.iter().enumerate() {
+        draw_text(&mut canvas, 8, 6 + 14 * k, line, 1, [20, 20, 20]);
+    }
+    encode_png(&img, w as u32, h as u32)
+}
+
+/// Draws `lines` (2-pixel wide) and labelled `markers` over an image, with
+/// `to_pixel` mapping a world point to pixel coordinates.
+fn draw_overlay(
+    img: &mut [u8],
+    w: usize,
+    h: usize,
+    lines: &[Polyline],
+    markers: &[Marker],
+    to_pixel: impl Fn(&Point3) -> (f64, f64),
+) {
     let put = |x: isize, y: isize, rgb: [u8; 3], img: &mut [u8]| {
         if x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h {
             let k = (y as usize * w + x as usize) * 3;
             img[k..k + 3].copy_from_slice(&rgb);
         }
     };
-    for line in &scene.polylines {
+    for line in lines {
         let n = line.points.len();
         let segments = if line.closed { n } else { n.saturating_sub(1) };
         for s in 0..segments {
-            let (ax, ay, _) = view(&line.points[s]);
-            let (bx, by, _) = view(&line.points[(s + 1) % n]);
-            let (pa, pb) = (pixel(ax, ay), pixel(bx, by));
-            let steps = (pb.0 - pa.0).abs().max((pb.1 - pa.1).abs()).max(1);
+            let (pa, pb) = (
+                to_pixel(&line.points[s]),
+                to_pixel(&line.points[(s + 1) % n]),
+            );
+            let steps = ((pb.0 - pa.0).abs().max((pb.1 - pa.1).abs()).ceil() as usize).max(1);
             for t in 0..=steps {
                 let f = t as f64 / steps as f64;
-                let x = pa.0 as f64 + f * (pb.0 - pa.0) as f64;
-                let y = pa.1 as f64 + f * (pb.1 - pa.1) as f64;
+                let x = (pa.0 + f * (pb.0 - pa.0)).round() as isize;
+                let y = (pa.1 + f * (pb.1 - pa.1)).round() as isize;
                 for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                    put(
-                        x.round() as isize + dx,
-                        y.round() as isize + dy,
-                        line.rgb,
-                        &mut img,
-                    );
+                    put(x + dx, y + dy, line.rgb, img);
                 }
             }
         }
     }
-    for m in &scene.markers {
-        let (x, y, _) = view(&m.at);
-        let (px, py) = pixel(x, y);
+    for m in markers {
+        let (x, y) = to_pixel(&m.at);
+        let (px, py) = (x as isize, y as isize);
         for dy in -6..=6isize {
             for dx in -6..=6isize {
                 let edge = dx.abs() == 6 || dy.abs() == 6;
-                put(
-                    px + dx,
-                    py + dy,
-                    if edge { [0, 0, 0] } else { m.rgb },
-                    &mut img,
-                );
+                put(px + dx, py + dy, if edge { [0, 0, 0] } else { m.rgb }, img);
             }
         }
         if !m.label.is_empty() {
             let mut canvas = Canvas {
-                rgb: &mut img,
+                rgb: img,
                 width: w,
                 height: h,
             };
@@ -309,15 +326,6 @@ pub fn render_scene_png(scene: &PointScene, opts: &RenderOptions) -> Result<Vec<
             );
         }
     }
-    let mut canvas = Canvas {
-        rgb: &mut img,
-        width: w,
-        height: h,
-    };
-    for (k, line) in opts.legend.iter().enumerate() {
-        draw_text(&mut canvas, 8, 6 + 14 * k, line, 1, [20, 20, 20]);
-    }
-    encode_png(&img, w as u32, h as u32)
 }
 
 /// Camera angles `(azimuth, elevation)` in degrees that look along `-n`,
@@ -538,61 +546,10 @@ fn render_rgb_with(
             }
         }
     }
-    let put = |x: isize, y: isize, rgb: [u8; 3], img: &mut [u8]| {
-        if x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h {
-            let k = (y as usize * w + x as usize) * 3;
-            img[k..k + 3].copy_from_slice(&rgb);
-        }
-    };
-    for line in lines {
-        let n = line.points.len();
-        let segments = if line.closed { n } else { n.saturating_sub(1) };
-        for s in 0..segments {
-            let (ax, ay, _) = proj(&line.points[s]);
-            let (bx, by, _) = proj(&line.points[(s + 1) % n]);
-            let (pa, pb) = (to_px(ax, ay), to_px(bx, by));
-            let steps = ((pb.0 - pa.0).abs().max((pb.1 - pa.1).abs()).ceil() as usize).max(1);
-            for t in 0..=steps {
-                let f = t as f64 / steps as f64;
-                let x = (pa.0 + f * (pb.0 - pa.0)).round() as isize;
-                let y = (pa.1 + f * (pb.1 - pa.1)).round() as isize;
-                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1), (-1, 0), (0, -1)] {
-                    put(x + dx, y + dy, line.rgb, &mut img);
-                }
-            }
-        }
-    }
-    for m in markers {
-        let (x, y, _) = proj(&m.at);
-        let (px, py) = to_px(x, y);
-        let (px, py) = (px as isize, py as isize);
-        for dy in -6..=6isize {
-            for dx in -6..=6isize {
-                let edge = dx.abs() == 6 || dy.abs() == 6;
-                put(
-                    px + dx,
-                    py + dy,
-                    if edge { [0, 0, 0] } else { m.rgb },
-                    &mut img,
-                );
-            }
-        }
-        if !m.label.is_empty() {
-            let mut canvas = Canvas {
-                rgb: &mut img,
-                width: w,
-                height: h,
-            };
-            draw_text(
-                &mut canvas,
-                (px + 10).max(0) as usize,
-                (py - 16).max(0) as usize,
-                &m.label,
-                2,
-                [0, 0, 0],
-            );
-        }
-    }
+    draw_overlay(&mut img, w, h, lines, markers, |p| {
+        let (x, y, _) = proj(p);
+        to_px(x, y)
+    });
     if let Colouring::Scalar { range, .. } = colouring {
         colour_bar(&mut img, w, h, range);
     }
