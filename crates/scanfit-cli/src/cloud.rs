@@ -454,11 +454,7 @@ fn normals(a: NormalsArgs) -> Result<()> {
         )?;
         files.push((p.clone(), png));
     }
-    let refs: Vec<(&Path, &[u8])> = files
-        .iter()
-        .map(|(p, b)| (p.as_path(), b.as_slice()))
-        .collect();
-    write_all_atomic(&refs)?;
+    write_all_atomic(&files)?;
     progress.finish();
     let mean_var = r.variation.iter().sum::<f64>() / r.variation.len().max(1) as f64;
     if a.json {
@@ -490,15 +486,6 @@ fn normals(a: NormalsArgs) -> Result<()> {
     for (p, _) in &files {
         println!("wrote {}", p.display());
     }
-    Ok(())
-}
-
-fn write_outputs(files: &[(PathBuf, Vec<u8>)]) -> Result<()> {
-    let refs: Vec<(&Path, &[u8])> = files
-        .iter()
-        .map(|(p, b)| (p.as_path(), b.as_slice()))
-        .collect();
-    write_all_atomic(&refs)?;
     Ok(())
 }
 
@@ -604,7 +591,7 @@ fn hpr(a: HprArgs) -> Result<()> {
         )?;
         files.push((p.clone(), png));
     }
-    write_outputs(&files)?;
+    write_all_atomic(&files)?;
     progress.finish();
     if a.json {
         let report = serde_json::json!({
@@ -852,7 +839,7 @@ fn boundary(a: BoundaryArgs) -> Result<()> {
         )?;
         files.push((p.clone(), png));
     }
-    write_outputs(&files)?;
+    write_all_atomic(&files)?;
     progress.finish();
     if a.json {
         println!("{}", serde_json::to_string_pretty(&doc)?);

@@ -2,7 +2,7 @@
 //! bilinearly blended Coons patch, parameters, then either the Coons paper's
 //! least-squares B-spline surface or the PDE paper's deformation surface.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
@@ -21,14 +21,13 @@ use scanfit::pde::{fit_pde, BsplineConversionConfig, PdeConfig};
 use scanfit::project::{GridIterationConfig, InversionConfig, SurfaceInverter};
 use scanfit::Point3;
 use scanfit_io::json::{Provenance, SurfaceDoc, SurfaceQualityDoc};
-use scanfit_io::ply::{points_ply, points_xyz, PlyFormat};
 use scanfit_io::render::{Marker, Polyline};
 use scanfit_io::write_all_atomic;
 
 use crate::args::pair;
 use crate::cloud::InputArgs;
 use crate::outputs::{
-    check_extensions, print_written, Deviation, Picture, PngStyle, SurfaceOutputArgs,
+    check_extensions, points_file, print_written, Deviation, Picture, PngStyle, SurfaceOutputArgs,
 };
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -431,21 +430,9 @@ pub fn run(a: CoonsArgs) -> Result<()> {
             ("distance", &dist),
             ("outside", &outside),
         ];
-        let bytes = if pout
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("ply"))
-        {
-            points_ply(pts, &attrs, PlyFormat::Binary)
-        } else {
-            points_xyz(pts, &attrs)
-        };
-        files.push((pout.clone(), bytes));
+        files.push((pout.clone(), points_file(pout, pts, &attrs)));
     }
-    let refs: Vec<(&Path, &[u8])> = files
-        .iter()
-        .map(|(p, b)| (p.as_path(), b.as_slice()))
-        .collect();
-    write_all_atomic(&refs)?;
+    write_all_atomic(&files)?;
     progress.finish();
 
     let (cu, cv) = surface.counts();

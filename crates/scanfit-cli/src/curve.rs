@@ -289,8 +289,7 @@ fn fit_cmd(a: FitArgs) -> Result<()> {
         CadItem::Curve(&fit.curve),
         &a.input,
     )?);
-    let refs: Vec<(&Path, &[u8])> = files.iter().map(|(p, b)| (*p, b.as_slice())).collect();
-    write_all_atomic(&refs)?;
+    write_all_atomic(&files)?;
     if a.json {
         let report = FitReport {
             input: a.input.display().to_string(),
@@ -464,8 +463,7 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
     if let Some(png) = &a.png {
         files.push((png, curve_panels_png(&panels, 4, &title, PanelSize::GRID)?));
     }
-    let refs: Vec<(&Path, &[u8])> = files.iter().map(|(p, b)| (*p, b.as_slice())).collect();
-    write_all_atomic(&refs)?;
+    write_all_atomic(&files)?;
 
     if a.json {
         let rows: Vec<CompareRow> = results

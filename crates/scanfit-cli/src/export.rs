@@ -95,8 +95,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
     if let Some(i) = &a.iges {
         files.push((i, iges_file(&cad, &name)?.into_bytes()));
     }
-    let refs: Vec<(&Path, &[u8])> = files.iter().map(|(p, b)| (*p, b.as_slice())).collect();
-    write_all_atomic(&refs)?;
+    write_all_atomic(&files)?;
     let (nc, ns) = items.iter().fold((0, 0), |(c, s), i| match i {
         Item::Curve(_) => (c + 1, s),
         Item::Surface(_) => (c, s + 1),

@@ -3,7 +3,6 @@
 //! paper's projection adjustment of control points.
 
 use std::collections::BTreeMap;
-use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
@@ -267,11 +266,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
         &input,
         &Picture::default(),
     )?;
-    let refs: Vec<(&Path, &[u8])> = files
-        .iter()
-        .map(|(p, b)| (p.as_path(), b.as_slice()))
-        .collect();
-    write_all_atomic(&refs)?;
+    write_all_atomic(&files)?;
     progress.finish();
     if a.json {
         let report = serde_json::json!({

@@ -12,7 +12,7 @@ use scanfit::metrics::{nearest_points, ErrorStats};
 use scanfit::Point3;
 use scanfit_io::gltf::mesh_glb;
 use scanfit_io::json::SurfaceDoc;
-use scanfit_io::ply::{mesh_obj, mesh_ply, PlyFormat};
+use scanfit_io::ply::{mesh_obj, mesh_ply, points_ply, points_xyz, PlyFormat};
 use scanfit_io::render::{
     render_surface_scene_png, viridis, Colouring, Marker, Polyline, RenderOptions,
 };
@@ -254,6 +254,16 @@ impl SurfaceOutputArgs {
             files.push((png.clone(), bytes));
         }
         Ok((files, exaggeration))
+    }
+}
+
+/// The bytes of a point file with per-point attributes: binary PLY for
+/// `.ply`, XYZ text otherwise (the callers check the extension first).
+pub fn points_file(path: &Path, points: &[Point3], attributes: &[(&str, &[f64])]) -> Vec<u8> {
+    if extension(path) == "ply" {
+        points_ply(points, attributes, PlyFormat::Binary)
+    } else {
+        points_xyz(points, attributes)
     }
 }
 

@@ -1,6 +1,6 @@
 //! `scanfit fit`: a least-squares B-spline surface through scattered points.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 use clap::Args;
@@ -14,11 +14,10 @@ use scanfit::metrics::{
 };
 use scanfit::project::{InversionConfig, SurfaceInverter};
 use scanfit_io::json::{Provenance, SurfaceDoc, SurfaceQualityDoc};
-use scanfit_io::ply::{points_ply, points_xyz, PlyFormat};
 use scanfit_io::{read_points, write_all_atomic};
 
 use crate::args::pair;
-use crate::outputs::{check_extensions, extension, print_written, Deviation, Picture};
+use crate::outputs::{check_extensions, points_file, print_written, Deviation, Picture};
 use crate::progress::Progress;
 use crate::table::{num, Table};
 
@@ -218,18 +217,9 @@ pub fn run(a: FitArgs) -> Result<()> {
             ("residual", &resid),
             ("distance", &dist),
         ];
-        let bytes = if extension(pout) == "ply" {
-            points_ply(pts, &attrs, PlyFormat::Binary)
-        } else {
-            points_xyz(pts, &attrs)
-        };
-        files.push((pout.clone(), bytes));
+        files.push((pout.clone(), points_file(pout, pts, &attrs)));
     }
-    let refs: Vec<(&Path, &[u8])> = files
-        .iter()
-        .map(|(p, b)| (p.as_path(), b.as_slice()))
-        .collect();
-    write_all_atomic(&refs)?;
+    write_all_atomic(&files)?;
     progress.finish();
     if a.json {
         let report = serde_json::json!({

@@ -3,7 +3,6 @@
 //! B-spline surface closed around the axis.
 
 use std::collections::BTreeMap;
-use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
@@ -252,11 +251,7 @@ pub fn run(a: TurntableArgs) -> Result<()> {
             .with_attribute("deviation", t.distances.clone())?;
         files.push((p.clone(), crate::cloud::cloud_file(p, &out)?));
     }
-    let refs: Vec<(&Path, &[u8])> = files
-        .iter()
-        .map(|(p, b)| (p.as_path(), b.as_slice()))
-        .collect();
-    write_all_atomic(&refs)?;
+    write_all_atomic(&files)?;
     progress.finish();
     let (cu, cv) = cfg.fit.ctrl;
     if a.json {

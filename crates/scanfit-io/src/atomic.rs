@@ -15,7 +15,9 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 /// Writes several files as a group: every content goes to its temporary file
 /// first, and only when all of them are written are they renamed into place.
 /// If any write fails, no target is touched and the temporaries are removed.
-pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<()> {
+/// Paths and contents may be owned or borrowed (`(PathBuf, Vec<u8>)`,
+/// `(&Path, &[u8])`, ...).
+pub fn write_all_atomic<P: AsRef<Path>, B: AsRef<[u8]>>(files: &[(P, B)]) -> Result<()> {
     let mut staged: Vec<(std::path::PathBuf, &Path)> = Vec::new();
     let cleanup = |staged: &[(std::path::PathBuf, &Path)]| {
         for (tmp, _) in staged {
@@ -23,6 +25,7 @@ pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<()> {
         }
     };
     for (path, bytes) in files {
+        let (path, bytes) = (path.as_ref(), bytes.as_ref());
         let dir = match path.parent() {
             Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
             _ => std::path::PathBuf::from("."),

@@ -98,6 +98,25 @@ impl Column<'_> {
     }
 }
 
+/// Runs the caller's local macro `$run!(T)` with the Rust type `T` of the
+/// scalar type `$scalar` (one monomorphised decoding loop per type).
+macro_rules! by_scalar {
+    ($scalar:expr, $run:ident) => {
+        match $scalar {
+            Scalar::I8 => $run!(i8),
+            Scalar::U8 => $run!(u8),
+            Scalar::I16 => $run!(i16),
+            Scalar::U16 => $run!(u16),
+            Scalar::I32 => $run!(i32),
+            Scalar::U32 => $run!(u32),
+            Scalar::I64 => $run!(i64),
+            Scalar::U64 => $run!(u64),
+            Scalar::F32 => $run!(f32),
+            Scalar::F64 => $run!(f64),
+        }
+    };
+}
+
 /// Decodes `n` values of a column as `f64`.
 pub(crate) fn decode_column(c: Column<'_>, n: usize) -> Vec<f64> {
     let mut out = Vec::new();
@@ -121,18 +140,7 @@ pub(crate) fn decode_column(c: Column<'_>, n: usize) -> Vec<f64> {
             }
         }};
     }
-    match c.ty {
-        Scalar::I8 => run!(i8),
-        Scalar::U8 => run!(u8),
-        Scalar::I16 => run!(i16),
-        Scalar::U16 => run!(u16),
-        Scalar::I32 => run!(i32),
-        Scalar::U32 => run!(u32),
-        Scalar::I64 => run!(i64),
-        Scalar::U64 => run!(u64),
-        Scalar::F32 => run!(f32),
-        Scalar::F64 => run!(f64),
-    }
+    by_scalar!(c.ty, run);
     out
 }
 
@@ -192,18 +200,7 @@ pub(crate) fn decode_points(x: Column<'_>, y: Column<'_>, z: Column<'_>, n: usiz
             }
         }};
     }
-    match x.ty {
-        Scalar::I8 => run!(i8),
-        Scalar::U8 => run!(u8),
-        Scalar::I16 => run!(i16),
-        Scalar::U16 => run!(u16),
-        Scalar::I32 => run!(i32),
-        Scalar::U32 => run!(u32),
-        Scalar::I64 => run!(i64),
-        Scalar::U64 => run!(u64),
-        Scalar::F32 => run!(f32),
-        Scalar::F64 => run!(f64),
-    }
+    by_scalar!(x.ty, run);
     out
 }
 
