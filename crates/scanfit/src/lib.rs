@@ -35,6 +35,7 @@ pub mod mba;
 pub mod metrics;
 pub mod param;
 pub mod pde;
+pub mod progress;
 pub mod project;
 pub mod quality;
 
