@@ -1,0 +1,307 @@
+//! The Coons pipeline: one patch of points to a surface, by the Coons paper
+//! ([COONS] in `docs/references.md`) or the PDE paper ([PDE]).
+//!
+//! 1. boundary loop of the points (alpha shape in their best-fit plane, [PDE] 4.1);
+//! 2. corners (smallest turning angle, [COONS] eqs. 10-12, or three-point
+//!    curvature, [PDE] 4.1), or given loop positions;
+//! 3. one B-spline per side ([PDE] 4.2) and the bilinearly blended Coons
+//!    patch on them ([COONS] eq. 16, [PDE] eq. 1; three-sided with one side
+//!    collapsed to the first corner);
+//! 4. parameters on the patch: the nearest grid vertex and the iteration of
+//!    [COONS] eqs. 17-22, or the exact closest point ([PDE] 4.4);
+//! 5. either the least-squares B-spline surface on those parameters
+//!    ([`CoonsRoute::Bspline`], [COONS]) or the thin-plate PDE deformation
+//!    `S = S_c + S_PDE` fitted by least squares ([`CoonsRoute::Pde`], [PDE]
+//!    eqs. 11-14), exported as a B-spline within a tolerance;
+//! 6. errors: [PDE] eq. 15 (`|P - S(u, v)|` at the parameters) for the patch
+//!    and the result, and the [`SurfaceQuality`] of the exported surface
+//!    (orthogonal distances both ways, fold-overs, grid RMSE).
+
+use crate::base::{
+    coons_from_cloud, coons_parameters, CoonsFromCloud, CoonsFromCloudConfig, CoonsParamConfig,
+    CoonsParameters, CoonsProjection,
+};
+use crate::bspline::Surface;
+use crate::fit::surface::{fit_surface, SurfaceFitConfig};
+use crate::metrics::{parametric_distances, ErrorStats};
+use crate::pde::{fit_pde, BsplineConversionConfig, PdeConfig, PdeFit};
+use crate::progress::Progress;
+use crate::project::{GridIterationConfig, InversionConfig};
+use crate::{Error, PointCloud, Result};
+
+use super::assess::{assess_surface, AssessConfig, Assessment};
+
+/// Which surface is fitted on the Coons patch's parameters.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum CoonsRoute {
+    /// The Coons paper: a least-squares B-spline surface on the parameters
+    /// (degree and control net from the config; periodicity is ignored).
+    Bspline(SurfaceFitConfig),
+    /// The PDE paper: `S = S_c + S_PDE` with `M x N` sine terms ([PDE] eqs.
+    /// 11-14), exported as a B-spline.
+    Pde {
+        /// Terms and rigidity (paper: 5 x 5, D = 1).
+        pde: PdeConfig,
+        /// Largest deviation of the exported B-spline from `S`, data units;
+        /// `None` (default): `1e-4` x the bounding-box diagonal of the points.
+        export_tolerance: Option<f64>,
+    },
+}
+
+impl CoonsRoute {
+    /// The Coons paper's route: bicubic, 20 x 20 control points.
+    pub fn bspline(degree: (usize, usize), ctrl: (usize, usize)) -> Self {
+        Self::Bspline(SurfaceFitConfig {
+            degree,
+            ctrl,
+            ..Default::default()
+        })
+    }
+
+    /// The PDE paper's route with `m x n` terms, rigidity 1 and the default
+    /// export tolerance.
+    pub fn pde(m: usize, n: usize) -> Self {
+        Self::Pde {
+            pde: PdeConfig { m, n, d: 1.0 },
+            export_tolerance: None,
+        }
+    }
+
+    /// One line that says what the route fits, e.g. "Coons patch + PDE
+    /// deformation, 5 x 5 terms (PDE paper)".
+    pub fn describe(&self) -> String {
+        match self {
+            Self::Bspline(f) => format!(
+                "least-squares B-spline surface, {} x {} control points (Coons paper)",
+                f.ctrl.0, f.ctrl.1
+            ),
+            Self::Pde { pde, .. } => format!(
+                "Coons patch + PDE deformation, {} x {} terms (PDE paper)",
+                pde.m, pde.n
+            ),
+        }
+    }
+
+    /// The projection this route uses when the config names none: the Coons
+    /// paper's grid iteration for the B-spline route, the exact closest
+    /// point for the PDE route (as each paper does).
+    pub fn default_projection(&self) -> CoonsProjection {
+        match self {
+            Self::Bspline(_) => CoonsProjection::GridIteration(GridIterationConfig::default()),
+            Self::Pde { .. } => CoonsProjection::Inversion(InversionConfig::default()),
+        }
+    }
+}
+
+impl Default for CoonsRoute {
+    fn default() -> Self {
+        Self::bspline((3, 3), (20, 20))
+    }
+}
+
+/// Settings of [`run`], with the papers' defaults.
+#[derive(Debug, Clone, PartialEq, Default)]
+#[non_exhaustive]
+pub struct CoonsConfig {
+    /// Boundary (alpha 2.5 x median Delaunay edge), corners (4, smallest
+    /// turning angle), given corner positions (none) and boundary curves
+    /// (cubic, end-pinned least squares).
+    pub base: CoonsFromCloudConfig,
+    /// The surface fitted on the parameters (default: B-spline, bicubic, 20 x 20).
+    pub route: CoonsRoute,
+    /// How the points get their parameters; `None` (default): the route's
+    /// [`CoonsRoute::default_projection`].
+    pub projection: Option<CoonsProjection>,
+    /// Tangential offset beyond the boundary above which a point counts as
+    /// outside the patch; `None` (default): `1e-3` x the diagonal of the
+    /// patch's control-net bounding box.
+    pub outside_tolerance: Option<f64>,
+    /// The assessment of the resulting surface (orthogonal distances by
+    /// point inversion, the sample grid of the surface-to-points direction).
+    pub assess: AssessConfig,
+}
+
+impl CoonsConfig {
+    /// The projection [`run`] uses: the configured one, or the route's default.
+    pub fn projection(&self) -> CoonsProjection {
+        self.projection
+            .unwrap_or_else(|| self.route.default_projection())
+    }
+}
+
+/// What the PDE route adds to the report.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct PdeOutcome {
+    /// The fitted PDE surface with its eq. 15 errors and residuals.
+    pub fit: PdeFit,
+    /// The export tolerance used (data units).
+    pub export_tolerance: f64,
+    /// Largest deviation of the exported B-spline from the PDE surface.
+    pub export_deviation: f64,
+}
+
+/// Everything [`run`] produced.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct CoonsReport {
+    /// The Coons patch and what was found on the way: boundary loops,
+    /// corners with their turning angles, side points, boundary curves.
+    pub base: CoonsFromCloud,
+    /// The Coons patch in B-spline form (domain `[0, 1]^2`).
+    pub coons_surface: Surface,
+    /// The projection that gave the parameters.
+    pub projection: CoonsProjection,
+    /// The points' parameters on the patch, with the outside flags.
+    pub parameters: CoonsParameters,
+    /// `|P_i - S_c(u_i, v_i)|` per point ([PDE] eq. 15 for the patch alone).
+    pub coons_distances: Vec<f64>,
+    /// Their statistics.
+    pub coons_errors: ErrorStats,
+    /// One line naming the route (as [`CoonsRoute::describe`]).
+    pub route: String,
+    /// The PDE surface and its export, on the PDE route.
+    pub pde: Option<PdeOutcome>,
+    /// The resulting B-spline surface (the exported form on the PDE route).
+    pub surface: Surface,
+    /// The assessment of the resulting surface: orthogonal distances from
+    /// the points and from surface samples to the points, fold-overs, the
+    /// grid RMSE. Its `at_parameters` is [PDE] eq. 15 of the fitted surface
+    /// (of the PDE surface itself on the PDE route); its `residuals` are
+    /// `|P_i - S(u_i, v_i)|` on the resulting B-spline surface.
+    pub assessment: Assessment,
+}
+
+impl CoonsReport {
+    /// `"grid"` (the Coons paper's grid iteration) or `"closest"` (exact
+    /// closest point): the name the command line uses for the projection.
+    pub fn projection_name(&self) -> &'static str {
+        projection_name(&self.projection)
+    }
+}
+
+/// `"grid"` or `"closest"` for a projection.
+pub fn projection_name(p: &CoonsProjection) -> &'static str {
+    match p {
+        CoonsProjection::GridIteration(_) => "grid",
+        CoonsProjection::Inversion(_) => "closest",
+    }
+}
+
+/// Stages of [`run`], as reported to the progress callback.
+pub const STAGES: [&str; 5] = [
+    "boundary and corners",
+    "parameters on the Coons patch",
+    "surface fit",
+    "B-spline form of the PDE surface",
+    "assessment (orthogonal distances)",
+];
+
+/// Runs the Coons pipeline on `cloud` (see the module documentation).
+///
+/// Errors: whatever [`coons_from_cloud`] refuses (too few points, a boundary
+/// with fewer corners than asked, bad corner positions), a failed
+/// projection or fit (too few points for the control net or the sine
+/// terms), and a non-positive export tolerance.
+///
+/// ```
+/// use scanfit::pipeline::coons::{run, CoonsConfig, CoonsRoute};
+/// use scanfit::progress::NoProgress;
+/// use scanfit::{Point3, PointCloud};
+///
+/// // a gently curved 10 x 7 panel on a 41 x 29 grid
+/// let mut pts = Vec::new();
+/// for i in 0..=40 {
+///     for j in 0..=28 {
+///         let (x, y) = (i as f64 * 0.25, j as f64 * 0.25);
+///         pts.push(Point3::new(x, y, 0.02 * x * y));
+///     }
+/// }
+/// let cloud = PointCloud::new(pts)?;
+/// let mut cfg = CoonsConfig::default();
+/// cfg.route = CoonsRoute::pde(4, 4);
+/// let r = run(&cloud, &cfg, &NoProgress)?;
+/// assert_eq!(r.base.corners.corners.len(), 4);
+/// // a bilinear patch z = 0.02 x y is its own Coons patch
+/// let e = r.assessment.quality.at_parameters;
+/// assert!(e.max < 1e-3, "{e:?}");
+/// assert_eq!(r.projection_name(), "closest");
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+pub fn run(
+    cloud: &PointCloud,
+    config: &CoonsConfig,
+    progress: &dyn Progress,
+) -> Result<CoonsReport> {
+    let pts = cloud.points();
+    progress.stage(STAGES[0], None);
+    let base = coons_from_cloud(pts, &config.base)?;
+    let coons_surface = base.patch.to_bspline()?;
+    progress.stage(STAGES[1], None);
+    let projection = config.projection();
+    let parameters = coons_parameters(
+        &coons_surface,
+        pts,
+        &CoonsParamConfig {
+            projection,
+            outside_tolerance: config.outside_tolerance,
+        },
+    )?;
+    let coons_distances = parametric_distances(&coons_surface, pts, &parameters.uv);
+    let coons_errors = ErrorStats::of(&coons_distances);
+    progress.stage(STAGES[2], None);
+    let (surface, pde) = match &config.route {
+        CoonsRoute::Bspline(fit) => {
+            let s = fit_surface(
+                pts,
+                &parameters.uv,
+                &SurfaceFitConfig {
+                    periodic_u: false,
+                    ..fit.clone()
+                },
+            )?;
+            (s, None)
+        }
+        CoonsRoute::Pde {
+            pde,
+            export_tolerance,
+        } => {
+            let f = fit_pde(&base.patch, pts, &parameters.uv, pde)?;
+            let tol = export_tolerance.unwrap_or(1e-4 * cloud.diagonal());
+            if !(tol.is_finite() && tol > 0.0) {
+                return Err(Error::InvalidInput(format!(
+                    "export tolerance {tol}: the B-spline form of the PDE surface needs a positive tolerance (in data units)"
+                )));
+            }
+            progress.stage(STAGES[3], None);
+            let b = f.surface.to_bspline(&BsplineConversionConfig::new(tol))?;
+            (
+                b.surface,
+                Some(PdeOutcome {
+                    fit: f,
+                    export_tolerance: tol,
+                    export_deviation: b.max_deviation,
+                }),
+            )
+        }
+    };
+    progress.stage(STAGES[4], None);
+    let mut assessment = assess_surface(&surface, pts, &parameters.uv, &config.assess)?;
+    if let Some(p) = &pde {
+        // [PDE] eq. 15 is measured on S itself, not on its B-spline form
+        assessment.quality.at_parameters = p.fit.errors;
+    }
+    Ok(CoonsReport {
+        route: config.route.describe(),
+        base,
+        coons_surface,
+        projection,
+        parameters,
+        coons_distances,
+        coons_errors,
+        pde,
+        surface,
+        assessment,
+    })
+}

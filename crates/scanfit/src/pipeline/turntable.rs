@@ -1,0 +1,189 @@
+//! The turntable pipeline: the virtual turntable parameterization of a
+//! cylinder-like cloud and a least-squares B-spline surface closed around its
+//! axis ([TURN] in `docs/references.md`; the stages are those of
+//! [`base::turntable`](crate::base::turntable)), optionally the paper's
+//! comparison of the directed projection's weight factors (its Tables 1-2:
+//! eq. 19 against eqs. 15 and 16 from the same layer curves), and the
+//! [`SurfaceQuality`](super::assess::SurfaceQuality) of the fitted surface
+//! over the points that entered the fit.
+
+use crate::base::turntable::{compare_weights, turntable, Turntable, STAGES};
+use crate::metrics::ErrorStats;
+use crate::progress::Progress;
+use crate::project::WeightFactor;
+use crate::{Error, Point3, PointCloud, Result};
+
+use super::assess::{assess_surface, AssessConfig, Assessment};
+
+/// Most rounds of the weight comparison (each round projects every layer
+/// sample once per weight factor).
+pub const MAX_COMPARE_ROUNDS: usize = 1000;
+
+/// The weight comparison of [TURN] Tables 1-2.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct WeightComparison {
+    /// Projection rounds (default 5; 1 to [`MAX_COMPARE_ROUNDS`]).
+    pub rounds: usize,
+    /// The weight factors compared (default eq. 19, eq. 15, eq. 16).
+    pub weights: Vec<WeightFactor>,
+}
+
+impl Default for WeightComparison {
+    fn default() -> Self {
+        Self {
+            rounds: 5,
+            weights: vec![WeightFactor::Moon, WeightFactor::Aza04, WeightFactor::As05],
+        }
+    }
+}
+
+impl WeightComparison {
+    /// The default comparison with `rounds` rounds.
+    pub fn with_rounds(rounds: usize) -> Self {
+        Self {
+            rounds,
+            ..Default::default()
+        }
+    }
+}
+
+/// Settings of [`run`], with the paper's defaults.
+#[derive(Debug, Clone, PartialEq, Default)]
+#[non_exhaustive]
+pub struct TurntableConfig {
+    /// The turntable itself: axis (principal), views (4), layers (40, eq.
+    /// 19), refinement (2 rounds), the final fit (bicubic 40 x 40, periodic
+    /// in `u`) and what happens beyond the end layers (left out of the fit).
+    pub turntable: crate::base::turntable::TurntableConfig,
+    /// Compare the weight factors on the same layer curves (default: no).
+    pub compare_weights: Option<WeightComparison>,
+    /// The assessment of the fitted surface.
+    pub assess: AssessConfig,
+}
+
+/// RMSE of the layer samples' nearest-point distances per projection round
+/// (round 0 first) for one weight factor.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WeightRounds {
+    /// The weight factor.
+    pub weight: WeightFactor,
+    /// RMSE before any round, then after each.
+    pub rmse: Vec<f64>,
+}
+
+/// Everything [`run`] produced.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct TurntableReport {
+    /// The turntable's results: frame, views, layer curves, base surface,
+    /// parameters of every point, the fitted surface and its point and
+    /// surface-to-cloud errors, fold-overs.
+    pub turntable: Turntable,
+    /// `|P_i - S(u_i, v_i)|` over the fitted points.
+    pub parametric: ErrorStats,
+    /// The assessment of the fitted surface over the fitted points (with
+    /// their parameters).
+    pub assessment: Assessment,
+    /// The weight comparison, when asked for.
+    pub weight_comparison: Option<Vec<WeightRounds>>,
+}
+
+impl TurntableReport {
+    /// The fitted points (the points with `fitted` set) and their parameters.
+    pub fn fitted_points(&self, cloud: &PointCloud) -> (Vec<Point3>, Vec<[f64; 2]>) {
+        fitted_subset(cloud, &self.turntable)
+    }
+}
+
+fn fitted_subset(cloud: &PointCloud, t: &Turntable) -> (Vec<Point3>, Vec<[f64; 2]>) {
+    cloud
+        .points()
+        .iter()
+        .zip(&t.uv)
+        .zip(&t.fitted)
+        .filter(|(_, &f)| f)
+        .map(|((p, uv), _)| (*p, *uv))
+        .unzip()
+}
+
+/// Runs the turntable pipeline on `cloud`: the stages of
+/// [`base::turntable::turntable`](crate::base::turntable::turntable), each
+/// reported to `progress` by its name in [`STAGES`], then the weight
+/// comparison (stage "weight factor comparison") and the assessment
+/// (stage "assessment").
+///
+/// Errors: everything the turntable refuses (a zero axis, views outside
+/// 3..=64, layers outside 2..=4096, more than 100 refinement rounds, too few
+/// points for the control net), and a weight comparison with no weight or
+/// with rounds outside `1..=`[`MAX_COMPARE_ROUNDS`].
+///
+/// ```
+/// use scanfit::pipeline::turntable::{run, TurntableConfig, WeightComparison};
+/// use scanfit::progress::NoProgress;
+/// use scanfit::{Point3, PointCloud};
+///
+/// // a noise-free cylinder of radius 10 and height 40 around z
+/// let mut pts = Vec::new();
+/// for j in 0..80 {
+///     for i in 0..120 {
+///         let t = i as f64 / 120.0 * std::f64::consts::TAU + 0.01 * j as f64;
+///         pts.push(Point3::new(10.0 * t.cos(), 10.0 * t.sin(), j as f64 * 0.5));
+///     }
+/// }
+/// let mut cfg = TurntableConfig::default();
+/// cfg.turntable.fit.ctrl = (16, 12);
+/// cfg.compare_weights = Some(WeightComparison::with_rounds(2));
+/// let r = run(&PointCloud::new(pts)?, &cfg, &NoProgress)?;
+/// assert_eq!(r.turntable.surface.periodic(), (true, false));
+/// assert!(r.assessment.quality.orthogonal.rmse < 0.05);
+/// assert_eq!(r.weight_comparison.map(|c| c.len()), Some(3));
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+pub fn run(
+    cloud: &PointCloud,
+    config: &TurntableConfig,
+    progress: &dyn Progress,
+) -> Result<TurntableReport> {
+    if let Some(c) = &config.compare_weights {
+        if c.rounds == 0 || c.rounds > MAX_COMPARE_ROUNDS {
+            return Err(Error::InvalidInput(format!(
+                "{} rounds of the weight comparison: give 1 to {MAX_COMPARE_ROUNDS} (the paper's tables show 5)",
+                c.rounds
+            )));
+        }
+        if c.weights.is_empty() {
+            return Err(Error::InvalidInput(
+                "a weight comparison without weight factors: name at least one (moon, aza04, as05)"
+                    .into(),
+            ));
+        }
+    }
+    let cfg = &config.turntable;
+    let t = turntable(cloud, cfg, &mut |i| {
+        progress.stage(STAGES.get(i).copied().unwrap_or("turntable"), None);
+        progress.advance(1);
+    })?;
+    let weight_comparison = match &config.compare_weights {
+        Some(c) => {
+            progress.stage("weight factor comparison", None);
+            let r = compare_weights(cloud, &t.frame, &t.loops, &cfg.layers, c.rounds, &c.weights)?;
+            Some(
+                r.into_iter()
+                    .map(|(weight, rmse)| WeightRounds { weight, rmse })
+                    .collect(),
+            )
+        }
+        None => None,
+    };
+    progress.stage("assessment", None);
+    let (fp, fuv) = fitted_subset(cloud, &t);
+    let assessment = assess_surface(&t.surface, &fp, &fuv, &config.assess)?;
+    let parametric = assessment.quality.at_parameters;
+    Ok(TurntableReport {
+        turntable: t,
+        parametric,
+        assessment,
+        weight_comparison,
+    })
+}
