@@ -69,7 +69,16 @@ fn main() {
         }
         default_hook(info);
     }));
-    let cli = Cli::parse();
+    // a value refused by a typed option parser is bad input (status 1, like
+    // any other); a malformed command line is a usage error (clap's status 2)
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) if e.kind() == clap::error::ErrorKind::ValueValidation => {
+            let _ = e.print();
+            std::process::exit(1);
+        }
+        Err(e) => e.exit(),
+    };
     let result = match cli.command {
         Command::Cloud(c) => cloud::run(c),
         Command::Coons(a) => coons::run(a),

@@ -39,7 +39,7 @@ of the distances from the grid points at the knots to their nearest data point."
 #[command(after_help = EXAMPLES)]
 pub struct MbaArgs {
     #[command(flatten)]
-    pub input: crate::cloud::InputArgs,
+    pub input: crate::args::InputArgs,
     /// Cells of the first lattice, "MxN" (control net (M+3) x (N+3))
     /// [default: 1 along the shorter side, the aspect ratio along the longer].
     #[arg(long, value_name = "MxN")]
@@ -128,10 +128,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
     };
     let progress = Progress::spinner(a.quiet || a.json);
     progress.stage(format!("reading {}", a.input.input.display()));
-    let (cloud, dropped) = a.input.load()?;
-    if dropped > 0 && !a.json {
-        eprintln!("note: {dropped} points with NaN or infinite coordinates dropped");
-    }
+    let cloud = a.input.load(a.json)?;
     let pts = cloud.points();
     let input = a.input.input.clone();
     let t0 = Instant::now();

@@ -3,22 +3,24 @@
 //! or glb) carrying the local fit error, a shaded picture with the points
 //! and a picture coloured by the fit error.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Result};
 use clap::Args;
 use scanfit::bspline::{tessellate, Surface};
 use scanfit::metrics::{nearest_points, ErrorStats};
+use scanfit::pipeline::SurfaceQuality;
 use scanfit::Point3;
 use scanfit_io::gltf::mesh_glb;
-use scanfit_io::json::SurfaceDoc;
+use scanfit_io::json::{Provenance, SurfaceDoc, SurfaceQualityDoc};
 use scanfit_io::ply::{mesh_obj, mesh_ply, points_ply, points_xyz, PlyFormat};
 use scanfit_io::render::{
     render_surface_scene_png, viridis, Colouring, Marker, Polyline, RenderOptions,
 };
 use scanfit_io::step::CadItem;
 
-use crate::table::num;
+use crate::table::{num, Table};
 
 /// `-o`, `--step`, `--iges`, `--mesh`, `--png`, `--deviation-png` and the camera.
 #[derive(Args, Debug)]
@@ -279,4 +281,100 @@ pub fn print_written(files: &Files, png: Option<&Path>, exaggeration: f64) {
             println!("wrote {}", p.display());
         }
     }
+}
+
+/// The JSON quality record of a surface: the library's one assessment
+/// ([`SurfaceQuality`]) in the schema's field names, with the RMSE after each
+/// parameter-correction round (empty when there were none).
+#[allow(dead_code)] // used as the handlers move onto scanfit::pipeline
+pub fn quality_doc(q: &SurfaceQuality, correction_rmse: Vec<f64>) -> SurfaceQualityDoc {
+    SurfaceQualityDoc {
+        points: q.points,
+        mean_error: q.at_parameters.mean,
+        max_error: q.at_parameters.max,
+        rmse: q.at_parameters.rmse,
+        mean_distance: q.orthogonal.mean,
+        max_distance: q.orthogonal.max,
+        rmse_distance: q.orthogonal.rmse,
+        unconverged: q.unconverged,
+        grid_rmse: q.grid_rmse,
+        triangles: q.parameterization.triangles,
+        fold_overs: q.parameterization.fold_overs,
+        l2_stretch: q.parameterization.l2_stretch,
+        max_anisotropy: q.parameterization.max_anisotropy,
+        correction_rmse,
+    }
+}
+
+/// The surface-to-points measures of [`SurfaceQuality`] for `--json`
+/// reports (the surface document's schema has no place for them).
+#[allow(dead_code)] // used as the handlers move onto scanfit::pipeline
+pub fn samples_json(q: &SurfaceQuality) -> serde_json::Value {
+    let s = &q.samples_to_points;
+    serde_json::json!({
+        "samples": s.stats.count,
+        "grid": [s.grid.0, s.grid.1],
+        "mean": s.stats.mean,
+        "max": s.stats.max,
+        "rmse": s.stats.rmse,
+        "point_spacing": s.spacing,
+        "far_spacings": s.far_spacings,
+        "far_share": s.far_share,
+    })
+}
+
+/// The provenance every command writes into its documents: this tool and
+/// version, what ran (`operation`), how the points got their parameters,
+/// the input file, the point count and the settings.
+#[allow(dead_code)] // used as the handlers move onto scanfit::pipeline
+pub fn provenance(
+    operation: impl Into<String>,
+    parameterization: Option<String>,
+    input: &Path,
+    point_count: usize,
+    settings: BTreeMap<String, serde_json::Value>,
+) -> Provenance {
+    Provenance {
+        tool: format!("scanfit {}", env!("CARGO_PKG_VERSION")),
+        operation: operation.into(),
+        parameterization,
+        input: Some(input.display().to_string()),
+        point_count: Some(point_count),
+        settings,
+    }
+}
+
+/// The rows every surface error table ends with: the orthogonal distance
+/// of the points to the surface, the MBA paper's eq. 17 and the surface
+/// samples' distance to the nearest point with the share beyond
+/// `far_spacings` point spacings. `eq17` labels the eq. 17 row.
+#[allow(dead_code)] // used as the handlers move onto scanfit::pipeline
+pub fn quality_rows(t: &mut Table, q: &SurfaceQuality, eq17: &str) {
+    let data = || "data units".to_string();
+    t.row(vec![
+        "orthogonal distance to the surface".into(),
+        num(q.orthogonal.mean),
+        num(q.orthogonal.max),
+        num(q.orthogonal.rmse),
+        data(),
+    ]);
+    t.row(vec![
+        eq17.into(),
+        "-".into(),
+        "-".into(),
+        num(q.grid_rmse),
+        data(),
+    ]);
+    let s = &q.samples_to_points;
+    t.row(vec![
+        format!(
+            "surface samples to nearest point ({:.1}% beyond {} spacings)",
+            100.0 * s.far_share,
+            s.far_spacings
+        ),
+        num(s.stats.mean),
+        num(s.stats.max),
+        num(s.stats.rmse),
+        data(),
+    ]);
 }

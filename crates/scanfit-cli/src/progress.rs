@@ -1,5 +1,9 @@
 //! Progress display on stderr: a spinner with the current stage when stderr is
 //! a terminal, nothing when it is piped or `--quiet` is given.
+//!
+//! [`Progress`] implements the library's [`scanfit::progress::Progress`], so a
+//! command hands it to a pipeline (`&progress`) and the pipeline's stages
+//! show on the spinner, its steps on a bar.
 
 use std::io::IsTerminal;
 use std::time::Duration;
@@ -57,6 +61,26 @@ impl Progress {
     pub fn finish(&self) {
         if let Some(b) = &self.bar {
             b.finish_and_clear();
+        }
+    }
+}
+
+impl scanfit::progress::Progress for Progress {
+    /// Shows the stage's name; a stage of known length turns a bar's length
+    /// to it and starts it from zero.
+    fn stage(&self, name: &str, steps: Option<u64>) {
+        if let Some(b) = &self.bar {
+            if let (Some(n), Some(_)) = (steps, b.length()) {
+                b.set_length(n);
+                b.set_position(0);
+            }
+            b.set_message(name.to_string());
+        }
+    }
+
+    fn advance(&self, n: u64) {
+        if let Some(b) = &self.bar {
+            b.inc(n);
         }
     }
 }

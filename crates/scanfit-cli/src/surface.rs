@@ -16,7 +16,7 @@ use scanfit::project::{InversionConfig, SurfaceInverter};
 use scanfit_io::json::{Provenance, SurfaceDoc, SurfaceQualityDoc};
 use scanfit_io::{read_points, write_all_atomic};
 
-use crate::args::pair;
+use crate::args::NXM;
 use crate::outputs::{check_extensions, points_file, print_written, Deviation, Picture};
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -42,11 +42,11 @@ pub struct FitArgs {
     #[arg(long, default_value = "plane", value_name = "SOURCE")]
     pub params: String,
     /// Degrees, "PxQ" or "P".
-    #[arg(long, default_value = "3x3", value_name = "PxQ")]
-    pub degree: String,
+    #[arg(long, default_value = "3x3", value_name = "PxQ", value_parser = NXM)]
+    pub degree: (usize, usize),
     /// Control net, "NUxNV" or "N".
-    #[arg(long, default_value = "16x16", value_name = "NUxNV")]
-    pub ctrl: String,
+    #[arg(long, default_value = "16x16", value_name = "NUxNV", value_parser = NXM)]
+    pub ctrl: (usize, usize),
     /// Knot placement: `distribution` (follows the parameters) or `uniform`.
     #[arg(long, default_value = "distribution", value_name = "PLACEMENT")]
     pub knots: String,
@@ -79,8 +79,7 @@ pub struct FitArgs {
 
 /// Runs `scanfit fit`.
 pub fn run(a: FitArgs) -> Result<()> {
-    let degree = pair(&a.degree, "--degree")?;
-    let ctrl = pair(&a.ctrl, "--ctrl")?;
+    let (degree, ctrl) = (a.degree, a.ctrl);
     let knots = match a.knots.as_str() {
         "distribution" => KnotPlacement::Distribution,
         "uniform" => KnotPlacement::Uniform,
@@ -122,17 +121,11 @@ pub fn run(a: FitArgs) -> Result<()> {
         smoothing: a.smooth,
         weights: None,
     };
+    // point indices in the library's errors map to lines of the file
     let locate = |e: scanfit::Error| -> anyhow::Error {
-        let msg = e.to_string();
-        // point indices in the library's messages map to lines of the file
-        if let Some(i) = msg
-            .strip_prefix("point ")
-            .and_then(|r| r.split(' ').next())
-            .and_then(|n| n.parse::<usize>().ok())
-        {
-            anyhow::anyhow!("{msg} ({})", table.locate(i))
-        } else {
-            anyhow::anyhow!("{msg}")
+        match e.point_indices().first() {
+            Some(&i) => anyhow::anyhow!("{e} ({})", table.locate(i)),
+            None => anyhow::anyhow!("{e}"),
         }
     };
     progress.stage(format!(

@@ -1,8 +1,23 @@
 //! The library's one error type.
 
 /// Everything that can go wrong in the library. Messages say what is wrong,
-/// where (point index, knot index) and what to change.
+/// where (point index, knot index) and what to change; the variants carry
+/// the where as data ([`Error::point_indices`], [`Error::patch`], the
+/// setting's name), so a front can map a point index to a line of its file
+/// or a setting to its option without reading the message.
+///
+/// `#[non_exhaustive]`: new variants may be added; match with a wildcard.
+///
+/// ```
+/// use scanfit::{validate_points, Error, Point3};
+///
+/// let e = validate_points(&[Point3::new(0., 0., 0.), Point3::new(f64::NAN, 1., 2.)])
+///     .unwrap_err();
+/// assert_eq!(e.point_indices(), vec![1]);
+/// assert!(matches!(e, Error::NonFinite { index: 1, .. }));
+/// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
     /// A knot vector is malformed.
     #[error("invalid knot vector: {0}")]
@@ -62,9 +77,96 @@ pub enum Error {
         /// what to change
         hint: String,
     },
+    /// One point cannot be used (its coordinates, its position in the data).
+    #[error("point {index} {problem}")]
+    BadPoint {
+        /// index of the point
+        index: usize,
+        /// what is wrong with it and what to change, e.g. "has a coordinate of
+        /// magnitude 1e300; ..."
+        problem: String,
+    },
+    /// A point's given parameters lie outside the surface's domain.
+    #[error(
+        "point {index} has parameters ({u}, {v}) outside the domain [{}, {}] x [{}, {}]",
+        u_range.0, u_range.1, v_range.0, v_range.1
+    )]
+    ParametersOutsideDomain {
+        /// index of the point
+        index: usize,
+        /// its u
+        u: f64,
+        /// its v
+        v: f64,
+        /// the domain in u
+        u_range: (f64, f64),
+        /// the domain in v
+        v_range: (f64, f64),
+    },
+    /// A setting of a config has a value the algorithm cannot use.
+    #[error("{setting} = {value}: {hint}")]
+    InvalidSetting {
+        /// the config field, e.g. `alpha` or `far_spacings`
+        setting: &'static str,
+        /// the value given, printed
+        value: String,
+        /// what is allowed, what to change
+        hint: String,
+    },
+    /// Two inputs that must have the same length do not.
+    #[error("{got} {what} given for {expected} points; give one per point")]
+    LengthMismatch {
+        /// what was given per point, e.g. "parameter pairs"
+        what: &'static str,
+        /// number of points
+        expected: usize,
+        /// number given
+        got: usize,
+    },
+    /// An error in one patch of a multi-patch input.
+    #[error("patch {patch}: {source}")]
+    InPatch {
+        /// the patch's id
+        patch: usize,
+        /// what went wrong in it
+        source: Box<Error>,
+    },
     /// Any other invalid argument.
     #[error("{0}")]
     InvalidInput(String),
+}
+
+impl Error {
+    /// The indices of the input points this error is about (empty when it
+    /// is not about particular points), for a front to name their place in
+    /// its file.
+    pub fn point_indices(&self) -> Vec<usize> {
+        match self {
+            Error::NonFinite { index, .. }
+            | Error::BadPoint { index, .. }
+            | Error::ParametersOutsideDomain { index, .. } => vec![*index],
+            Error::DuplicatePoints { first, second, .. }
+            | Error::CoincidentParameters { first, second, .. } => vec![*first, *second],
+            Error::InPatch { source, .. } => source.point_indices(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// The patch this error is about, if it came from one patch of several.
+    pub fn patch(&self) -> Option<usize> {
+        match self {
+            Error::InPatch { patch, .. } => Some(*patch),
+            _ => None,
+        }
+    }
+
+    /// This error as one of patch `patch`.
+    pub fn in_patch(self, patch: usize) -> Error {
+        Error::InPatch {
+            patch,
+            source: Box::new(self),
+        }
+    }
 }
 
 /// Result alias for the library.

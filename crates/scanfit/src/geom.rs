@@ -22,9 +22,12 @@ pub fn validate_points(points: &[Point3]) -> Result<()> {
             });
         }
         if let Some(v) = p.coords.iter().find(|v| v.abs() > MAX_COORDINATE) {
-            return Err(Error::InvalidInput(format!(
-                "point {index} has a coordinate of magnitude {v:e}; values beyond {MAX_COORDINATE:e} overflow squared distances, rescale the data"
-            )));
+            return Err(Error::BadPoint {
+                index,
+                problem: format!(
+                    "has a coordinate of magnitude {v:e}; values beyond {MAX_COORDINATE:e} overflow squared distances, rescale the data"
+                ),
+            });
         }
     }
     // tiny data: distances would underflow (points that differ would coincide)

@@ -23,6 +23,8 @@
 //!   Shin 1997) and the MBA paper's projection adjustment of control points.
 //! * [`metrics`]: surface error measures and parameterization quality.
 //! * [`project`]: point inversion (orthogonal projection onto surfaces).
+//! * [`pipeline`]: every pipeline of the command line as one call (config,
+//!   progress, report), and the one surface assessment [`pipeline::SurfaceQuality`].
 //! * [`quality`]: per-curve quality report (deviation, curvature, loops, length).
 
 pub mod base;
@@ -35,6 +37,7 @@ pub mod mba;
 pub mod metrics;
 pub mod param;
 pub mod pde;
+pub mod pipeline;
 pub mod progress;
 pub mod project;
 pub mod quality;

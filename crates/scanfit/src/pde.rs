@@ -329,10 +329,13 @@ pub fn fit_pde(
         .iter()
         .position(|t| !t.iter().all(|x| (0.0..=1.0).contains(x)))
     {
-        return Err(Error::InvalidInput(format!(
-            "point {i} has parameters ({}, {}) outside [0, 1]^2",
-            uv[i][0], uv[i][1]
-        )));
+        return Err(Error::ParametersOutsideDomain {
+            index: i,
+            u: uv[i][0],
+            v: uv[i][1],
+            u_range: (0.0, 1.0),
+            v_range: (0.0, 1.0),
+        });
     }
     let kk = mm
         .checked_mul(nn)

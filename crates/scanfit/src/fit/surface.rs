@@ -274,11 +274,11 @@ fn validate(
     unknowns: usize,
 ) -> Result<()> {
     if points.len() != uv.len() {
-        return Err(Error::InvalidInput(format!(
-            "{} points but {} parameter pairs",
-            points.len(),
-            uv.len()
-        )));
+        return Err(Error::LengthMismatch {
+            what: "parameter pairs",
+            expected: points.len(),
+            got: uv.len(),
+        });
     }
     crate::validate_points(points)?;
     let ((u0, u1), (v0, v1)) = (ku.domain(), kv.domain());
@@ -286,10 +286,13 @@ fn validate(
     for (k, t) in uv.iter().enumerate() {
         let inside = t[0] >= u0 - tol && t[0] <= u1 + tol && t[1] >= v0 - tol && t[1] <= v1 + tol;
         if !inside || !t[0].is_finite() || !t[1].is_finite() {
-            return Err(Error::InvalidInput(format!(
-                "point {k} has parameters ({}, {}) outside the domain [{u0}, {u1}] x [{v0}, {v1}]",
-                t[0], t[1]
-            )));
+            return Err(Error::ParametersOutsideDomain {
+                index: k,
+                u: t[0],
+                v: t[1],
+                u_range: (u0, u1),
+                v_range: (v0, v1),
+            });
         }
     }
     super::validate_weights_and_smoothing(opts.weights, points.len(), opts.smoothing)?;

@@ -1,0 +1,32 @@
+//! Every pipeline of the command line as one library call.
+//!
+//! The CLI, the Python package and any other front (a multi-patch driver, a
+//! distributed run) call these functions and only parse, read, print and
+//! write around them. Each pipeline module follows the same conventions:
+//!
+//! * **`XxxConfig`**: a `#[non_exhaustive]` struct with `Default`, every field
+//!   documented with its default and the paper equation or section it comes
+//!   from. Build one with `XxxConfig::default()` and set the fields you need
+//!   (`#[non_exhaustive]` forbids struct literals outside the crate, so new
+//!   settings can be added without breaking callers).
+//! * **`run(input, &config, &dyn Progress) -> Result<XxxReport>`**: the one
+//!   entry point. `input` is the data (a [`PointCloud`](crate::PointCloud),
+//!   points, or points with attributes); the function validates it and the
+//!   config and returns a typed [`Error`](crate::Error) that says what is
+//!   wrong and where, never panics. It reports its stages and steps to a
+//!   [`Progress`](crate::progress::Progress) (pass
+//!   [`NoProgress`](crate::progress::NoProgress) when nobody watches) and
+//!   never prints.
+//! * **`XxxReport`**: a `#[non_exhaustive]` struct holding the surface or
+//!   curve, the parameters of the points, the quality assessment (for
+//!   surfaces the one [`SurfaceQuality`](assess::SurfaceQuality) of
+//!   [`assess`], measured in both directions) and the pipeline's
+//!   diagnostics (per-level tables, correction rounds, timings, notes).
+//!
+//! Modules:
+//!
+//! * [`assess`]: the surface assessment every surface pipeline ends with.
+
+pub mod assess;
+
+pub use assess::{assess_surface, AssessConfig, Assessment, SampleDistances, SurfaceQuality};
