@@ -307,6 +307,48 @@ pub fn note_dropped(dropped: usize, quiet: bool) {
     }
 }
 
+// ---- typed parsers of coons, turntable and cloud (helper apib) ----
+
+impl<T> Parsed<T> {
+    /// A parser from `f(value, option name)`, for a command's own typed
+    /// values (`--axis`, `--orient`, `--corners`).
+    pub const fn new(f: fn(&str, &str) -> std::result::Result<T, String>) -> Self {
+        Self(f)
+    }
+
+    /// Parses `s` as the value of the option `what` outside clap (a part of
+    /// another option's value, e.g. the `X,Y,Z` of `--orient view:X,Y,Z`).
+    pub fn parse_str(&self, s: &str, what: &str) -> std::result::Result<T, String> {
+        (self.0)(s, what)
+    }
+}
+
+/// The name a `ValueEnum` value has on the command line (`angle`, `lsq`).
+pub fn value_name<T: ValueEnum>(v: &T) -> String {
+    v.to_possible_value()
+        .map(|p| p.get_name().to_string())
+        .unwrap_or_default()
+}
+
+impl InputArgs {
+    /// Reads the file like [`InputArgs::load`] and returns the cloud with
+    /// the number of non-finite points dropped, telling nothing (for reports
+    /// that show the count themselves).
+    pub fn load_counted(&self) -> Result<(PointCloud, usize)> {
+        let options = ReadOptions {
+            format: self.format.map(Format::from),
+            non_finite: if self.drop_non_finite {
+                NonFinite::Drop
+            } else {
+                NonFinite::Reject
+            },
+        };
+        let table = read_cloud(&self.input, &options)?;
+        let dropped = table.dropped_non_finite;
+        Ok((table.into_cloud()?, dropped))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,26 +1,30 @@
 //! `scanfit cloud ...`: look at and prepare point clouds: statistics,
-//! normals, hidden point removal, boundary loops and corners.
+//! normals, hidden point removal, boundary loops and corners. The tools are
+//! [`scanfit::pipeline::cloud`]; this file parses, reads, calls, prints and
+//! writes.
 
+use std::fmt;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{bail, Context, Result};
-use clap::{Args, Subcommand};
-use scanfit::cloud::boundary::{boundary_loops, BoundaryConfig};
-use scanfit::cloud::corners::{
-    corner_values, find_corners, split_at_corners, CornerConfig, CornerCriterion, Corners,
+use anyhow::{Context, Result};
+use clap::{Args, Subcommand, ValueEnum};
+use scanfit::cloud::corners::CornerCriterion;
+use scanfit::cloud::normals::Orientation;
+use scanfit::pipeline::cloud::{
+    boundary as find_boundary, hpr as remove_hidden, info as cloud_info, normals as estimate,
+    CloudBoundary, CloudBoundaryConfig, CloudHpr, CloudHprConfig, CloudInfo, CloudInfoConfig,
+    CloudNormalsConfig,
 };
-use scanfit::cloud::hpr::{hidden_point_removal, HprConfig};
-use scanfit::cloud::normals::{estimate_normals, NormalsConfig, Orientation};
 use scanfit::{Point3, PointCloud, Vector3};
 use scanfit_io::render::{
     angles_facing, render_scene_png, viridis, Marker, PointScene, Polyline, RenderOptions,
 };
-use scanfit_io::{
-    cloud_bytes, read_cloud, write_all_atomic, Format, NonFinite, ReadOptions, WriteFormat,
-};
+use scanfit_io::{cloud_bytes, write_all_atomic, WriteFormat};
 
-use crate::outputs::{check_extensions, extension};
+pub use crate::args::InputArgs;
+use crate::args::{choice, value_name, Angles, Indices, Parsed, ANGLES, INDICES, VECTOR3};
+use crate::outputs::{check_extensions, extension, Files};
 use crate::progress::Progress;
 use crate::table::{num, Table};
 
@@ -35,6 +39,61 @@ pub enum CloudCommand {
     Hpr(HprArgs),
     /// Boundary loop of a sheet-like patch (alpha shape), its corners and sides.
     Boundary(BoundaryArgs),
+}
+
+/// `--criterion`: the corner measure (`cloud boundary`, `coons`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CriterionArg {
+    /// Smallest turning angle (Coons paper eqs. 10-12).
+    Angle,
+    /// Largest three-point curvature 4S/(abc) (PDE paper 4.1).
+    Curvature,
+}
+
+impl From<CriterionArg> for CornerCriterion {
+    fn from(c: CriterionArg) -> Self {
+        match c {
+            CriterionArg::Angle => Self::TurningAngle,
+            CriterionArg::Curvature => Self::ThreePointCurvature,
+        }
+    }
+}
+
+/// `--orient`: how normals get their sign.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum OrientArg {
+    /// Spanning-tree propagation from the seed along `--hint`.
+    Mst,
+    /// Every normal towards this viewpoint.
+    View(Point3),
+    /// The eigen solver's signs.
+    None,
+}
+
+impl fmt::Display for OrientArg {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Mst => write!(f, "mst"),
+            Self::View(p) => write!(f, "view:{},{},{}", p.x, p.y, p.z),
+            Self::None => write!(f, "none"),
+        }
+    }
+}
+
+/// `"mst"`, `"none"` or `"view:X,Y,Z"` ([`OrientArg`]).
+pub const ORIENT: Parsed<OrientArg> = Parsed::new(orient);
+
+fn orient(s: &str, what: &str) -> std::result::Result<OrientArg, String> {
+    match s.trim() {
+        "mst" => Ok(OrientArg::Mst),
+        "none" => Ok(OrientArg::None),
+        v => match v.strip_prefix("view:") {
+            Some(p) => Ok(OrientArg::View(Point3::from(
+                VECTOR3.parse_str(p, &format!("{what} view:"))?,
+            ))),
+            None => Err(format!("unknown {what} '{s}'; use mst, view:X,Y,Z or none")),
+        },
+    }
 }
 
 const HPR_EXAMPLES: &str = "Examples:
@@ -54,8 +113,8 @@ pub struct HprArgs {
     #[command(flatten)]
     pub input: InputArgs,
     /// Viewpoint (scanner or camera position), in the units of the points.
-    #[arg(long = "view", value_name = "X,Y,Z", allow_negative_numbers = true)]
-    pub viewpoint: String,
+    #[arg(long = "view", value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = VECTOR3)]
+    pub viewpoint: Vector3,
     /// Flipping radius exponent: R = max distance * 10^gamma.
     #[arg(long, default_value_t = 2.0)]
     pub gamma: f64,
@@ -67,8 +126,8 @@ pub struct HprArgs {
     #[arg(long, value_name = "OUT.png")]
     pub png: Option<PathBuf>,
     /// Camera azimuth and elevation of the picture [default: from the side of the view direction].
-    #[arg(long = "camera", value_name = "AZ,EL", allow_negative_numbers = true)]
-    pub camera: Option<String>,
+    #[arg(long = "camera", value_name = "AZ,EL", allow_hyphen_values = true, value_parser = ANGLES)]
+    pub camera: Option<Angles>,
     /// Print the report as JSON on stdout instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -110,8 +169,8 @@ pub struct BoundaryArgs {
     #[arg(long, default_value_t = 4, value_name = "N")]
     pub corners: usize,
     /// Corner criterion: `angle` (smallest turning angle) or `curvature` (three-point).
-    #[arg(long, default_value = "angle", value_name = "C")]
-    pub criterion: String,
+    #[arg(long, default_value = "angle", value_name = "C", value_parser = choice::<CriterionArg>())]
+    pub criterion: CriterionArg,
     /// Neighbour offset m of the corner criterion [default: 1% of the loop].
     #[arg(long, value_name = "M")]
     pub corner_offset: Option<usize>,
@@ -119,8 +178,8 @@ pub struct BoundaryArgs {
     #[arg(long, default_value_t = 0.03, value_name = "F")]
     pub min_separation: f64,
     /// Use these loop positions as the corners instead of detecting them.
-    #[arg(long, value_name = "I,J,K,L")]
-    pub corner_at: Option<String>,
+    #[arg(long, value_name = "I,J,K,L", value_parser = INDICES)]
+    pub corner_at: Option<Indices>,
     /// Output: the loops, corners and sides (.json), or the outer loop (.ply/.xyz).
     #[arg(short, long, value_name = "OUT")]
     pub output: Option<PathBuf>,
@@ -176,16 +235,17 @@ pub struct NormalsArgs {
     #[arg(long, default_value_t = 16)]
     pub k: usize,
     /// Orientation: `mst`, `view:X,Y,Z` or `none`.
-    #[arg(long, default_value = "mst", value_name = "HOW")]
-    pub orient: String,
+    #[arg(long, default_value = "mst", value_name = "HOW", value_parser = ORIENT)]
+    pub orient: OrientArg,
     /// Direction the seed normal of each connected part points along (with --orient mst).
     #[arg(
         long,
         default_value = "0,0,1",
         value_name = "X,Y,Z",
-        allow_negative_numbers = true
+        allow_hyphen_values = true,
+        value_parser = VECTOR3
     )]
-    pub hint: String,
+    pub hint: Vector3,
     /// Output points with normals (.ply binary, or .xyz text).
     #[arg(short, long, value_name = "OUT")]
     pub output: Option<PathBuf>,
@@ -212,64 +272,6 @@ pub fn run(c: CloudCommand) -> Result<()> {
     }
 }
 
-/// The input file of a `cloud` command and how to read it.
-#[derive(Args, Debug, Clone)]
-pub struct InputArgs {
-    /// Input point file (.ply, .pcd, .las/.laz, .xyz/.csv/.txt/.pts/.asc).
-    pub input: PathBuf,
-    /// Read as this format whatever the extension: ply, pcd, las, text.
-    #[arg(long, value_name = "FORMAT")]
-    pub format: Option<String>,
-    /// Drop points with NaN or infinite coordinates (and report how many)
-    /// instead of stopping at the first one.
-    #[arg(long)]
-    pub drop_non_finite: bool,
-}
-
-impl InputArgs {
-    /// Reads the file into a cloud that keeps every extra column as an
-    /// attribute; returns it with the number of non-finite points dropped.
-    pub fn load(&self) -> Result<(PointCloud, usize)> {
-        let format = match self
-            .format
-            .as_deref()
-            .map(str::to_ascii_lowercase)
-            .as_deref()
-        {
-            None => None,
-            Some("ply") => Some(Format::Ply),
-            Some("pcd") => Some(Format::Pcd),
-            Some("las") | Some("laz") => Some(Format::Las),
-            Some("text") | Some("xyz") | Some("csv") | Some("txt") => Some(Format::Text),
-            Some(f) => bail!("unknown --format '{f}'; use ply, pcd, las or text"),
-        };
-        let options = ReadOptions {
-            format,
-            non_finite: if self.drop_non_finite {
-                NonFinite::Drop
-            } else {
-                NonFinite::Reject
-            },
-        };
-        let table = read_cloud(&self.input, &options)?;
-        let dropped = table.dropped_non_finite;
-        Ok((table.into_cloud()?, dropped))
-    }
-}
-
-/// Parses "X,Y,Z".
-pub fn triple(s: &str, what: &str) -> Result<[f64; 3]> {
-    let v: Vec<f64> = s
-        .split(',')
-        .map(|x| x.trim().parse::<f64>())
-        .collect::<std::result::Result<_, _>>()
-        .with_context(|| format!("{what} '{s}' must be three numbers X,Y,Z"))?;
-    match v[..] {
-        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok([x, y, z]),
-        _ => bail!("{what} '{s}' must be three finite numbers X,Y,Z"),
-    }
-}
-
 /// The bytes of `cloud` with all its attributes as binary PLY or XYZ text, by extension.
 pub fn cloud_file(path: &Path, cloud: &PointCloud) -> Result<Vec<u8>> {
     let format = WriteFormat::from_path(path)
@@ -277,57 +279,50 @@ pub fn cloud_file(path: &Path, cloud: &PointCloud) -> Result<Vec<u8>> {
     Ok(cloud_bytes(cloud, format))
 }
 
-/// Tells on stderr how many non-finite points were dropped (unless JSON is printed).
-fn note_dropped(dropped: usize, json: bool) {
-    if dropped > 0 && !json {
-        eprintln!("note: {dropped} points with NaN or infinite coordinates dropped");
+/// Prints `wrote FILE` for each file.
+fn print_files(files: &Files) {
+    for (p, _) in files {
+        println!("wrote {}", p.display());
     }
 }
 
 fn info(a: InfoArgs) -> Result<()> {
     let t0 = Instant::now();
-    let (cloud, dropped) = a.input.load()?;
+    let (cloud, dropped) = a.input.load_counted()?;
     let read_s = t0.elapsed().as_secs_f64();
-    let (lo, hi) = cloud
-        .bounding_box()
-        .with_context(|| format!("{}: no points", a.input.input.display()))?;
-    let spacing = if cloud.len() >= 2 {
-        Some(cloud.spacing()?)
-    } else {
-        None
-    };
-    let attrs: Vec<(String, f64, f64)> = cloud
-        .attributes()
-        .iter()
-        .map(|at| {
-            let (mn, mx) = at
-                .values
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                    (a.min(v), b.max(v))
-                });
-            (at.name.clone(), mn, mx)
-        })
-        .collect();
+    let r = cloud_info(
+        &cloud,
+        &CloudInfoConfig::default(),
+        &scanfit::progress::NoProgress,
+    )
+    .with_context(|| a.input.input.display().to_string())?;
     if a.json {
+        let (lo, hi) = (r.bbox_min, r.bbox_max);
         let report = serde_json::json!({
             "file": a.input.input.display().to_string(),
-            "points": cloud.len(),
+            "points": r.points,
             "dropped_non_finite": dropped,
             "bbox_min": [lo.x, lo.y, lo.z],
             "bbox_max": [hi.x, hi.y, hi.z],
-            "diagonal": (hi - lo).norm(),
-            "attributes": attrs.iter().map(|(n, mn, mx)| serde_json::json!({"name": n, "min": mn, "max": mx})).collect::<Vec<_>>(),
-            "spacing": spacing.map(|s| serde_json::json!({"min": s.min, "median": s.median, "mean": s.mean, "max": s.max, "duplicates": s.duplicates})),
+            "diagonal": r.diagonal,
+            "attributes": r.attributes.iter().map(|at| serde_json::json!({"name": at.name, "min": at.min, "max": at.max})).collect::<Vec<_>>(),
+            "spacing": r.spacing.map(|s| serde_json::json!({"min": s.min, "median": s.median, "mean": s.mean, "max": s.max, "duplicates": s.duplicates})),
             "read_seconds": read_s,
         });
         println!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
     }
+    print_info(&a.input.input, &r, read_s);
+    Ok(())
+}
+
+/// The tables of `cloud info`.
+fn print_info(input: &Path, r: &CloudInfo, read_s: f64) {
+    let (lo, hi) = (r.bbox_min, r.bbox_max);
     println!(
         "{}: {} points (read in {:.3} s)\n",
-        a.input.input.display(),
-        cloud.len(),
+        input.display(),
+        r.points,
         read_s
     );
     let mut t = Table::new(&["axis", "min", "max", "size"], &[true]);
@@ -340,16 +335,16 @@ fn info(a: InfoArgs) -> Result<()> {
         ]);
     }
     print!("{}", t.render());
-    println!("bounding-box diagonal {}\n", num((hi - lo).norm()));
-    if !attrs.is_empty() {
+    println!("bounding-box diagonal {}\n", num(r.diagonal));
+    if !r.attributes.is_empty() {
         let mut t = Table::new(&["attribute", "min", "max"], &[true]);
-        for (n, mn, mx) in &attrs {
-            t.row(vec![n.clone(), num(*mn), num(*mx)]);
+        for at in &r.attributes {
+            t.row(vec![at.name.clone(), num(at.min), num(at.max)]);
         }
         print!("{}", t.render());
         println!();
     }
-    if let Some(s) = spacing {
+    if let Some(s) = r.spacing {
         let mut t = Table::new(&["nearest-neighbour distance", "value"], &[true]);
         for (n, v) in [
             ("min", s.min),
@@ -364,7 +359,6 @@ fn info(a: InfoArgs) -> Result<()> {
             println!("{} points coincide with another point", s.duplicates);
         }
     }
-    Ok(())
 }
 
 /// Colours that shade each point by its normal against a light from the
@@ -398,36 +392,24 @@ fn normals(a: NormalsArgs) -> Result<()> {
         (&a.output, "--output", &["ply", "xyz"][..]),
         (&a.png, "--png", &["png"][..]),
     ])?;
-    let orientation = match a.orient.as_str() {
-        "mst" => Orientation::SpanningTree {
-            hint: Vector3::from(triple(&a.hint, "--hint")?),
-        },
-        "none" => Orientation::None,
-        v if v.starts_with("view:") => {
-            Orientation::Viewpoint(Point3::from(triple(&v[5..], "--orient view:")?))
-        }
-        o => bail!("unknown --orient '{o}'; use mst, view:X,Y,Z or none"),
+    let mut cfg = CloudNormalsConfig::default();
+    cfg.normals.k = a.k;
+    cfg.normals.orientation = match a.orient {
+        OrientArg::Mst => Orientation::SpanningTree { hint: a.hint },
+        OrientArg::View(p) => Orientation::Viewpoint(p),
+        OrientArg::None => Orientation::None,
     };
     let progress = Progress::spinner(a.quiet || a.json);
     progress.stage("reading");
-    let (mut cloud, dropped) = a.input.load()?;
-    note_dropped(dropped, a.json);
+    let cloud = a.input.load(a.json)?;
     progress.stage(format!("normals of {} points", cloud.len()));
     let t0 = Instant::now();
-    let r = estimate_normals(
-        &cloud,
-        &NormalsConfig {
-            k: a.k,
-            orientation,
-        },
-    )
-    .with_context(|| format!("normals of {}", a.input.input.display()))?;
+    let r = estimate(&cloud, &cfg, &progress)
+        .with_context(|| format!("normals of {}", a.input.input.display()))?;
     let secs = t0.elapsed().as_secs_f64();
-    cloud.set_normals(&r.normals)?;
-    cloud.set_attribute("variation", r.variation.clone())?;
-    let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
+    let mut files: Files = Vec::new();
     if let Some(o) = &a.output {
-        files.push((o.clone(), cloud_file(o, &cloud)?));
+        files.push((o.clone(), cloud_file(o, &r.cloud)?));
     }
     if let Some(p) = &a.png {
         progress.stage("picture");
@@ -443,29 +425,26 @@ fn normals(a: NormalsArgs) -> Result<()> {
             "orange = normal towards the camera (shaded by the light), blue = normal facing away"
                 .into(),
         ];
-        let colours = normal_shading(&r.normals, &opts);
-        let png = render_scene_png(
-            &PointScene {
-                points: cloud.points(),
-                colours: Some(&colours),
-                ..Default::default()
-            },
-            &opts,
-        )?;
-        files.push((p.clone(), png));
+        let colours = normal_shading(&r.normals.normals, &opts);
+        let scene = PointScene {
+            points: cloud.points(),
+            colours: Some(&colours),
+            ..Default::default()
+        };
+        files.push((p.clone(), render_scene_png(&scene, &opts)?));
     }
     write_all_atomic(&files)?;
     progress.finish();
-    let mean_var = r.variation.iter().sum::<f64>() / r.variation.len().max(1) as f64;
+    let n = &r.normals;
     if a.json {
         let report = serde_json::json!({
             "file": a.input.input.display().to_string(),
             "points": cloud.len(),
             "k": a.k,
-            "orientation": a.orient,
-            "components": r.components,
-            "degenerate": r.degenerate.len(),
-            "mean_variation": mean_var,
+            "orientation": a.orient.to_string(),
+            "components": n.components,
+            "degenerate": n.degenerate.len(),
+            "mean_variation": r.mean_variation,
             "seconds": secs,
         });
         println!("{}", serde_json::to_string_pretty(&report)?);
@@ -474,37 +453,78 @@ fn normals(a: NormalsArgs) -> Result<()> {
     let mut t = Table::new(&["normals", "value"], &[true]);
     t.row(vec!["points".into(), cloud.len().to_string()]);
     t.row(vec!["neighbours k".into(), a.k.to_string()]);
-    t.row(vec!["orientation".into(), a.orient.clone()]);
-    t.row(vec!["connected parts".into(), r.components.to_string()]);
+    t.row(vec!["orientation".into(), a.orient.to_string()]);
+    t.row(vec!["connected parts".into(), n.components.to_string()]);
     t.row(vec![
         "degenerate neighbourhoods".into(),
-        r.degenerate.len().to_string(),
+        n.degenerate.len().to_string(),
     ]);
-    t.row(vec!["mean surface variation".into(), num(mean_var)]);
+    t.row(vec!["mean surface variation".into(), num(r.mean_variation)]);
     t.row(vec!["time (s)".into(), format!("{secs:.3}")]);
     print!("{}", t.render());
-    for (p, _) in &files {
-        println!("wrote {}", p.display());
-    }
+    print_files(&files);
     Ok(())
 }
 
-fn parse_angles(s: &str, what: &str) -> Result<(f64, f64)> {
-    let (a, e) = s
-        .split_once(',')
-        .with_context(|| format!("{what} needs two angles, AZ,EL"))?;
-    let az: f64 = a
-        .trim()
-        .parse()
-        .with_context(|| format!("{what} azimuth '{a}' is not a number"))?;
-    let el: f64 = e
-        .trim()
-        .parse()
-        .with_context(|| format!("{what} elevation '{e}' is not a number"))?;
-    if !az.is_finite() || !(-90.0..=90.0).contains(&el) {
-        bail!("{what} {s}: the elevation must lie in [-90, 90] degrees");
-    }
-    Ok((az, el))
+/// The picture of `cloud hpr`: the cloud from the side of the view
+/// direction, visible points coloured by nearness to the viewpoint, hidden
+/// ones grey.
+fn hpr_picture(a: &HprArgs, cloud: &PointCloud, view: Point3, r: &CloudHpr) -> Result<Vec<u8>> {
+    let (lo, hi) = cloud.bounding_box().context("no points")?;
+    let centre = Point3::from((lo.coords + hi.coords) / 2.0);
+    let dir = view - centre;
+    let (az, el) = match a.camera {
+        Some(c) => (c.azimuth, c.elevation),
+        // from the side: the visible cap shows as a half shell
+        None => (dir.y.atan2(dir.x).to_degrees() + 90.0, 20.0),
+    };
+    let is_visible = r.visible_mask(cloud.len());
+    let along: Vec<f64> = cloud
+        .points()
+        .iter()
+        .map(|p| (p - centre).dot(&dir))
+        .collect();
+    let (mn, mx) = along
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    let colours: Vec<[u8; 3]> = along
+        .iter()
+        .zip(&is_visible)
+        .map(|(&t, &vis)| {
+            if vis {
+                viridis(((t - mn) / (mx - mn).max(f64::MIN_POSITIVE)).clamp(0.0, 1.0))
+                    .map(|c| (c * 255.0).round() as u8)
+            } else {
+                [205, 205, 205]
+            }
+        })
+        .collect();
+    let opts = RenderOptions {
+        azimuth: az,
+        elevation: el,
+        legend: vec![
+            format!(
+                "{}: {} of {} points visible from ({}, {}, {}), gamma = {}",
+                a.input.input.display(),
+                r.visible.len(),
+                cloud.len(),
+                num(view.x),
+                num(view.y),
+                num(view.z),
+                a.gamma
+            ),
+            "visible: coloured by nearness to the viewpoint (yellow = near); hidden: grey".into(),
+        ],
+        ..Default::default()
+    };
+    let scene = PointScene {
+        points: cloud.points(),
+        colours: Some(&colours),
+        ..Default::default()
+    };
+    Ok(render_scene_png(&scene, &opts)?)
 }
 
 fn hpr(a: HprArgs) -> Result<()> {
@@ -512,84 +532,24 @@ fn hpr(a: HprArgs) -> Result<()> {
         (&a.output, "--output", &["ply", "xyz"][..]),
         (&a.png, "--png", &["png"][..]),
     ])?;
-    let view = Point3::from(triple(&a.viewpoint, "--view")?);
+    let view = Point3::from(a.viewpoint);
+    let mut cfg = CloudHprConfig::from_viewpoint(view);
+    cfg.hpr.gamma = a.gamma;
     let progress = Progress::spinner(a.quiet || a.json);
     progress.stage("reading");
-    let (cloud, dropped) = a.input.load()?;
-    note_dropped(dropped, a.json);
+    let cloud = a.input.load(a.json)?;
     progress.stage(format!("hidden point removal over {} points", cloud.len()));
     let t0 = Instant::now();
-    let visible = hidden_point_removal(cloud.points(), &view, &HprConfig { gamma: a.gamma })
+    let r = remove_hidden(&cloud, &cfg, &progress)
         .with_context(|| format!("hidden point removal on {}", a.input.input.display()))?;
     let secs = t0.elapsed().as_secs_f64();
-    let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
+    let mut files: Files = Vec::new();
     if let Some(o) = &a.output {
-        let mut out = cloud.select(&visible)?;
-        out.set_attribute("index", visible.iter().map(|&i| i as f64).collect())?;
-        files.push((o.clone(), cloud_file(o, &out)?));
+        files.push((o.clone(), cloud_file(o, &r.cloud)?));
     }
     if let Some(p) = &a.png {
         progress.stage("picture");
-        let (lo, hi) = cloud.bounding_box().context("no points")?;
-        let centre = Point3::from((lo.coords + hi.coords) / 2.0);
-        let dir = view - centre;
-        let (az, el) = match &a.camera {
-            Some(c) => parse_angles(c, "--camera")?,
-            // from the side: the visible cap shows as a half shell
-            None => (dir.y.atan2(dir.x).to_degrees() + 90.0, 20.0),
-        };
-        let mut is_visible = vec![false; cloud.len()];
-        for &i in &visible {
-            is_visible[i] = true;
-        }
-        let along: Vec<f64> = cloud
-            .points()
-            .iter()
-            .map(|p| (p - centre).dot(&dir))
-            .collect();
-        let (mn, mx) = along
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                (a.min(v), b.max(v))
-            });
-        let colours: Vec<[u8; 3]> = (0..cloud.len())
-            .map(|i| {
-                if is_visible[i] {
-                    viridis(((along[i] - mn) / (mx - mn).max(f64::MIN_POSITIVE)).clamp(0.0, 1.0))
-                        .map(|c| (c * 255.0).round() as u8)
-                } else {
-                    [205, 205, 205]
-                }
-            })
-            .collect();
-        let opts = RenderOptions {
-            azimuth: az,
-            elevation: el,
-            legend: vec![
-                format!(
-                    "{}: {} of {} points visible from ({}, {}, {}), gamma = {}",
-                    a.input.input.display(),
-                    visible.len(),
-                    cloud.len(),
-                    num(view.x),
-                    num(view.y),
-                    num(view.z),
-                    a.gamma
-                ),
-                "visible: coloured by nearness to the viewpoint (yellow = near); hidden: grey"
-                    .into(),
-            ],
-            ..Default::default()
-        };
-        let png = render_scene_png(
-            &PointScene {
-                points: cloud.points(),
-                colours: Some(&colours),
-                ..Default::default()
-            },
-            &opts,
-        )?;
-        files.push((p.clone(), png));
+        files.push((p.clone(), hpr_picture(&a, &cloud, view, &r)?));
     }
     write_all_atomic(&files)?;
     progress.finish();
@@ -597,8 +557,8 @@ fn hpr(a: HprArgs) -> Result<()> {
         let report = serde_json::json!({
             "file": a.input.input.display().to_string(),
             "points": cloud.len(),
-            "visible": visible.len(),
-            "hidden": cloud.len() - visible.len(),
+            "visible": r.visible.len(),
+            "hidden": r.hidden,
             "viewpoint": [view.x, view.y, view.z],
             "gamma": a.gamma,
             "seconds": secs,
@@ -608,11 +568,8 @@ fn hpr(a: HprArgs) -> Result<()> {
     }
     let mut t = Table::new(&["hidden point removal", "value"], &[true]);
     t.row(vec!["points".into(), cloud.len().to_string()]);
-    t.row(vec!["visible".into(), visible.len().to_string()]);
-    t.row(vec![
-        "hidden".into(),
-        (cloud.len() - visible.len()).to_string(),
-    ]);
+    t.row(vec!["visible".into(), r.visible.len().to_string()]);
+    t.row(vec!["hidden".into(), r.hidden.to_string()]);
     t.row(vec![
         "viewpoint".into(),
         format!("{}, {}, {}", num(view.x), num(view.y), num(view.z)),
@@ -620,9 +577,7 @@ fn hpr(a: HprArgs) -> Result<()> {
     t.row(vec!["gamma".into(), a.gamma.to_string()]);
     t.row(vec!["time (s)".into(), format!("{secs:.3}")]);
     print!("{}", t.render());
-    for (p, _) in &files {
-        println!("wrote {}", p.display());
-    }
+    print_files(&files);
     Ok(())
 }
 
@@ -636,80 +591,16 @@ const SIDE_COLOURS: [[u8; 3]; 6] = [
     [0, 160, 170],
 ];
 
-fn boundary(a: BoundaryArgs) -> Result<()> {
-    check_extensions(&[
-        (&a.output, "--output", &["json", "ply", "xyz"][..]),
-        (&a.png, "--png", &["png"][..]),
-    ])?;
-    let criterion = match a.criterion.as_str() {
-        "angle" => CornerCriterion::TurningAngle,
-        "curvature" => CornerCriterion::ThreePointCurvature,
-        c => bail!("unknown --criterion '{c}'; use angle or curvature"),
-    };
-    let user_corners: Option<Vec<usize>> = match &a.corner_at {
-        None => None,
-        Some(s) => Some(
-            s.split(',')
-                .map(|x| x.trim().parse::<usize>())
-                .collect::<std::result::Result<_, _>>()
-                .with_context(|| {
-                    format!("--corner-at '{s}' must be loop positions I,J,K,...  (whole numbers)")
-                })?,
-        ),
-    };
-    let progress = Progress::spinner(a.quiet || a.json);
-    progress.stage("reading");
-    let (cloud, dropped) = a.input.load()?;
-    note_dropped(dropped, a.json);
-    progress.stage(format!("alpha shape of {} points", cloud.len()));
-    let t0 = Instant::now();
-    let b = boundary_loops(
-        cloud.points(),
-        &BoundaryConfig {
-            alpha: a.alpha,
-            alpha_factor: a.alpha_factor,
-        },
-    )
-    .with_context(|| format!("boundary of {}", a.input.input.display()))?;
-    let outer = b.outer_loop().to_vec();
-    let loop_points: Vec<Point3> = outer.iter().map(|&i| cloud.points()[i]).collect();
-    progress.stage("corners");
-    let corners: Option<Corners> = match (&user_corners, a.corners) {
-        (Some(c), _) => {
-            let sides = split_at_corners(outer.len(), c).context("--corner-at")?;
-            let values = corner_values(
-                &loop_points,
-                criterion,
-                a.corner_offset
-                    .unwrap_or_else(|| (outer.len() as f64 / 100.0).round().max(1.0) as usize),
-            )?;
-            Some(Corners {
-                corners: c.clone(),
-                sides,
-                values,
-                offset: a.corner_offset.unwrap_or(0),
-            })
-        }
-        (None, 0) => None,
-        (None, count) => Some(
-            find_corners(
-                &loop_points,
-                &CornerConfig {
-                    criterion,
-                    count,
-                    offset: a.corner_offset,
-                    min_separation: a.min_separation,
-                },
-            )
-            .with_context(|| format!("corners of the outer loop ({} points)", outer.len()))?,
-        ),
-    };
-    let secs = t0.elapsed().as_secs_f64();
-    let corner_value = |v: f64| match criterion {
-        CornerCriterion::TurningAngle => v.to_degrees(),
-        CornerCriterion::ThreePointCurvature => v,
-    };
-    let value_name = match criterion {
+/// The JSON document of `cloud boundary` (`-o OUT.json` and `--json`).
+fn boundary_doc(
+    a: &BoundaryArgs,
+    cloud: &PointCloud,
+    r: &CloudBoundary,
+    secs: f64,
+) -> serde_json::Value {
+    let b = &r.boundary;
+    let outer = r.outer();
+    let value_name = match r.criterion {
         CornerCriterion::TurningAngle => "angle_degrees",
         CornerCriterion::ThreePointCurvature => "curvature",
     };
@@ -717,7 +608,7 @@ fn boundary(a: BoundaryArgs) -> Result<()> {
         let p = cloud.points()[i];
         [p.x, p.y, p.z]
     };
-    let doc = serde_json::json!({
+    serde_json::json!({
         "schema": "scanfit-boundary/1",
         "file": a.input.input.display().to_string(),
         "points": cloud.len(),
@@ -733,118 +624,91 @@ fn boundary(a: BoundaryArgs) -> Result<()> {
             "area": area,
             "points": l.iter().map(|&i| pt(i)).collect::<Vec<_>>(),
         })).collect::<Vec<_>>(),
-        "corners": corners.as_ref().map(|c| c.corners.iter().map(|&k| serde_json::json!({
+        "corners": r.corners.as_ref().map(|c| c.corners.iter().map(|&k| serde_json::json!({
             "position": k,
             "index": outer[k],
             "point": pt(outer[k]),
-            value_name: corner_value(c.values[k]),
+            value_name: r.corner_value(k),
         })).collect::<Vec<_>>()),
-        "sides": corners.as_ref().map(|c| c.sides.iter().map(|s| s.iter().map(|&k| outer[k]).collect::<Vec<_>>()).collect::<Vec<_>>()),
+        "sides": r.corners.as_ref().map(|c| c.sides.iter().map(|s| s.iter().map(|&k| outer[k]).collect::<Vec<_>>()).collect::<Vec<_>>()),
         "seconds": secs,
-    });
-    let mut files: Vec<(PathBuf, Vec<u8>)> = Vec::new();
-    if let Some(o) = &a.output {
-        if extension(o) == "json" {
-            files.push((o.clone(), serde_json::to_string_pretty(&doc)?.into_bytes()));
-        } else {
-            let mut out = PointCloud::new(loop_points.clone())?;
-            let n = outer.len();
-            let mut side = vec![-1.0; n];
-            let mut corner = vec![0.0; n];
-            if let Some(c) = &corners {
-                for (k, s) in c.sides.iter().enumerate() {
-                    // a corner belongs to the side it starts
-                    for &q in s.iter().rev() {
-                        side[q] = k as f64;
-                    }
-                }
-                for (k, &q) in c.corners.iter().enumerate() {
-                    corner[q] = 1.0;
-                    side[q] = k as f64;
-                }
-            }
-            out.set_attribute("index", outer.iter().map(|&i| i as f64).collect())?;
-            out.set_attribute("position", (0..n).map(|k| k as f64).collect())?;
-            out.set_attribute("side", side)?;
-            out.set_attribute("corner", corner)?;
-            files.push((o.clone(), cloud_file(o, &out)?));
-        }
-    }
-    if let Some(p) = &a.png {
-        progress.stage("picture");
-        let mut opts = a
-            .view
-            .options_or(cloud.points(), angles_facing(&b.plane.normal))?;
-        opts.legend = vec![
-            format!(
-                "{}: {} points, {} boundary loop(s), outer loop {} points, alpha = {}",
-                a.input.input.display(),
-                cloud.len(),
-                b.loops.len(),
-                outer.len(),
-                num(b.alpha)
+    })
+}
+
+/// The picture of `cloud boundary`: the points grey, holes purple, the
+/// sides in colour with the corners labelled (or the outer loop red).
+fn boundary_picture(a: &BoundaryArgs, cloud: &PointCloud, r: &CloudBoundary) -> Result<Vec<u8>> {
+    let b = &r.boundary;
+    let mut opts = a
+        .view
+        .options_or(cloud.points(), angles_facing(&b.plane.normal))?;
+    opts.legend = vec![
+        format!(
+            "{}: {} points, {} boundary loop(s), outer loop {} points, alpha = {}",
+            a.input.input.display(),
+            cloud.len(),
+            b.loops.len(),
+            r.outer().len(),
+            num(b.alpha)
+        ),
+        match &r.corners {
+            Some(c) => format!(
+                "{} corners by {} (C0..), sides in colour from each corner to the next",
+                c.corners.len(),
+                value_name(&a.criterion)
             ),
-            match &corners {
-                Some(c) => format!(
-                    "{} corners by {} (C0..), sides in colour from each corner to the next",
-                    c.corners.len(),
-                    a.criterion
-                ),
-                None => "outer loop red, holes purple".into(),
-            },
-        ];
-        let pts: Vec<[u8; 3]> = vec![[150, 150, 150]; cloud.len()];
-        let mut polylines = Vec::new();
-        for (li, l) in b.loops.iter().enumerate() {
-            if li != b.outer {
+            None => "outer loop red, holes purple".into(),
+        },
+    ];
+    let grey: Vec<[u8; 3]> = vec![[150, 150, 150]; cloud.len()];
+    let mut polylines: Vec<Polyline> = b
+        .loops
+        .iter()
+        .enumerate()
+        .filter(|&(li, _)| li != b.outer)
+        .map(|(_, l)| Polyline {
+            points: l.iter().map(|&i| cloud.points()[i]).collect(),
+            rgb: [160, 30, 180],
+            closed: true,
+        })
+        .collect();
+    let mut markers = Vec::new();
+    match &r.corners {
+        Some(c) => {
+            for (k, s) in c.sides.iter().enumerate() {
                 polylines.push(Polyline {
-                    points: l.iter().map(|&i| cloud.points()[i]).collect(),
-                    rgb: [160, 30, 180],
-                    closed: true,
+                    points: s.iter().map(|&q| r.loop_points[q]).collect(),
+                    rgb: SIDE_COLOURS[k % SIDE_COLOURS.len()],
+                    closed: false,
+                });
+            }
+            for (k, &q) in c.corners.iter().enumerate() {
+                markers.push(Marker {
+                    at: r.loop_points[q],
+                    rgb: [255, 255, 255],
+                    label: format!("C{k}"),
                 });
             }
         }
-        let mut markers = Vec::new();
-        match &corners {
-            Some(c) => {
-                for (k, s) in c.sides.iter().enumerate() {
-                    polylines.push(Polyline {
-                        points: s.iter().map(|&q| loop_points[q]).collect(),
-                        rgb: SIDE_COLOURS[k % SIDE_COLOURS.len()],
-                        closed: false,
-                    });
-                }
-                for (k, &q) in c.corners.iter().enumerate() {
-                    markers.push(Marker {
-                        at: loop_points[q],
-                        rgb: [255, 255, 255],
-                        label: format!("C{k}"),
-                    });
-                }
-            }
-            None => polylines.push(Polyline {
-                points: loop_points.clone(),
-                rgb: [220, 30, 30],
-                closed: true,
-            }),
-        }
-        let png = render_scene_png(
-            &PointScene {
-                points: cloud.points(),
-                colours: Some(&pts),
-                polylines,
-                markers,
-            },
-            &opts,
-        )?;
-        files.push((p.clone(), png));
+        None => polylines.push(Polyline {
+            points: r.loop_points.clone(),
+            rgb: [220, 30, 30],
+            closed: true,
+        }),
     }
-    write_all_atomic(&files)?;
-    progress.finish();
-    if a.json {
-        println!("{}", serde_json::to_string_pretty(&doc)?);
-        return Ok(());
-    }
+    let scene = PointScene {
+        points: cloud.points(),
+        colours: Some(&grey),
+        polylines,
+        markers,
+    };
+    Ok(render_scene_png(&scene, &opts)?)
+}
+
+/// The tables of `cloud boundary`: the loops, then the corners.
+fn print_boundary(cloud: &PointCloud, r: &CloudBoundary, secs: f64) {
+    let b = &r.boundary;
+    let outer = r.outer();
     let mut t = Table::new(&["boundary", "value"], &[true]);
     t.row(vec!["points".into(), cloud.len().to_string()]);
     t.row(vec![
@@ -860,42 +724,85 @@ fn boundary(a: BoundaryArgs) -> Result<()> {
     ]);
     t.row(vec!["time (s)".into(), format!("{secs:.3}")]);
     print!("{}", t.render());
-    if let Some(c) = &corners {
-        println!();
-        let head = match criterion {
-            CornerCriterion::TurningAngle => "angle (deg)",
-            CornerCriterion::ThreePointCurvature => "curvature (1/unit)",
+    let Some(c) = &r.corners else {
+        return;
+    };
+    println!();
+    let head = match r.criterion {
+        CornerCriterion::TurningAngle => "angle (deg)",
+        CornerCriterion::ThreePointCurvature => "curvature (1/unit)",
+    };
+    let mut t = Table::new(
+        &[
+            "corner",
+            "loop position",
+            "point index",
+            "x",
+            "y",
+            "z",
+            head,
+            "side points",
+        ],
+        &[true],
+    );
+    for (k, &q) in c.corners.iter().enumerate() {
+        let p = r.loop_points[q];
+        t.row(vec![
+            format!("C{k}"),
+            q.to_string(),
+            outer[q].to_string(),
+            num(p.x),
+            num(p.y),
+            num(p.z),
+            num(r.corner_value(q).unwrap_or(f64::NAN)),
+            c.sides[k].len().to_string(),
+        ]);
+    }
+    print!("{}", t.render());
+}
+
+fn boundary(a: BoundaryArgs) -> Result<()> {
+    check_extensions(&[
+        (&a.output, "--output", &["json", "ply", "xyz"][..]),
+        (&a.png, "--png", &["png"][..]),
+    ])?;
+    let mut cfg = CloudBoundaryConfig::default();
+    cfg.boundary.alpha = a.alpha;
+    cfg.boundary.alpha_factor = a.alpha_factor;
+    cfg.corners.criterion = CornerCriterion::from(a.criterion);
+    cfg.corners.count = a.corners;
+    cfg.corners.offset = a.corner_offset;
+    cfg.corners.min_separation = a.min_separation;
+    cfg.corner_positions = a.corner_at.as_ref().map(|c| c.0.clone());
+    let progress = Progress::spinner(a.quiet || a.json);
+    progress.stage("reading");
+    let cloud = a.input.load(a.json)?;
+    progress.stage(format!("alpha shape of {} points", cloud.len()));
+    let t0 = Instant::now();
+    let r = find_boundary(&cloud, &cfg, &progress)
+        .with_context(|| format!("boundary of {}", a.input.input.display()))?;
+    let secs = t0.elapsed().as_secs_f64();
+    let doc = boundary_doc(&a, &cloud, &r, secs);
+    let mut files: Files = Vec::new();
+    if let Some(o) = &a.output {
+        let bytes = if extension(o) == "json" {
+            serde_json::to_string_pretty(&doc)?.into_bytes()
+        } else {
+            cloud_file(o, &r.loop_cloud()?)?
         };
-        let mut t = Table::new(
-            &[
-                "corner",
-                "loop position",
-                "point index",
-                "x",
-                "y",
-                "z",
-                head,
-                "side points",
-            ],
-            &[true],
-        );
-        for (k, &q) in c.corners.iter().enumerate() {
-            let p = loop_points[q];
-            t.row(vec![
-                format!("C{k}"),
-                q.to_string(),
-                outer[q].to_string(),
-                num(p.x),
-                num(p.y),
-                num(p.z),
-                num(corner_value(c.values[q])),
-                c.sides[k].len().to_string(),
-            ]);
-        }
-        print!("{}", t.render());
+        files.push((o.clone(), bytes));
     }
-    for (p, _) in &files {
-        println!("wrote {}", p.display());
+    if let Some(p) = &a.png {
+        progress.stage("picture");
+        files.push((p.clone(), boundary_picture(&a, &cloud, &r)?));
     }
+    write_all_atomic(&files)?;
+    progress.finish();
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&doc)?);
+        return Ok(());
+    }
+    print_boundary(&cloud, &r, secs);
+    print_files(&files);
     Ok(())
 }

@@ -1,33 +1,30 @@
 //! `scanfit coons`: one patch of points -> boundary, corners, boundary curves,
 //! bilinearly blended Coons patch, parameters, then either the Coons paper's
 //! least-squares B-spline surface or the PDE paper's deformation surface.
+//! The pipeline is [`scanfit::pipeline::coons`]; this file parses, reads,
+//! calls, prints and writes.
 
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
-use clap::Args;
-use scanfit::base::{
-    coons_from_cloud, coons_parameters, BoundaryCurveConfig, BoundaryFit, CoonsFromCloudConfig,
-    CoonsParamConfig, CoonsProjection, Sides,
-};
-use scanfit::cloud::boundary::BoundaryConfig;
-use scanfit::cloud::corners::{CornerConfig, CornerCriterion};
-use scanfit::fit::surface::{fit_surface, SurfaceFitConfig};
-use scanfit::metrics::{
-    grid_rmse, orthogonal_errors, parameterization_quality, parametric_distances, ErrorStats,
-};
-use scanfit::pde::{fit_pde, BsplineConversionConfig, PdeConfig};
-use scanfit::project::{GridIterationConfig, InversionConfig, SurfaceInverter};
+use clap::{Args, ValueEnum};
+use scanfit::base::{BoundaryFit, CoonsProjection, Sides};
+use scanfit::cloud::corners::CornerCriterion;
+use scanfit::pde::PdeConfig;
+use scanfit::pipeline::coons::{run as coons, CoonsConfig, CoonsReport, CoonsRoute};
+use scanfit::project::{GridIterationConfig, InversionConfig};
 use scanfit::Point3;
-use scanfit_io::json::{Provenance, SurfaceDoc, SurfaceQualityDoc};
+use scanfit_io::json::SurfaceDoc;
 use scanfit_io::render::{Marker, Polyline};
 use scanfit_io::write_all_atomic;
 
-use crate::args::pair;
-use crate::cloud::InputArgs;
+use crate::args::{choice, value_name as name, InputArgs, Parsed, INDICES, NXM};
+use crate::cloud::CriterionArg;
 use crate::outputs::{
-    check_extensions, points_file, print_written, Deviation, Picture, PngStyle, SurfaceOutputArgs,
+    check_extensions, points_file, print_written, provenance, quality_doc, samples_json, Deviation,
+    Files, Picture, PngStyle, SurfaceOutputArgs,
 };
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -57,6 +54,77 @@ Errors: eq. 15 of the PDE paper (|P - S(u,v)| at the parameters) for the Coons
 patch and the result, and orthogonal distances to the exported surface.
 Points outside the patch project onto its boundary sideways; they are counted.";
 
+/// `--sides`: four, or three with one side collapsed to a corner.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SidesArg {
+    /// A four-sided patch.
+    #[value(name = "4")]
+    Four,
+    /// A three-sided patch (the fourth side degenerates to the first corner).
+    #[value(name = "3")]
+    Three,
+}
+
+impl SidesArg {
+    fn count(self) -> usize {
+        match self {
+            Self::Four => 4,
+            Self::Three => 3,
+        }
+    }
+}
+
+/// `--curves`: how the boundary curves are fitted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CurvesArg {
+    /// End-pinned least squares (PDE paper 4.2).
+    Lsq,
+    /// Interpolation of every side point.
+    Interpolate,
+}
+
+/// `--fit`: the surface route.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RouteArg {
+    /// Least-squares B-spline surface (Coons paper).
+    Bspline,
+    /// PDE deformation of the Coons patch (PDE paper).
+    Pde,
+}
+
+/// `--params`: how the points get their parameters on the Coons patch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ParamsArg {
+    /// Nearest grid vertex and iteration (Coons paper eqs. 17-22).
+    Grid,
+    /// Exact closest point (PDE paper 4.4).
+    Closest,
+}
+
+/// `--corners`: detected, or loop positions.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum CornersArg {
+    /// Detected by the corner criterion.
+    Auto,
+    /// Loop positions of the outer boundary loop, in loop order.
+    At(Vec<usize>),
+}
+
+/// `"auto"` or loop positions `"I,J,K[,L]"` ([`CornersArg`]).
+pub const CORNERS: Parsed<CornersArg> = Parsed::new(corners);
+
+fn corners(s: &str, what: &str) -> std::result::Result<CornersArg, String> {
+    if s.trim() == "auto" {
+        return Ok(CornersArg::Auto);
+    }
+    INDICES
+        .parse_str(s, what)
+        .map(|i| CornersArg::At(i.0))
+        .map_err(|_| {
+            format!("{what} '{s}' must be `auto` or loop positions I,J,K,L (whole numbers)")
+        })
+}
+
 /// Arguments of `scanfit coons`.
 #[derive(Args, Debug)]
 #[command(after_help = EXAMPLES)]
@@ -64,14 +132,14 @@ pub struct CoonsArgs {
     #[command(flatten)]
     pub input: InputArgs,
     /// Corners: `auto` (detected) or loop positions I,J,K[,L] of the outer boundary loop.
-    #[arg(long, default_value = "auto", value_name = "auto|I,J,K,L")]
-    pub corners: String,
+    #[arg(long, default_value = "auto", value_name = "auto|I,J,K,L", value_parser = CORNERS)]
+    pub corners: CornersArg,
     /// Number of sides of the patch: 4, or 3 (one side degenerates to a corner).
-    #[arg(long, default_value_t = 4, value_name = "4|3")]
-    pub sides: usize,
+    #[arg(long, default_value = "4", value_name = "4|3", value_parser = choice::<SidesArg>())]
+    pub sides: SidesArg,
     /// Corner criterion: `angle` (Coons paper) or `curvature` (PDE paper).
-    #[arg(long, default_value = "angle", value_name = "C")]
-    pub criterion: String,
+    #[arg(long, default_value = "angle", value_name = "C", value_parser = choice::<CriterionArg>())]
+    pub criterion: CriterionArg,
     /// Alpha radius of the boundary [default: --alpha-factor x median spacing].
     #[arg(long, value_name = "A")]
     pub alpha: Option<f64>,
@@ -79,30 +147,30 @@ pub struct CoonsArgs {
     #[arg(long, default_value_t = 2.5, value_name = "F")]
     pub alpha_factor: f64,
     /// Boundary curves: `lsq` (end-pinned least squares) or `interpolate`.
-    #[arg(long, default_value = "lsq", value_name = "HOW")]
-    pub curves: String,
+    #[arg(long, default_value = "lsq", value_name = "HOW", value_parser = choice::<CurvesArg>())]
+    pub curves: CurvesArg,
     /// Control points per boundary curve (lsq) [default: sqrt(side points), 4..30].
     #[arg(long, value_name = "N")]
     pub curve_ctrl: Option<usize>,
     /// Surface route: `bspline` (Coons paper) or `pde` (PDE paper; implied by --pde).
-    #[arg(long, value_name = "ROUTE")]
-    pub fit: Option<String>,
+    #[arg(long, value_name = "ROUTE", value_parser = choice::<RouteArg>())]
+    pub fit: Option<RouteArg>,
     /// Control net of the least-squares surface (bspline route), "NUxNV" or "N".
-    #[arg(long, default_value = "20x20", value_name = "NUxNV")]
-    pub ctrl: String,
+    #[arg(long, default_value = "20x20", value_name = "NUxNV", value_parser = NXM)]
+    pub ctrl: (usize, usize),
     /// Degrees of the least-squares surface (bspline route), "PxQ" or "P".
-    #[arg(long, default_value = "3x3", value_name = "PxQ")]
-    pub degree: String,
+    #[arg(long, default_value = "3x3", value_name = "PxQ", value_parser = NXM)]
+    pub degree: (usize, usize),
     /// PDE deformation with M x N sine terms (PDE paper; 5x5 in the paper, 10x10 in its Table 2).
-    #[arg(long, value_name = "MxN")]
-    pub pde: Option<String>,
+    #[arg(long, value_name = "MxN", value_parser = NXM)]
+    pub pde: Option<(usize, usize)>,
     /// Flexural rigidity D of the PDE (does not change the surface; paper: 1).
     #[arg(long, default_value_t = 1.0, value_name = "D")]
     pub rigidity: f64,
     /// Parameters: `grid` (Coons paper) or `closest` (PDE paper) [default: grid
     /// for --fit bspline, closest for --pde].
-    #[arg(long, value_name = "HOW")]
-    pub params: Option<String>,
+    #[arg(long, value_name = "HOW", value_parser = choice::<ParamsArg>())]
+    pub params: Option<ParamsArg>,
     /// Grid step h of --params grid (Coons paper: 0.001).
     #[arg(long, default_value_t = 0.001, value_name = "H")]
     pub h: f64,
@@ -129,234 +197,127 @@ pub struct CoonsArgs {
 
 const SIDE_COLOURS: [[u8; 3]; 4] = [[220, 30, 30], [30, 110, 220], [230, 140, 0], [150, 40, 190]];
 
-/// Runs `scanfit coons`.
-pub fn run(a: CoonsArgs) -> Result<()> {
-    a.out.check()?;
-    check_extensions(&[(&a.points_out, "--points-out", &["ply", "xyz"][..])])?;
-    if a.sides != 3 && a.sides != 4 {
-        bail!(
-            "--sides {}: a Coons patch has 4 sides, or 3 with one degenerate",
-            a.sides
-        );
-    }
-    let pde_terms = match (a.fit.as_deref(), &a.pde) {
-        (Some("bspline"), Some(_)) => {
+/// The pipeline's settings from the arguments.
+fn config(a: &CoonsArgs) -> Result<CoonsConfig> {
+    let sides = a.sides.count();
+    let pde_terms = match (a.fit, a.pde) {
+        (Some(RouteArg::Bspline), Some(_)) => {
             bail!("--fit bspline and --pde exclude each other; choose one route")
         }
-        (None | Some("pde"), Some(t)) => Some(pair(t, "--pde")?),
-        (Some("pde"), None) => Some((5, 5)),
-        (None | Some("bspline"), None) => None,
-        (Some(f), _) => bail!("unknown --fit '{f}'; use bspline or pde (with --pde MxN)"),
+        (_, Some(terms)) => Some(terms),
+        (Some(RouteArg::Pde), None) => Some((5, 5)),
+        (_, None) => None,
     };
-    let criterion = match a.criterion.as_str() {
-        "angle" => CornerCriterion::TurningAngle,
-        "curvature" => CornerCriterion::ThreePointCurvature,
-        c => bail!("unknown --criterion '{c}'; use angle or curvature"),
-    };
-    let corner_positions: Option<Vec<usize>> = match a.corners.as_str() {
-        "auto" => None,
-        s => {
-            let c: Vec<usize> = s
-                .split(',')
-                .map(|x| x.trim().parse::<usize>())
-                .collect::<std::result::Result<_, _>>()
-                .with_context(|| {
-                    format!(
-                        "--corners '{s}' must be `auto` or loop positions I,J,K,L (whole numbers)"
-                    )
-                })?;
-            if c.len() != a.sides {
-                bail!(
-                    "--corners '{s}' lists {} positions but --sides is {}; give one position per corner",
-                    c.len(),
-                    a.sides
-                );
-            }
-            Some(c)
-        }
-    };
-    let fit = match a.curves.as_str() {
-        "lsq" => BoundaryFit::LeastSquares {
-            ctrl_count: a.curve_ctrl,
+    let mut cfg = CoonsConfig::default();
+    cfg.route = match pde_terms {
+        None => CoonsRoute::bspline(a.degree, a.ctrl),
+        Some((m, n)) => CoonsRoute::Pde {
+            pde: PdeConfig {
+                m,
+                n,
+                d: a.rigidity,
+            },
+            export_tolerance: a.export_tolerance,
         },
-        "interpolate" => BoundaryFit::Interpolation,
-        c => bail!("unknown --curves '{c}'; use lsq or interpolate"),
     };
-    let params_how = a.params.clone().unwrap_or_else(|| {
-        if pde_terms.is_some() {
-            "closest"
-        } else {
-            "grid"
-        }
-        .into()
+    let params = a.params.unwrap_or(match cfg.route {
+        CoonsRoute::Bspline(_) => ParamsArg::Grid,
+        _ => ParamsArg::Closest,
     });
-    let projection = match params_how.as_str() {
-        "grid" => CoonsProjection::GridIteration(GridIterationConfig {
+    cfg.projection = Some(match params {
+        ParamsArg::Grid => CoonsProjection::GridIteration(GridIterationConfig {
             h: a.h,
             epsilon: a.epsilon,
             ..Default::default()
         }),
-        "closest" => CoonsProjection::Inversion(InversionConfig::default()),
-        p => bail!("unknown --params '{p}'; use grid or closest"),
+        ParamsArg::Closest => CoonsProjection::Inversion(InversionConfig::default()),
+    });
+    cfg.base.boundary.alpha = a.alpha;
+    cfg.base.boundary.alpha_factor = a.alpha_factor;
+    cfg.base.corners.criterion = CornerCriterion::from(a.criterion);
+    cfg.base.corners.count = sides;
+    cfg.base.corner_positions = match &a.corners {
+        CornersArg::Auto => None,
+        CornersArg::At(c) if c.len() != sides => bail!(
+            "--corners '{}' lists {} positions but --sides is {sides}; give one position per corner",
+            c.iter().map(usize::to_string).collect::<Vec<_>>().join(","),
+            c.len()
+        ),
+        CornersArg::At(c) => Some(c.clone()),
     };
-    let (degree, ctrl) = (pair(&a.degree, "--degree")?, pair(&a.ctrl, "--ctrl")?);
+    cfg.base.curves.degree = 3;
+    cfg.base.curves.fit = match a.curves {
+        CurvesArg::Lsq => BoundaryFit::LeastSquares {
+            ctrl_count: a.curve_ctrl,
+        },
+        CurvesArg::Interpolate => BoundaryFit::Interpolation,
+    };
+    Ok(cfg)
+}
 
+/// Runs `scanfit coons`.
+pub fn run(a: CoonsArgs) -> Result<()> {
+    a.out.check()?;
+    check_extensions(&[(&a.points_out, "--points-out", &["ply", "xyz"][..])])?;
+    let cfg = config(&a)?;
     let t0 = Instant::now();
     let progress = Progress::spinner(a.quiet || a.json);
     let input = a.input.input.display().to_string();
     progress.stage(format!("reading {input}"));
-    let (cloud, dropped) = a.input.load()?;
-    if dropped > 0 && !a.json {
-        eprintln!("note: {dropped} points with NaN or infinite coordinates dropped");
-    }
-    let pts = cloud.points();
-    progress.stage(format!("boundary and corners of {} points", pts.len()));
-    let cfg = CoonsFromCloudConfig {
-        boundary: BoundaryConfig {
-            alpha: a.alpha,
-            alpha_factor: a.alpha_factor,
-        },
-        corners: CornerConfig {
-            criterion,
-            count: a.sides,
-            ..Default::default()
-        },
-        corner_positions,
-        curves: BoundaryCurveConfig { degree: 3, fit },
-        ..Default::default()
-    };
-    let base = coons_from_cloud(pts, &cfg)
-        .with_context(|| format!("Coons patch of {input} ({} sides)", a.sides))?;
-    let coons_b = base.patch.to_bspline()?;
-    progress.stage(format!("parameters on the Coons patch ({params_how})"));
-    let par = coons_parameters(
-        &coons_b,
-        pts,
-        &CoonsParamConfig {
-            projection,
-            outside_tolerance: None,
-        },
-    )?;
-    let coons_err = ErrorStats::of(&parametric_distances(&coons_b, pts, &par.uv));
-    let diag = cloud.diagonal();
-    let (surface, fit_err, export_dev, route) = match pde_terms {
-        None => {
-            progress.stage(format!(
-                "least-squares surface, {} x {} control points",
-                ctrl.0, ctrl.1
-            ));
-            let s = fit_surface(
-                pts,
-                &par.uv,
-                &SurfaceFitConfig {
-                    degree,
-                    ctrl,
-                    ..Default::default()
-                },
-            )?;
-            let e = ErrorStats::of(&parametric_distances(&s, pts, &par.uv));
-            (
-                s,
-                e,
-                None,
-                format!(
-                    "least-squares B-spline surface, {} x {} control points (Coons paper)",
-                    ctrl.0, ctrl.1
-                ),
-            )
-        }
-        Some((m, n)) => {
-            progress.stage(format!("PDE deformation, {m} x {n} terms"));
-            let f = fit_pde(
-                &base.patch,
-                pts,
-                &par.uv,
-                &PdeConfig {
-                    m,
-                    n,
-                    d: a.rigidity,
-                },
-            )?;
-            let tol = a.export_tolerance.unwrap_or(1e-4 * diag);
-            progress.stage("B-spline form of the PDE surface");
-            let b = f.surface.to_bspline(&BsplineConversionConfig::new(tol))?;
-            (
-                b.surface,
-                f.errors,
-                Some((b.max_deviation, tol)),
-                format!("Coons patch + PDE deformation, {m} x {n} terms (PDE paper)"),
-            )
-        }
-    };
-    progress.stage("orthogonal distances");
-    let inverter = SurfaceInverter::new(&surface, InversionConfig::default())?;
-    let (orth, inv) = orthogonal_errors(&inverter, pts);
-    let resid: Vec<f64> = match pde_terms {
-        None => parametric_distances(&surface, pts, &par.uv),
-        Some(_) => Vec::new(),
-    };
+    let cloud = a.input.load(a.json)?;
+    let r = coons(&cloud, &cfg, &progress)
+        .with_context(|| format!("Coons patch of {input} ({} sides)", a.sides.count()))?;
     let secs = t0.elapsed().as_secs_f64();
-
     progress.stage("writing");
-    let curve_ctrl: Vec<usize> = base
-        .curves
-        .iter()
-        .map(|c| c.curve.control_points().len())
-        .collect();
-    let curve_err: Vec<f64> = base.curves.iter().map(|c| c.max_error).collect();
-    let outer = base.boundary.outer_loop();
-    // the MBA paper's eq. 17 and the parameterization's fold-overs and stretch
-    let grid = grid_rmse(&surface, pts, None)?;
-    let pq = parameterization_quality(&surface, pts, &par.uv).unwrap_or_default();
-    let quality = SurfaceQualityDoc {
-        points: pts.len(),
-        mean_error: fit_err.mean,
-        max_error: fit_err.max,
-        rmse: fit_err.rmse,
-        mean_distance: orth.mean,
-        max_distance: orth.max,
-        rmse_distance: orth.rmse,
-        unconverged: inv.iter().filter(|r| !r.converged).count(),
-        grid_rmse: grid,
-        triangles: pq.triangles,
-        fold_overs: pq.fold_overs,
-        l2_stretch: pq.l2_stretch,
-        max_anisotropy: pq.max_anisotropy,
-        correction_rmse: Vec::new(),
-    };
-    let mut settings = std::collections::BTreeMap::new();
-    settings.insert("sides".into(), a.sides.into());
+    let (files, exaggeration) = outputs(&a, cloud.points(), &r)?;
+    write_all_atomic(&files)?;
+    progress.finish();
+    if a.json {
+        return print_json(&a, cloud.points(), &r, secs, &files);
+    }
+    print_tables(&a, cloud.points(), &r, secs);
+    print_written(&files, a.out.png.as_deref(), exaggeration);
+    Ok(())
+}
+
+/// The surface document: the surface, its provenance and quality record.
+fn document(a: &CoonsArgs, points: usize, r: &CoonsReport) -> SurfaceDoc {
+    let mut settings = BTreeMap::new();
+    settings.insert("sides".into(), a.sides.count().into());
     settings.insert(
         "corners".into(),
-        serde_json::json!(base.corners.corners.clone()),
+        serde_json::json!(r.base.corners.corners.clone()),
     );
-    settings.insert("criterion".into(), a.criterion.clone().into());
-    settings.insert("curves".into(), a.curves.clone().into());
-    match pde_terms {
-        Some((m, n)) => {
+    settings.insert("criterion".into(), name(&a.criterion).into());
+    settings.insert("curves".into(), name(&a.curves).into());
+    match &r.pde {
+        Some(p) => {
+            let (m, n) = p.fit.surface.deformation.terms();
             settings.insert("pde_terms".into(), serde_json::json!([m, n]));
             settings.insert("rigidity".into(), a.rigidity.into());
-            if let Some((dev, tol)) = export_dev {
-                settings.insert("export_tolerance".into(), tol.into());
-                settings.insert("export_deviation".into(), dev.into());
-            }
+            settings.insert("export_tolerance".into(), p.export_tolerance.into());
+            settings.insert("export_deviation".into(), p.export_deviation.into());
         }
         None => {
-            settings.insert("ctrl".into(), serde_json::json!([ctrl.0, ctrl.1]));
-            settings.insert("degree".into(), serde_json::json!([degree.0, degree.1]));
+            settings.insert("ctrl".into(), serde_json::json!([a.ctrl.0, a.ctrl.1]));
+            settings.insert("degree".into(), serde_json::json!([a.degree.0, a.degree.1]));
         }
     }
-    let mut doc = SurfaceDoc::new(&surface);
-    doc.provenance = Some(Provenance {
-        tool: format!("scanfit {}", env!("CARGO_PKG_VERSION")),
-        operation: format!("coons ({route})"),
-        parameterization: Some(format!("Coons patch, {params_how}")),
-        input: Some(input.clone()),
-        point_count: Some(pts.len()),
+    let mut doc = SurfaceDoc::new(&r.surface);
+    doc.provenance = Some(provenance(
+        format!("coons ({})", r.route),
+        Some(format!("Coons patch, {}", r.projection_name())),
+        &a.input.input,
+        points,
         settings,
-    });
-    doc.quality = Some(quality.clone());
-    let p = &base.patch;
+    ));
+    doc.quality = Some(quality_doc(&r.assessment.quality, Vec::new()));
+    doc
+}
+
+/// The boundary curves (in loop order) and the corners over the pictures.
+fn picture(points: &[Point3], r: &CoonsReport) -> Picture {
+    let p = &r.base.patch;
     let sample = |f: &dyn Fn(f64) -> Point3| -> Vec<Point3> {
         (0..=200).map(|k| f(k as f64 / 200.0)).collect()
     };
@@ -369,55 +330,58 @@ pub fn run(a: CoonsArgs) -> Result<()> {
     if p.sides() == Sides::Four {
         curves.push(sample(&|t| p.left().point(1.0 - t)));
     }
-    let picture = Picture {
+    let outer = r.base.boundary.outer_loop();
+    Picture {
         style: PngStyle::Deviation,
         lines: curves
             .into_iter()
-            .enumerate()
-            .map(|(k, points)| Polyline {
+            .zip(SIDE_COLOURS)
+            .map(|(points, rgb)| Polyline {
                 points,
-                rgb: SIDE_COLOURS[k],
+                rgb,
                 closed: false,
             })
             .collect(),
-        markers: base
+        markers: r
+            .base
             .corners
             .corners
             .iter()
             .enumerate()
             .map(|(k, &q)| Marker {
-                at: pts[outer[q]],
+                at: points[outer[q]],
                 rgb: [255, 255, 255],
                 label: format!("C{k}"),
             })
             .collect(),
         legend: vec![format!(
-            "{route}; dots = points, lines = boundary curves, C0.. = corners"
+            "{}; dots = points, lines = boundary curves, C0.. = corners",
+            r.route
         )],
-    };
-    let dist: Vec<f64> = inv.iter().map(|r| r.distance).collect();
+    }
+}
+
+/// Every requested output file, and the exaggeration of `--png`.
+fn outputs(a: &CoonsArgs, points: &[Point3], r: &CoonsReport) -> Result<(Files, f64)> {
+    let dist = r.assessment.distances();
     let (mut files, exaggeration) = a.out.files(
-        &surface,
-        &doc,
-        pts,
+        &r.surface,
+        &document(a, points.len(), r),
+        points,
         &Deviation {
             per_point: &dist,
-            stats: orth,
+            stats: r.assessment.quality.orthogonal,
             name: "orthogonal distance",
         },
         &a.input.input,
-        &picture,
+        &picture(points, r),
     )?;
     if let Some(pout) = &a.points_out {
-        let u: Vec<f64> = par.uv.iter().map(|t| t[0]).collect();
-        let v: Vec<f64> = par.uv.iter().map(|t| t[1]).collect();
-        let coons_d = parametric_distances(&coons_b, pts, &par.uv);
-        let residual = if resid.is_empty() {
-            parametric_distances(&surface, pts, &par.uv)
-        } else {
-            resid
-        };
-        let outside: Vec<f64> = par
+        let uv = &r.parameters.uv;
+        let u: Vec<f64> = uv.iter().map(|t| t[0]).collect();
+        let v: Vec<f64> = uv.iter().map(|t| t[1]).collect();
+        let outside: Vec<f64> = r
+            .parameters
             .outside
             .iter()
             .map(|&o| f64::from(u8::from(o)))
@@ -425,157 +389,188 @@ pub fn run(a: CoonsArgs) -> Result<()> {
         let attrs: [(&str, &[f64]); 6] = [
             ("u", &u),
             ("v", &v),
-            ("coons", &coons_d),
-            ("residual", &residual),
+            ("coons", &r.coons_distances),
+            ("residual", &r.assessment.residuals),
             ("distance", &dist),
             ("outside", &outside),
         ];
-        files.push((pout.clone(), points_file(pout, pts, &attrs)));
+        files.push((pout.clone(), points_file(pout, points, &attrs)));
     }
-    write_all_atomic(&files)?;
-    progress.finish();
+    Ok((files, exaggeration))
+}
 
-    let (cu, cv) = surface.counts();
-    let (dp, dq) = surface.degrees();
-    if a.json {
-        let report = serde_json::json!({
-            "input": input,
-            "point_count": pts.len(),
-            "sides": a.sides,
-            "boundary": {
-                "outer_loop_points": outer.len(),
-                "alpha": base.boundary.alpha,
-            },
-            "corners": base.corners.corners.iter().zip(&base.corner_angles).map(|(&q, ang)| serde_json::json!({
-                "position": q,
-                "index": outer[q],
-                "point": [pts[outer[q]].x, pts[outer[q]].y, pts[outer[q]].z],
+/// Mean, max and RMSE as JSON.
+fn stats_json(e: &scanfit::metrics::ErrorStats) -> serde_json::Value {
+    serde_json::json!({"mean": e.mean, "max": e.max, "rmse": e.rmse})
+}
+
+/// `--json`: the report on stdout.
+fn print_json(
+    a: &CoonsArgs,
+    points: &[Point3],
+    r: &CoonsReport,
+    secs: f64,
+    files: &Files,
+) -> Result<()> {
+    let outer = r.base.boundary.outer_loop();
+    let (cu, cv) = r.surface.counts();
+    let (dp, dq) = r.surface.degrees();
+    let q = &r.assessment.quality;
+    let par = &r.parameters;
+    let report = serde_json::json!({
+        "input": a.input.input.display().to_string(),
+        "point_count": points.len(),
+        "sides": a.sides.count(),
+        "boundary": {
+            "outer_loop_points": outer.len(),
+            "alpha": r.base.boundary.alpha,
+        },
+        "corners": r.base.corners.corners.iter().zip(&r.base.corner_angles).map(|(&k, ang)| {
+            let p = points[outer[k]];
+            serde_json::json!({
+                "position": k,
+                "index": outer[k],
+                "point": [p.x, p.y, p.z],
                 "angle_degrees": ang.to_degrees(),
-            })).collect::<Vec<_>>(),
-            "curves": base.curves.iter().zip(&base.side_points).map(|(c, s)| serde_json::json!({
-                "side_points": s.len(),
-                "control_points": c.curve.control_points().len(),
-                "max_error": c.max_error,
-            })).collect::<Vec<_>>(),
-            "parameters": {
-                "method": params_how,
-                "outside": par.outside_count,
-                "outside_tolerance": par.outside_tolerance,
-                "unconverged": par.unconverged,
-                "mean_iterations": par.mean_iterations,
-            },
-            "route": route,
-            "coons_error": {"mean": coons_err.mean, "max": coons_err.max, "rmse": coons_err.rmse},
-            "fit_error": {"mean": fit_err.mean, "max": fit_err.max, "rmse": fit_err.rmse},
-            "orthogonal": {"mean": orth.mean, "max": orth.max, "rmse": orth.rmse},
-            "export_deviation": export_dev.map(|(d, _)| d),
-            "surface": {"degree": [dp, dq], "control_points": [cu, cv]},
-            "seconds": secs,
-            "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
-        });
-        println!("{}", serde_json::to_string_pretty(&report)?);
-        return Ok(());
-    }
-    println!(
-        "{input}: {} points -> {}-sided Coons patch -> {route}\n",
-        pts.len(),
-        a.sides
-    );
+            })
+        }).collect::<Vec<_>>(),
+        "curves": r.base.curves.iter().zip(&r.base.side_points).map(|(c, s)| serde_json::json!({
+            "side_points": s.len(),
+            "control_points": c.curve.control_points().len(),
+            "max_error": c.max_error,
+        })).collect::<Vec<_>>(),
+        "parameters": {
+            "method": r.projection_name(),
+            "outside": par.outside_count,
+            "outside_tolerance": par.outside_tolerance,
+            "unconverged": par.unconverged,
+            "mean_iterations": par.mean_iterations,
+        },
+        "route": r.route,
+        "coons_error": stats_json(&r.coons_errors),
+        "fit_error": stats_json(&q.at_parameters),
+        "orthogonal": stats_json(&q.orthogonal),
+        "surface_to_points": samples_json(q),
+        "export_deviation": r.pde.as_ref().map(|p| p.export_deviation),
+        "surface": {"degree": [dp, dq], "control_points": [cu, cv]},
+        "seconds": secs,
+        "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
+    });
+    println!("{}", serde_json::to_string_pretty(&report)?);
+    Ok(())
+}
+
+/// The steps table: boundary, corners, curves, parameters, surface, time.
+fn steps_table(a: &CoonsArgs, points: usize, r: &CoonsReport, secs: f64) -> Table {
+    let join = |v: Vec<String>, sep: &str| v.join(sep);
+    let par = &r.parameters;
+    let (cu, cv) = r.surface.counts();
+    let (dp, dq) = r.surface.degrees();
     let mut t = Table::new(&["step", "result"], &[true, true]);
     t.row(vec![
         "boundary".into(),
         format!(
             "outer loop of {} points, alpha {}",
-            outer.len(),
-            num(base.boundary.alpha)
+            r.base.boundary.outer_loop().len(),
+            num(r.base.boundary.alpha)
         ),
     ]);
     t.row(vec![
         "corners (loop position: angle)".into(),
-        base.corners
-            .corners
-            .iter()
-            .zip(&base.corner_angles)
-            .enumerate()
-            .map(|(k, (q, ang))| format!("C{k} {q}: {:.0} deg", ang.to_degrees()))
-            .collect::<Vec<_>>()
-            .join(", "),
+        join(
+            r.base
+                .corners
+                .corners
+                .iter()
+                .zip(&r.base.corner_angles)
+                .enumerate()
+                .map(|(k, (q, ang))| format!("C{k} {q}: {:.0} deg", ang.to_degrees()))
+                .collect(),
+            ", ",
+        ),
     ]);
+    let curves = &r.base.curves;
     t.row(vec![
-        format!("boundary curves ({})", a.curves),
+        format!("boundary curves ({})", name(&a.curves)),
         format!(
             "{} control points, max error {}",
-            curve_ctrl
-                .iter()
-                .map(usize::to_string)
-                .collect::<Vec<_>>()
-                .join("/"),
-            curve_err
-                .iter()
-                .map(|&e| num(e))
-                .collect::<Vec<_>>()
-                .join("/")
+            join(
+                curves
+                    .iter()
+                    .map(|c| c.curve.control_points().len().to_string())
+                    .collect(),
+                "/"
+            ),
+            join(curves.iter().map(|c| num(c.max_error)).collect(), "/")
         ),
     ]);
     t.row(vec![
-        format!("parameters ({params_how})"),
+        format!("parameters ({})", r.projection_name()),
         format!(
             "{} outside the patch ({:.2}%), {} unconverged, {:.1} iterations on average",
             par.outside_count,
-            100.0 * par.outside_count as f64 / pts.len().max(1) as f64,
+            100.0 * par.outside_count as f64 / points.max(1) as f64,
             par.unconverged,
             par.mean_iterations
         ),
     ]);
+    let export = r.pde.as_ref().map(|p| {
+        format!(
+            " (B-spline form within {} of S; tolerance {})",
+            num(p.export_deviation),
+            num(p.export_tolerance)
+        )
+    });
     t.row(vec![
         "surface".into(),
         format!(
             "degree {dp} x {dq}, {cu} x {cv} control points{}",
-            export_dev
-                .map(|(d, tol)| format!(
-                    " (B-spline form within {} of S; tolerance {})",
-                    num(d),
-                    num(tol)
-                ))
-                .unwrap_or_default()
+            export.unwrap_or_default()
         ),
     ]);
     t.row(vec!["time (s)".into(), format!("{secs:.2}")]);
-    print!("{}", t.render());
+    t
+}
+
+/// The tables: the steps, then the errors.
+fn print_tables(a: &CoonsArgs, points: &[Point3], r: &CoonsReport, secs: f64) {
+    println!(
+        "{}: {} points -> {}-sided Coons patch -> {}\n",
+        a.input.input.display(),
+        points.len(),
+        a.sides.count(),
+        r.route
+    );
+    print!("{}", steps_table(a, points.len(), r, secs).render());
     println!();
     let mut t = Table::new(
         &["error", "mean", "max", "RMSE", "unit"],
         &[true, false, false, false, true],
     );
-    t.row(vec![
-        "Coons patch |P - S_c(u,v)| (eq. 15)".into(),
-        num(coons_err.mean),
-        num(coons_err.max),
-        num(coons_err.rmse),
-        "data units".into(),
-    ]);
-    t.row(vec![
-        format!(
-            "{} |P - S(u,v)| (eq. 15)",
-            if pde_terms.is_some() {
-                "PDE surface"
-            } else {
-                "B-spline surface"
-            }
+    let q = &r.assessment.quality;
+    let surface = if r.pde.is_some() {
+        "PDE surface"
+    } else {
+        "B-spline surface"
+    };
+    for (label, e) in [
+        (
+            "Coons patch |P - S_c(u,v)| (eq. 15)".to_string(),
+            &r.coons_errors,
         ),
-        num(fit_err.mean),
-        num(fit_err.max),
-        num(fit_err.rmse),
-        "data units".into(),
-    ]);
-    t.row(vec![
-        "orthogonal distance to the exported surface".into(),
-        num(orth.mean),
-        num(orth.max),
-        num(orth.rmse),
-        "data units".into(),
-    ]);
+        (format!("{surface} |P - S(u,v)| (eq. 15)"), &q.at_parameters),
+        (
+            "orthogonal distance to the exported surface".to_string(),
+            &q.orthogonal,
+        ),
+    ] {
+        t.row(vec![
+            label,
+            num(e.mean),
+            num(e.max),
+            num(e.rmse),
+            "data units".into(),
+        ]);
+    }
     print!("{}", t.render());
-    print_written(&files, a.out.png.as_deref(), exaggeration);
-    Ok(())
 }

@@ -1,24 +1,27 @@
 //! `scanfit turntable`: the virtual turntable parameterization of a
 //! cylinder-like cloud (a head, a bottle, an arm) and a least-squares
-//! B-spline surface closed around the axis.
+//! B-spline surface closed around the axis. The pipeline is
+//! [`scanfit::pipeline::turntable`]; this file parses, reads, calls, prints
+//! and writes.
 
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-use anyhow::{bail, Context, Result};
-use clap::Args;
-use scanfit::base::turntable::{
-    compare_weights, turntable, AxisChoice, Ends, TurntableConfig, STAGES,
+use anyhow::{Context, Result};
+use clap::{Args, ValueEnum};
+use scanfit::base::turntable::{AxisChoice, Ends, STAGES};
+use scanfit::pipeline::turntable::{
+    run as turntable, TurntableConfig, TurntableReport, WeightComparison,
 };
-use scanfit::metrics::{grid_rmse, parametric_distances};
 use scanfit::project::WeightFactor;
 use scanfit::{PointCloud, Vector3};
-use scanfit_io::json::{Provenance, SurfaceDoc, SurfaceQualityDoc};
+use scanfit_io::json::SurfaceDoc;
 use scanfit_io::write_all_atomic;
 
-use crate::args::pair;
+use crate::args::{choice, InputArgs, Parsed, NXM};
 use crate::outputs::{
-    check_extensions, print_written, Deviation, Picture, PngStyle, SurfaceOutputArgs,
+    check_extensions, print_written, provenance, quality_doc, samples_json, Deviation, Files,
+    Picture, PngStyle, SurfaceOutputArgs,
 };
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -26,7 +29,7 @@ use crate::table::{num, Table};
 const EXAMPLES: &str = "Examples:
   scanfit turntable examples/data/blob_30k.ply -o blob.json --png blob.png
   scanfit turntable head.ply --axis y --layers 50 --ctrl 40x60 --mesh head.ply --points-out params.ply
-  scanfit turntable bottle.xyz --axis 0,0,1 --compare-weights
+  scanfit turntable bottle.xyz --axis -0.34,0.91,0.24 --compare-weights
 
 The cloud turns about the axis (principal axis unless --axis) in --views steps;
 each turn keeps the points visible from +z (hidden point removal) and fits a
@@ -39,16 +42,67 @@ relaxed; every point's orthogonal projection onto it gives (u, v), and a
 least-squares surface periodic in u is fitted (--ctrl). --png shows the points
 and the fitted surface coloured by each point's distance to it.";
 
+/// `--weight`: the weight factor of the directed projection.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum WeightArg {
+    /// Eq. 19 of the turntable paper (default).
+    Moon,
+    /// Eq. 15 (Azariadis 2004).
+    Aza04,
+    /// Eq. 16 (Azariadis & Sapidis 2005).
+    As05,
+    /// The distance to the projection axis only (not in the paper).
+    #[value(hide = true)]
+    Axis4,
+}
+
+impl From<WeightArg> for WeightFactor {
+    fn from(w: WeightArg) -> Self {
+        match w {
+            WeightArg::Moon => Self::Moon,
+            WeightArg::Aza04 => Self::Aza04,
+            WeightArg::As05 => Self::As05,
+            WeightArg::Axis4 => Self::Axis4,
+        }
+    }
+}
+
+/// `--ends`: the points beyond the end layers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum EndsArg {
+    /// Kept out of the fit; the surface spans the layers.
+    Exclude,
+    /// `v` continued past the base surface and every point fitted.
+    Extend,
+}
+
+/// `--axis`: `auto`/`principal`, `x`, `y`, `z` or a direction `X,Y,Z`.
+pub const AXIS: Parsed<AxisChoice> = Parsed::new(axis);
+
+fn axis(s: &str, what: &str) -> std::result::Result<AxisChoice, String> {
+    Ok(match s.trim().to_ascii_lowercase().as_str() {
+        "auto" | "principal" => AxisChoice::Principal,
+        "x" => AxisChoice::Given(Vector3::x()),
+        "y" => AxisChoice::Given(Vector3::y()),
+        "z" => AxisChoice::Given(Vector3::z()),
+        _ => AxisChoice::Given(crate::args::VECTOR3.parse_str(s, what).map_err(|_| {
+            format!(
+                "{what} '{s}' must be auto, x, y, z or a direction X,Y,Z (three finite numbers)"
+            )
+        })?),
+    })
+}
+
 /// Arguments of `scanfit turntable`.
 #[derive(Args, Debug)]
 #[command(after_help = EXAMPLES)]
 pub struct TurntableArgs {
     #[command(flatten)]
-    pub input: crate::cloud::InputArgs,
+    pub input: InputArgs,
     /// Turntable axis: x, y (the paper's), z, a direction "X,Y,Z", or "auto"
     /// (the cloud's principal axis).
-    #[arg(long, default_value = "auto", value_name = "AXIS")]
-    pub axis: String,
+    #[arg(long, default_value = "auto", value_name = "AXIS", allow_hyphen_values = true, value_parser = AXIS)]
+    pub axis: AxisChoice,
     /// Turns of the virtual turntable (the paper: 4, every 90 degrees).
     #[arg(long, default_value_t = 4, value_name = "V")]
     pub views: usize,
@@ -59,11 +113,11 @@ pub struct TurntableArgs {
     #[arg(long, default_value_t = 32, value_name = "N")]
     pub grid: usize,
     /// Control net of the fitted surface, "NUxNV" (NU around the axis, periodic).
-    #[arg(long, default_value = "40x40", value_name = "NUxNV")]
-    pub ctrl: String,
+    #[arg(long, default_value = "40x40", value_name = "NUxNV", value_parser = NXM)]
+    pub ctrl: (usize, usize),
     /// Weight factor of the directed projection: moon (eq. 19), aza04 (eq. 15), as05 (eq. 16).
-    #[arg(long, default_value = "moon", value_name = "W")]
-    pub weight: String,
+    #[arg(long, default_value = "moon", value_name = "W", value_parser = choice::<WeightArg>())]
+    pub weight: WeightArg,
     /// Most projection rounds of the layer curves.
     #[arg(long, default_value_t = 10, value_name = "N")]
     pub rounds: usize,
@@ -78,8 +132,8 @@ pub struct TurntableArgs {
     /// surface spans the layers) or "extend" (v continued past the base
     /// surface and every point fitted; around a closed end the surface may
     /// flare where no points hold it).
-    #[arg(long, default_value = "exclude", value_name = "MODE")]
-    pub ends: String,
+    #[arg(long, default_value = "exclude", value_name = "MODE", value_parser = choice::<EndsArg>())]
+    pub ends: EndsArg,
     /// Also print the RMSE per projection round for the three weight factors
     /// from the same layer curves (the paper's Tables 1-2).
     #[arg(long)]
@@ -101,144 +155,101 @@ pub struct TurntableArgs {
     pub quiet: bool,
 }
 
-fn parse_axis(s: &str) -> Result<AxisChoice> {
-    Ok(match s.trim().to_ascii_lowercase().as_str() {
-        "auto" | "principal" => AxisChoice::Principal,
-        "x" => AxisChoice::Given(Vector3::x()),
-        "y" => AxisChoice::Given(Vector3::y()),
-        "z" => AxisChoice::Given(Vector3::z()),
-        _ => {
-            let v = crate::cloud::triple(s, "--axis")?;
-            AxisChoice::Given(Vector3::new(v[0], v[1], v[2]))
-        }
-    })
+/// The pipeline's settings from the arguments.
+fn config(a: &TurntableArgs) -> TurntableConfig {
+    let weight = WeightFactor::from(a.weight);
+    let mut cfg = TurntableConfig::default();
+    let t = &mut cfg.turntable;
+    t.axis = a.axis;
+    t.views.views = a.views;
+    t.views.grid_u = a.grid;
+    t.layers.layers = a.layers;
+    t.layers.max_rounds = a.rounds;
+    t.layers.projection.weight = weight;
+    t.layers.margin = a.margin;
+    t.refine.rounds = a.refine;
+    t.refine.projection.weight = weight;
+    t.ends = match a.ends {
+        EndsArg::Exclude => Ends::Exclude,
+        EndsArg::Extend => Ends::Extend,
+    };
+    t.fit.ctrl = a.ctrl;
+    if a.compare_weights {
+        cfg.compare_weights = Some(WeightComparison::with_rounds(a.compare_rounds));
+    }
+    cfg
 }
 
 /// Runs `scanfit turntable`.
 pub fn run(a: TurntableArgs) -> Result<()> {
     a.out.check()?;
     check_extensions(&[(&a.points_out, "--points-out", &["ply", "xyz"][..])])?;
-    let weight = WeightFactor::from_name(&a.weight).with_context(|| {
-        format!(
-            "unknown --weight '{}'; use moon, aza04 or as05 (or axis4)",
-            a.weight
-        )
-    })?;
-    let mut cfg = TurntableConfig {
-        axis: parse_axis(&a.axis)?,
-        ..Default::default()
-    };
-    cfg.views.views = a.views;
-    cfg.views.grid_u = a.grid;
-    cfg.layers.layers = a.layers;
-    cfg.layers.max_rounds = a.rounds;
-    cfg.layers.projection.weight = weight;
-    cfg.refine.rounds = a.refine;
-    cfg.layers.margin = a.margin;
-    cfg.ends = match a.ends.to_ascii_lowercase().as_str() {
-        "exclude" => Ends::Exclude,
-        "extend" => Ends::Extend,
-        other => bail!("unknown --ends '{other}'; use exclude or extend"),
-    };
-    cfg.refine.projection.weight = weight;
-    cfg.fit.ctrl = pair(&a.ctrl, "--ctrl")?;
-    if a.compare_weights && a.compare_rounds == 0 {
-        bail!("--compare-rounds must be at least 1");
-    }
-    let progress = Progress::bar(a.quiet || a.json, STAGES.len() as u64 + 2);
+    let cfg = config(&a);
+    let progress = Progress::bar(a.quiet || a.json, STAGES.len() as u64 + 3);
     progress.stage(format!("reading {}", a.input.input.display()));
-    let (cloud, dropped) = a.input.load()?;
-    if dropped > 0 && !a.json {
-        eprintln!("note: {dropped} points with NaN or infinite coordinates dropped");
-    }
+    let cloud = a.input.load(a.json)?;
     progress.inc();
-    let input = a.input.input.clone();
     let t0 = Instant::now();
-    let t = turntable(&cloud, &cfg, &mut |i| {
-        progress.stage(STAGES[i]);
-        if i > 0 {
-            progress.inc();
-        }
-    })
-    .map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
+    let r =
+        turntable(&cloud, &cfg, &progress).with_context(|| a.input.input.display().to_string())?;
     let seconds = t0.elapsed().as_secs_f64();
-    let comparison = if a.compare_weights {
-        progress.stage("weight factor comparison");
-        Some(
-            compare_weights(
-                &cloud,
-                &t.frame,
-                &t.loops,
-                &cfg.layers,
-                a.compare_rounds,
-                &[WeightFactor::Moon, WeightFactor::Aza04, WeightFactor::As05],
-            )
-            .map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?,
-        )
-    } else {
-        None
-    };
     progress.stage("writing");
     progress.inc();
-    let pts = cloud.points();
-    let param = scanfit::metrics::ErrorStats::of(
-        &parametric_distances(&t.surface, pts, &t.uv)
-            .into_iter()
-            .zip(&t.fitted)
-            .filter(|(_, &f)| f)
-            .map(|(d, _)| d)
-            .collect::<Vec<_>>(),
-    );
-    let mut doc = SurfaceDoc::new(&t.surface);
+    let (files, exaggeration) = outputs(&a, &cloud, &r)?;
+    write_all_atomic(&files)?;
+    progress.finish();
+    if a.json {
+        return print_json(&a, &cloud, &r, seconds, &files);
+    }
+    print_report(&a, &cloud, &r, seconds);
+    print_written(&files, a.out.png.as_deref(), exaggeration);
+    Ok(())
+}
+
+/// The surface document: the surface, its provenance and quality record.
+fn document(a: &TurntableArgs, points: usize, r: &TurntableReport) -> SurfaceDoc {
+    let t = &r.turntable;
+    let (ax, c) = (t.frame.axis, t.frame.centre);
     let mut settings = BTreeMap::new();
-    let ax = t.frame.axis;
     settings.insert("axis".to_string(), serde_json::json!([ax.x, ax.y, ax.z]));
-    let c = t.frame.centre;
     settings.insert("centre".to_string(), serde_json::json!([c.x, c.y, c.z]));
     settings.insert("views".to_string(), a.views.into());
     settings.insert("layers".to_string(), a.layers.into());
     settings.insert("grid".to_string(), a.grid.into());
-    settings.insert("weight".to_string(), weight.name().into());
+    settings.insert(
+        "weight".to_string(),
+        WeightFactor::from(a.weight).name().into(),
+    );
     settings.insert("refine_rounds".to_string(), a.refine.into());
-    doc.provenance = Some(Provenance {
-        tool: format!("scanfit {}", env!("CARGO_PKG_VERSION")),
-        operation: "turntable (virtual turntable base surface + least squares, periodic in u)"
-            .into(),
-        parameterization: Some(
+    let mut doc = SurfaceDoc::new(&t.surface);
+    doc.provenance = Some(provenance(
+        "turntable (virtual turntable base surface + least squares, periodic in u)",
+        Some(
             "orthogonal projection onto the turntable base surface (u around the axis, periodic)"
                 .into(),
         ),
-        input: Some(input.display().to_string()),
-        point_count: Some(pts.len()),
+        &a.input.input,
+        points,
         settings,
-    });
-    doc.quality = Some(SurfaceQualityDoc {
-        points: t.errors.count,
-        mean_error: param.mean,
-        max_error: param.max,
-        rmse: param.rmse,
-        mean_distance: t.errors.mean,
-        max_distance: t.errors.max,
-        rmse_distance: t.errors.rmse,
-        unconverged: t.unconverged,
-        // the MBA paper's eq. 17 over the fitted surface's knot grid
-        grid_rmse: grid_rmse(&t.surface, pts, None)?,
-        triangles: t.quality.triangles,
-        fold_overs: t.quality.fold_overs,
-        l2_stretch: t.quality.l2_stretch,
-        max_anisotropy: t.quality.max_anisotropy,
-        correction_rmse: Vec::new(),
-    });
+    ));
+    doc.quality = Some(quality_doc(&r.assessment.quality, Vec::new()));
+    doc
+}
+
+/// Every requested output file, and the exaggeration of `--png`.
+fn outputs(a: &TurntableArgs, cloud: &PointCloud, r: &TurntableReport) -> Result<(Files, f64)> {
+    let t = &r.turntable;
+    let pts = cloud.points();
     let (mut files, exaggeration) = a.out.files(
         &t.surface,
-        &doc,
+        &document(a, pts.len(), r),
         pts,
         &Deviation {
             per_point: &t.distances,
             stats: t.errors,
             name: "orthogonal distance (scale: fitted points)",
         },
-        &input,
+        &a.input.input,
         &Picture {
             style: PngStyle::Deviation,
             ..Default::default()
@@ -251,48 +262,72 @@ pub fn run(a: TurntableArgs) -> Result<()> {
             .with_attribute("deviation", t.distances.clone())?;
         files.push((p.clone(), crate::cloud::cloud_file(p, &out)?));
     }
-    write_all_atomic(&files)?;
-    progress.finish();
-    let (cu, cv) = cfg.fit.ctrl;
-    if a.json {
-        let report = serde_json::json!({
-            "input": input.display().to_string(),
-            "point_count": pts.len(),
-            "axis": [ax.x, ax.y, ax.z],
-            "centre": [c.x, c.y, c.z],
-            "radius": t.frame.radius,
-            "visible": t.views.iter().map(|v| v.visible.len()).collect::<Vec<_>>(),
-            "layer_points": t.loops.iter().map(Vec::len).collect::<Vec<_>>(),
-            "layer_rmse": t.layers.rmse,
-            "base_grid": [t.grid_u, t.heights.len()],
-            "refine_rmse": t.refine_rmse,
-            "base_distance": {"mean": t.base_errors.mean, "max": t.base_errors.max, "rmse": t.base_errors.rmse},
-            "beyond_end_layers": t.on_v_boundary,
-            "ends": a.ends.to_ascii_lowercase(),
-            "distance_all_points": {"mean": t.errors_all.mean, "max": t.errors_all.max, "rmse": t.errors_all.rmse},
-            "surface_to_cloud": {"mean": t.surface_to_cloud.mean, "max": t.surface_to_cloud.max, "rmse": t.surface_to_cloud.rmse},
-            "control_points": [cu, cv],
-            "quality": doc.quality,
-            "fold_overs_inside_layers": t.quality_inside.fold_overs,
-            "fold_overs_corrected": t.quality_fitted.fold_overs,
-            "weight_comparison": comparison.as_ref().map(|c| c.iter().map(|(w, r)| serde_json::json!({"weight": w.name(), "rmse": r})).collect::<Vec<_>>()),
-            "seconds": seconds,
-            "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
-        });
-        println!("{}", serde_json::to_string_pretty(&report)?);
-        return Ok(());
-    }
+    Ok((files, exaggeration))
+}
+
+/// Mean, max and RMSE as JSON.
+fn stats_json(e: &scanfit::metrics::ErrorStats) -> serde_json::Value {
+    serde_json::json!({"mean": e.mean, "max": e.max, "rmse": e.rmse})
+}
+
+/// `--json`: the report on stdout.
+fn print_json(
+    a: &TurntableArgs,
+    cloud: &PointCloud,
+    r: &TurntableReport,
+    seconds: f64,
+    files: &Files,
+) -> Result<()> {
+    let t = &r.turntable;
+    let (ax, c) = (t.frame.axis, t.frame.centre);
+    let quality = quality_doc(&r.assessment.quality, Vec::new());
+    let report = serde_json::json!({
+        "input": a.input.input.display().to_string(),
+        "point_count": cloud.len(),
+        "axis": [ax.x, ax.y, ax.z],
+        "centre": [c.x, c.y, c.z],
+        "radius": t.frame.radius,
+        "visible": t.views.iter().map(|v| v.visible.len()).collect::<Vec<_>>(),
+        "layer_points": t.loops.iter().map(Vec::len).collect::<Vec<_>>(),
+        "layer_rmse": t.layers.rmse,
+        "base_grid": [t.grid_u, t.heights.len()],
+        "refine_rmse": t.refine_rmse,
+        "base_distance": stats_json(&t.base_errors),
+        "beyond_end_layers": t.on_v_boundary,
+        "ends": crate::args::value_name(&a.ends),
+        "distance_all_points": stats_json(&t.errors_all),
+        "surface_to_cloud": stats_json(&t.surface_to_cloud),
+        "surface_to_points": samples_json(&r.assessment.quality),
+        "control_points": [a.ctrl.0, a.ctrl.1],
+        "quality": quality,
+        "fold_overs_inside_layers": t.quality_inside.fold_overs,
+        "fold_overs_corrected": t.quality_fitted.fold_overs,
+        "weight_comparison": r.weight_comparison.as_ref().map(|c| c.iter().map(|w| serde_json::json!({"weight": w.weight.name(), "rmse": w.rmse})).collect::<Vec<_>>()),
+        "seconds": seconds,
+        "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
+    });
+    println!("{}", serde_json::to_string_pretty(&report)?);
+    Ok(())
+}
+
+/// The lines above the error table: axis, views, layers, base surface, parameters.
+fn print_steps(a: &TurntableArgs, cloud: &PointCloud, r: &TurntableReport, seconds: f64) {
+    let t = &r.turntable;
+    let (ax, c) = (t.frame.axis, t.frame.centre);
+    let join = |v: &[f64]| v.iter().map(|&x| num(x)).collect::<Vec<_>>().join(" -> ");
     println!(
-        "{}: {} points -> bicubic B-spline surface closed around the axis, {cu} x {cv} control points ({seconds:.2} s)",
-        input.display(),
-        pts.len(),
+        "{}: {} points -> bicubic B-spline surface closed around the axis, {} x {} control points ({seconds:.2} s)",
+        a.input.input.display(),
+        cloud.len(),
+        a.ctrl.0,
+        a.ctrl.1,
     );
     println!(
         "axis ({:.4}, {:.4}, {:.4}){}, centre ({}, {}, {}), radius {}, height {}",
         ax.x,
         ax.y,
         ax.z,
-        if matches!(cfg.axis, AxisChoice::Principal) {
+        if matches!(a.axis, AxisChoice::Principal) {
             " (principal axis)"
         } else {
             ""
@@ -303,14 +338,15 @@ pub fn run(a: TurntableArgs) -> Result<()> {
         num(t.frame.radius),
         num(t.frame.height.1 - t.frame.height.0)
     );
+    let visible: Vec<String> = t
+        .views
+        .iter()
+        .map(|v| v.visible.len().to_string())
+        .collect();
     println!(
         "views: {} (visible points {})",
         t.views.len(),
-        t.views
-            .iter()
-            .map(|v| v.visible.len().to_string())
-            .collect::<Vec<_>>()
-            .join(", ")
+        visible.join(", ")
     );
     let counts: Vec<usize> = t.loops.iter().map(Vec::len).collect();
     println!(
@@ -318,68 +354,51 @@ pub fn run(a: TurntableArgs) -> Result<()> {
         counts.len(),
         counts.iter().min().copied().unwrap_or(0),
         counts.iter().max().copied().unwrap_or(0),
-        weight.name(),
-        t.layers
-            .rmse
-            .iter()
-            .map(|&r| num(r))
-            .collect::<Vec<_>>()
-            .join(" -> ")
+        WeightFactor::from(a.weight).name(),
+        join(&t.layers.rmse)
     );
     println!(
         "base surface: {} x {} grid, refinement RMSE {}; points to base surface: mean {}, max {}, RMSE {}",
         t.grid_u,
         t.heights.len(),
-        t.refine_rmse
-            .iter()
-            .map(|&r| num(r))
-            .collect::<Vec<_>>()
-            .join(" -> "),
+        join(&t.refine_rmse),
         num(t.base_errors.mean),
         num(t.base_errors.max),
         num(t.base_errors.rmse)
     );
     println!(
         "parameters: {} points, {} beyond the end layers ({})\n",
-        pts.len(),
+        cloud.len(),
         t.on_v_boundary,
-        match cfg.ends {
-            Ends::Exclude => "left out of the fit",
-            Ends::Extend => "v continued past the base surface, fitted",
+        match a.ends {
+            EndsArg::Exclude => "left out of the fit",
+            EndsArg::Extend => "v continued past the base surface, fitted",
         }
     );
+}
+
+/// The whole text report: steps, errors, fold-overs, the weight comparison.
+fn print_report(a: &TurntableArgs, cloud: &PointCloud, r: &TurntableReport, seconds: f64) {
+    print_steps(a, cloud, r, seconds);
+    let t = &r.turntable;
     let mut tab = Table::new(
         &["error [data units]", "points", "mean", "max", "RMSE"],
         &[true],
     );
-    tab.row(vec![
-        "orthogonal distance, fitted points".into(),
-        t.errors.count.to_string(),
-        num(t.errors.mean),
-        num(t.errors.max),
-        num(t.errors.rmse),
-    ]);
-    tab.row(vec![
-        "|P - S(u, v)|, fitted points".into(),
-        param.count.to_string(),
-        num(param.mean),
-        num(param.max),
-        num(param.rmse),
-    ]);
-    tab.row(vec![
-        "orthogonal distance, all points".into(),
-        t.errors_all.count.to_string(),
-        num(t.errors_all.mean),
-        num(t.errors_all.max),
-        num(t.errors_all.rmse),
-    ]);
-    tab.row(vec![
-        "surface samples to nearest point".into(),
-        t.surface_to_cloud.count.to_string(),
-        num(t.surface_to_cloud.mean),
-        num(t.surface_to_cloud.max),
-        num(t.surface_to_cloud.rmse),
-    ]);
+    for (label, e) in [
+        ("orthogonal distance, fitted points", &t.errors),
+        ("|P - S(u, v)|, fitted points", &r.parametric),
+        ("orthogonal distance, all points", &t.errors_all),
+        ("surface samples to nearest point", &t.surface_to_cloud),
+    ] {
+        tab.row(vec![
+            label.into(),
+            e.count.to_string(),
+            num(e.mean),
+            num(e.max),
+            num(e.rmse),
+        ]);
+    }
     print!("{}", tab.render());
     println!(
         "\nfold-overs: {} of {} triangles of the fitted points ({} of {} inside the layers' range); L2 stretch {}",
@@ -393,31 +412,27 @@ pub fn run(a: TurntableArgs) -> Result<()> {
         "fold-overs after projecting the points onto the fitted surface (parameter correction): {} of {}",
         t.quality_fitted.fold_overs, t.quality_fitted.triangles
     );
-    if let Some(cmp) = &comparison {
+    if let Some(cmp) = &r.weight_comparison {
         println!("\nRMSE of the layer samples' nearest-point distances by projection round:");
-        let mut head = vec!["round"];
         let names: Vec<String> = cmp
             .iter()
-            .map(|(w, _)| {
-                match w {
-                    WeightFactor::Moon => "eq. 19 (moon)",
-                    WeightFactor::Aza04 => "eq. 15 (aza04)",
-                    WeightFactor::As05 => "eq. 16 (as05)",
-                    WeightFactor::Axis4 => "axis4",
-                }
-                .to_string()
+            .map(|w| match w.weight {
+                WeightFactor::Moon => "eq. 19 (moon)".to_string(),
+                WeightFactor::Aza04 => "eq. 15 (aza04)".to_string(),
+                WeightFactor::As05 => "eq. 16 (as05)".to_string(),
+                other => other.name().to_string(),
             })
             .collect();
+        let mut head = vec!["round"];
         head.extend(names.iter().map(String::as_str));
         let mut tab = Table::new(&head, &[false]);
-        for r in 0..=a.compare_rounds {
-            let mut row = vec![r.to_string()];
-            row.extend(cmp.iter().map(|(_, v)| num(v[r])));
+        let rounds = cmp.iter().map(|w| w.rmse.len()).min().unwrap_or(0);
+        for k in 0..rounds {
+            let mut row = vec![k.to_string()];
+            row.extend(cmp.iter().map(|w| num(w.rmse[k])));
             tab.row(row);
         }
         print!("{}", tab.render());
     }
     println!();
-    print_written(&files, a.out.png.as_deref(), exaggeration);
-    Ok(())
 }

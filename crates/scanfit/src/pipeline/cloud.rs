@@ -304,7 +304,6 @@ pub struct CloudBoundaryConfig {
     pub corner_positions: Option<Vec<usize>>,
 }
 
-
 /// What [`boundary`] found.
 #[derive(Debug, Clone)]
 #[non_exhaustive]

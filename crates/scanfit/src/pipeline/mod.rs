@@ -26,7 +26,15 @@
 //! Modules:
 //!
 //! * [`assess`]: the surface assessment every surface pipeline ends with.
+//! * [`coons`]: one patch to a surface by the Coons paper (B-spline) or the
+//!   PDE paper (thin-plate deformation).
+//! * [`turntable`]: cylinder-like clouds by the virtual turntable.
+//! * [`cloud`]: the point-cloud tools (info, normals, hidden point removal,
+//!   boundary and corners).
 
 pub mod assess;
+pub mod cloud;
+pub mod coons;
+pub mod turntable;
 
 pub use assess::{assess_surface, AssessConfig, Assessment, SampleDistances, SurfaceQuality};
