@@ -23,7 +23,9 @@ use scanfit_io::render::{
 use scanfit_io::{cloud_bytes, write_all_atomic, WriteFormat};
 
 pub use crate::args::InputArgs;
-use crate::args::{choice, value_name, Angles, Indices, Parsed, ANGLES, INDICES, VECTOR3};
+use crate::args::{
+    choice, name_option, value_name, Angles, Indices, Parsed, ANGLES, INDICES, VECTOR3,
+};
 use crate::outputs::{check_extensions, extension, Files};
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -780,6 +782,7 @@ fn boundary(a: BoundaryArgs) -> Result<()> {
     progress.stage(format!("alpha shape of {} points", cloud.len()));
     let t0 = Instant::now();
     let r = find_boundary(&cloud, &cfg, &progress)
+        .map_err(|e| name_option(e, &[("corner_positions", "--corner-at")]))
         .with_context(|| format!("boundary of {}", a.input.input.display()))?;
     let secs = t0.elapsed().as_secs_f64();
     let doc = boundary_doc(&a, &cloud, &r, secs);

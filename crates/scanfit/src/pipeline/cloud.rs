@@ -92,9 +92,11 @@ pub fn info(
     progress: &dyn Progress,
 ) -> Result<CloudInfo> {
     progress.stage("statistics", None);
-    let (lo, hi) = cloud
-        .bounding_box()
-        .ok_or_else(|| Error::InvalidInput("the cloud has no points".into()))?;
+    let (lo, hi) = cloud.bounding_box().ok_or_else(|| Error::TooFewPoints {
+        got: 0,
+        needed: 1,
+        what: "cloud statistics".into(),
+    })?;
     let attributes = cloud
         .attributes()
         .iter()
@@ -402,11 +404,15 @@ pub fn boundary(
     let corners = match &config.corner_positions {
         Some(c) => {
             if let Some(&bad) = c.iter().find(|&&k| k >= outer.len()) {
-                return Err(Error::InvalidInput(format!(
-                    "corner position {bad} is beyond the outer loop, which has {} points (positions 0..{})",
-                    outer.len(),
-                    outer.len().saturating_sub(1)
-                )));
+                return Err(Error::InvalidSetting {
+                    setting: "corner_positions",
+                    value: bad.to_string(),
+                    hint: format!(
+                        "a corner position must lie in the outer loop, which has {} points (positions 0..{})",
+                        outer.len(),
+                        outer.len().saturating_sub(1)
+                    ),
+                });
             }
             let sides = split_at_corners(outer.len(), c)?;
             let offset = config

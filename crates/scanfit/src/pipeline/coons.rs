@@ -270,9 +270,11 @@ pub fn run(
             let f = fit_pde(&base.patch, pts, &parameters.uv, pde)?;
             let tol = export_tolerance.unwrap_or(1e-4 * cloud.diagonal());
             if !(tol.is_finite() && tol > 0.0) {
-                return Err(Error::InvalidInput(format!(
-                    "export tolerance {tol}: the B-spline form of the PDE surface needs a positive tolerance (in data units)"
-                )));
+                return Err(Error::InvalidSetting {
+                    setting: "export_tolerance",
+                    value: tol.to_string(),
+                    hint: "the B-spline form of the PDE surface needs a positive, finite tolerance in data units (default 1e-4 x the diagonal)".into(),
+                });
             }
             progress.stage(STAGES[3], None);
             let b = f.surface.to_bspline(&BsplineConversionConfig::new(tol))?;

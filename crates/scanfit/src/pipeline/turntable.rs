@@ -82,8 +82,9 @@ pub struct TurntableReport {
     pub turntable: Turntable,
     /// `|P_i - S(u_i, v_i)|` over the fitted points.
     pub parametric: ErrorStats,
-    /// The assessment of the fitted surface over the fitted points (with
-    /// their parameters).
+    /// The assessment of the fitted surface: points to surface over the
+    /// fitted points (with their parameters), surface to points (eq. 17 of
+    /// the MBA paper and the sample grid) over every point of the cloud.
     pub assessment: Assessment,
     /// The weight comparison, when asked for.
     pub weight_comparison: Option<Vec<WeightRounds>>,
@@ -147,16 +148,20 @@ pub fn run(
 ) -> Result<TurntableReport> {
     if let Some(c) = &config.compare_weights {
         if c.rounds == 0 || c.rounds > MAX_COMPARE_ROUNDS {
-            return Err(Error::InvalidInput(format!(
-                "{} rounds of the weight comparison: give 1 to {MAX_COMPARE_ROUNDS} (the paper's tables show 5)",
-                c.rounds
-            )));
+            return Err(Error::InvalidSetting {
+                setting: "compare_weights.rounds",
+                value: c.rounds.to_string(),
+                hint: format!(
+                    "the weight comparison needs 1 to {MAX_COMPARE_ROUNDS} rounds (the paper's tables show 5)"
+                ),
+            });
         }
         if c.weights.is_empty() {
-            return Err(Error::InvalidInput(
-                "a weight comparison without weight factors: name at least one (moon, aza04, as05)"
-                    .into(),
-            ));
+            return Err(Error::InvalidSetting {
+                setting: "compare_weights.weights",
+                value: "[]".into(),
+                hint: "name at least one weight factor to compare (moon, aza04, as05)".into(),
+            });
         }
     }
     let cfg = &config.turntable;
@@ -178,7 +183,24 @@ pub fn run(
     };
     progress.stage("assessment", None);
     let (fp, fuv) = fitted_subset(cloud, &t);
-    let assessment = assess_surface(&t.surface, &fp, &fuv, &config.assess)?;
+    let mut assessment = assess_surface(&t.surface, &fp, &fuv, &config.assess)?;
+    if fp.len() < cloud.len() {
+        // points to surface over the fitted points (the surface spans the
+        // layers only), surface to points over the whole cloud: the points
+        // beyond the end layers are data the surface's end rows should
+        // approach too
+        let whole = assess_surface(
+            &t.surface,
+            cloud.points(),
+            &t.uv,
+            &AssessConfig {
+                parameterization: false,
+                ..config.assess
+            },
+        )?;
+        assessment.quality.grid_rmse = whole.quality.grid_rmse;
+        assessment.quality.samples_to_points = whole.quality.samples_to_points;
+    }
     let parametric = assessment.quality.at_parameters;
     Ok(TurntableReport {
         turntable: t,
