@@ -436,3 +436,86 @@ pub fn boundary(
         criterion,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::progress::NoProgress;
+
+    /// A 30 x 20 grid in the plane z = 0.
+    fn grid() -> PointCloud {
+        PointCloud::new(
+            (0..600)
+                .map(|i| Point3::new((i % 30) as f64, (i / 30) as f64, 0.0))
+                .collect(),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn given_corners_split_the_loop_into_sides_on_the_loop_cloud() {
+        let cloud = grid();
+        let mut cfg = CloudBoundaryConfig::default();
+        cfg.corner_positions = Some(vec![0, 20, 50, 70]);
+        let r = boundary(&cloud, &cfg, &NoProgress).unwrap();
+        let c = r.corners.as_ref().unwrap();
+        assert_eq!(
+            c.sides.iter().map(Vec::len).collect::<Vec<_>>(),
+            [21, 31, 21, 27]
+        );
+        let lc = r.loop_cloud().unwrap();
+        let side = lc.attribute("side").unwrap();
+        // a corner belongs to the side it starts; the points between to theirs
+        assert_eq!(
+            (side[0], side[19], side[20], side[50], side[95]),
+            (0.0, 0.0, 1.0, 2.0, 3.0)
+        );
+        assert_eq!(lc.attribute("position").unwrap()[95], 95.0);
+        let index = lc.attribute("index").unwrap();
+        assert_eq!(cloud.points()[index[20] as usize], r.loop_points[20]);
+        cfg.corner_positions = Some(vec![0, 20, 50, 96]);
+        match boundary(&cloud, &cfg, &NoProgress) {
+            Err(Error::InvalidSetting {
+                setting,
+                value,
+                hint,
+            }) => {
+                assert_eq!((setting, value.as_str()), ("corner_positions", "96"));
+                assert!(hint.contains("96 points"), "{hint}");
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn no_corners_asked_leaves_the_loop_undivided() {
+        let mut cfg = CloudBoundaryConfig::default();
+        cfg.corners.count = 0;
+        let r = boundary(&grid(), &cfg, &NoProgress).unwrap();
+        assert!(r.corners.is_none() && r.corner_value(0).is_none());
+        let lc = r.loop_cloud().unwrap();
+        assert!(lc.attribute("side").unwrap().iter().all(|&s| s == -1.0));
+        assert_eq!(lc.attribute("corner").unwrap().iter().sum::<f64>(), 0.0);
+    }
+
+    #[test]
+    fn hpr_mask_and_normals_cloud_carry_the_results() {
+        let cloud = grid();
+        let r = hpr(
+            &cloud,
+            &CloudHprConfig::from_viewpoint(Point3::new(14.5, 9.5, 50.0)),
+            &NoProgress,
+        )
+        .unwrap();
+        // a plane seen from above: every point is visible
+        assert_eq!((r.visible.len(), r.hidden), (600, 0));
+        assert!(r.visible_mask(600).iter().all(|&v| v));
+        let n = normals(&cloud, &CloudNormalsConfig::default(), &NoProgress).unwrap();
+        let normals = n.cloud.normals().unwrap();
+        assert!(normals.iter().all(|v| (v.z - 1.0).abs() < 1e-12));
+        assert_eq!(n.mean_variation, 0.0);
+        let i = info(&cloud, &CloudInfoConfig { spacing: false }, &NoProgress).unwrap();
+        assert!(i.spacing.is_none());
+        assert_eq!(i.bbox_max, Point3::new(29.0, 19.0, 0.0));
+    }
+}

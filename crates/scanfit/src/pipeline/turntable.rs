@@ -8,7 +8,7 @@
 //! over the points that entered the fit.
 
 use crate::base::turntable::{compare_weights, turntable, Turntable, STAGES};
-use crate::metrics::ErrorStats;
+use crate::metrics::{grid_rmse, ErrorStats};
 use crate::progress::Progress;
 use crate::project::WeightFactor;
 use crate::{Error, Point3, PointCloud, Result};
@@ -82,9 +82,10 @@ pub struct TurntableReport {
     pub turntable: Turntable,
     /// `|P_i - S(u_i, v_i)|` over the fitted points.
     pub parametric: ErrorStats,
-    /// The assessment of the fitted surface: points to surface over the
-    /// fitted points (with their parameters), surface to points (eq. 17 of
-    /// the MBA paper and the sample grid) over every point of the cloud.
+    /// The assessment of the fitted surface over the fitted points (with
+    /// their parameters), except its `grid_rmse` (eq. 17 of the MBA paper),
+    /// measured to every point of the cloud; `turntable.surface_to_cloud`
+    /// is the sample distance to every point.
     pub assessment: Assessment,
     /// The weight comparison, when asked for.
     pub weight_comparison: Option<Vec<WeightRounds>>,
@@ -183,23 +184,24 @@ pub fn run(
     };
     progress.stage("assessment", None);
     let (fp, fuv) = fitted_subset(cloud, &t);
-    let mut assessment = assess_surface(&t.surface, &fp, &fuv, &config.assess)?;
+    // the turntable measured the fitted points' fold-overs and stretch
+    // already (the same call on the same points and parameters)
+    let mut assessment = assess_surface(
+        &t.surface,
+        &fp,
+        &fuv,
+        &AssessConfig {
+            parameterization: false,
+            ..config.assess
+        },
+    )?;
+    assessment.quality.parameterization = t.quality;
     if fp.len() < cloud.len() {
-        // points to surface over the fitted points (the surface spans the
-        // layers only), surface to points over the whole cloud: the points
-        // beyond the end layers are data the surface's end rows should
-        // approach too
-        let whole = assess_surface(
-            &t.surface,
-            cloud.points(),
-            &t.uv,
-            &AssessConfig {
-                parameterization: false,
-                ..config.assess
-            },
-        )?;
-        assessment.quality.grid_rmse = whole.quality.grid_rmse;
-        assessment.quality.samples_to_points = whole.quality.samples_to_points;
+        // eq. 17 (surface to points) over the whole cloud, as the points
+        // beyond the end layers are data the surface's end rows approach
+        // too; `turntable.surface_to_cloud` is the whole cloud's sample
+        // distance, `samples_to_points` the fitted points'
+        assessment.quality.grid_rmse = grid_rmse(&t.surface, cloud.points(), None)?;
     }
     let parametric = assessment.quality.at_parameters;
     Ok(TurntableReport {
@@ -208,4 +210,83 @@ pub fn run(
         assessment,
         weight_comparison,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::progress::NoProgress;
+
+    /// A closed-bottom cup: a cylinder of radius 10 around z with a disk at
+    /// the bottom (the disk lies beyond the end layers).
+    fn cup() -> PointCloud {
+        let mut pts = Vec::new();
+        for j in 0..60 {
+            for i in 0..90 {
+                let t = i as f64 / 90.0 * std::f64::consts::TAU + 0.013 * j as f64;
+                pts.push(Point3::new(10.0 * t.cos(), 10.0 * t.sin(), j as f64 * 0.5));
+            }
+        }
+        for r in 1..10 {
+            for i in 0..(9 * r) {
+                let t = i as f64 / (9 * r) as f64 * std::f64::consts::TAU;
+                pts.push(Point3::new(r as f64 * t.cos(), r as f64 * t.sin(), 0.0));
+            }
+        }
+        PointCloud::new(pts).unwrap()
+    }
+
+    #[test]
+    fn weight_comparison_is_checked_before_any_work() {
+        let mut cfg = TurntableConfig::default();
+        cfg.compare_weights = Some(WeightComparison::with_rounds(0));
+        // an empty-looking cloud would fail later; the setting fails first
+        let cloud = PointCloud::new(vec![Point3::origin(); 3]).unwrap();
+        match run(&cloud, &cfg, &NoProgress) {
+            Err(Error::InvalidSetting { setting, .. }) => {
+                assert_eq!(setting, "compare_weights.rounds")
+            }
+            other => panic!("{other:?}"),
+        }
+        cfg.compare_weights = Some(WeightComparison {
+            rounds: 2,
+            weights: Vec::new(),
+        });
+        assert!(run(&cloud, &cfg, &NoProgress)
+            .unwrap_err()
+            .to_string()
+            .contains("at least one weight factor"));
+    }
+
+    #[test]
+    fn assessment_splits_the_fitted_points_from_the_whole_cloud() {
+        let cloud = cup();
+        let mut cfg = TurntableConfig::default();
+        cfg.turntable.fit.ctrl = (16, 10);
+        cfg.turntable.layers.layers = 16;
+        cfg.compare_weights = Some(WeightComparison::with_rounds(2));
+        let r = run(&cloud, &cfg, &NoProgress).unwrap();
+        let t = &r.turntable;
+        let fitted = t.fitted.iter().filter(|&&f| f).count();
+        // the bottom disk lies beyond the end layers and is not fitted
+        assert!(fitted < cloud.len() - 300, "{fitted}");
+        let q = r.assessment.quality;
+        assert_eq!(q.points, fitted);
+        assert_eq!(q.at_parameters, r.parametric);
+        // points to surface over the fitted points: the same distances the
+        // turntable measured (inversions from other starts, same feet)
+        assert!((q.orthogonal.rmse - t.errors.rmse).abs() < 1e-9 * (1.0 + t.errors.rmse));
+        // eq. 17 over the whole cloud, fold-overs of the fitted points
+        assert_eq!(
+            q.grid_rmse,
+            grid_rmse(&t.surface, cloud.points(), None).unwrap()
+        );
+        assert_eq!(q.parameterization, t.quality);
+        assert!(q.parameterization.triangles > fitted);
+        let cmp = r.weight_comparison.unwrap();
+        assert_eq!(cmp.len(), 3);
+        assert!(cmp
+            .iter()
+            .all(|w| w.rmse.len() == 3 && w.rmse[0] == cmp[0].rmse[0]));
+    }
 }
