@@ -455,8 +455,10 @@ mod tests {
     #[test]
     fn given_corners_split_the_loop_into_sides_on_the_loop_cloud() {
         let cloud = grid();
-        let mut cfg = CloudBoundaryConfig::default();
-        cfg.corner_positions = Some(vec![0, 20, 50, 70]);
+        let mut cfg = CloudBoundaryConfig {
+            corner_positions: Some(vec![0, 20, 50, 70]),
+            ..Default::default()
+        };
         let r = boundary(&cloud, &cfg, &NoProgress).unwrap();
         let c = r.corners.as_ref().unwrap();
         assert_eq!(

@@ -339,8 +339,10 @@ mod tests {
     #[test]
     fn bspline_route_fits_the_panel_on_grid_parameters() {
         let cloud = panel();
-        let mut cfg = CoonsConfig::default();
-        cfg.route = CoonsRoute::bspline((3, 3), (12, 10));
+        let cfg = CoonsConfig {
+            route: CoonsRoute::bspline((3, 3), (12, 10)),
+            ..Default::default()
+        };
         let r = run(&cloud, &cfg, &crate::progress::NoProgress).unwrap();
         assert_eq!(r.projection_name(), "grid");
         assert_eq!(r.surface.counts(), (12, 10));
@@ -377,8 +379,10 @@ mod tests {
     #[test]
     fn pde_route_measures_eq15_on_the_pde_surface_and_exports_within_tolerance() {
         let cloud = panel();
-        let mut cfg = CoonsConfig::default();
-        cfg.route = CoonsRoute::pde(4, 4);
+        let cfg = CoonsConfig {
+            route: CoonsRoute::pde(4, 4),
+            ..Default::default()
+        };
         let r = run(&cloud, &cfg, &crate::progress::NoProgress).unwrap();
         assert_eq!(r.projection_name(), "closest");
         let p = r.pde.as_ref().unwrap();

@@ -238,8 +238,10 @@ mod tests {
 
     #[test]
     fn weight_comparison_is_checked_before_any_work() {
-        let mut cfg = TurntableConfig::default();
-        cfg.compare_weights = Some(WeightComparison::with_rounds(0));
+        let mut cfg = TurntableConfig {
+            compare_weights: Some(WeightComparison::with_rounds(0)),
+            ..Default::default()
+        };
         // an empty-looking cloud would fail later; the setting fails first
         let cloud = PointCloud::new(vec![Point3::origin(); 3]).unwrap();
         match run(&cloud, &cfg, &NoProgress) {
