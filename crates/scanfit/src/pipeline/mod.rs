@@ -26,7 +26,14 @@
 //! Modules:
 //!
 //! * [`assess`]: the surface assessment every surface pipeline ends with.
+//! * [`mba`]: multilevel B-spline approximation (`scanfit mba`), optionally
+//!   with the MBA paper's projection adjustment, with its per-level table.
+//! * [`surface_fit`]: least-squares surface through scattered points
+//!   (`scanfit fit`): parameters from the best-fit plane or given
+//!   attributes, optional Hoschek parameter correction.
 
 pub mod assess;
+pub mod mba;
+pub mod surface_fit;
 
 pub use assess::{assess_surface, AssessConfig, Assessment, SampleDistances, SurfaceQuality};
