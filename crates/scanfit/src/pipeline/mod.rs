@@ -26,14 +26,22 @@
 //! Modules:
 //!
 //! * [`assess`]: the surface assessment every surface pipeline ends with.
+//! * [`curve`]: curve interpolation / least squares and the comparison of
+//!   the curve paper's parameterizations (`scanfit curve fit|compare`).
 //! * [`mba`]: multilevel B-spline approximation (`scanfit mba`), optionally
 //!   with the MBA paper's projection adjustment, with its per-level table.
+//! * [`measure`]: what `scanfit report` measures for a surface and points
+//!   (the assessment of their projections, percentiles, histogram).
 //! * [`surface_fit`]: least-squares surface through scattered points
 //!   (`scanfit fit`): parameters from the best-fit plane or given
 //!   attributes, optional Hoschek parameter correction.
 
 pub mod assess;
+pub mod curve;
 pub mod mba;
+pub mod measure;
 pub mod surface_fit;
 
-pub use assess::{assess_surface, AssessConfig, Assessment, SampleDistances, SurfaceQuality};
+pub use assess::{
+    assess_projected, assess_surface, AssessConfig, Assessment, SampleDistances, SurfaceQuality,
+};
