@@ -50,7 +50,7 @@ fn invalid(cmd: &Command, message: String) -> clap::Error {
 
 /// A clap value parser from a function `(value, option name) -> T`.
 #[derive(Clone, Copy)]
-pub struct Parsed<T>(fn(&str, &str) -> std::result::Result<T, String>);
+pub struct Parsed<T>(pub fn(&str, &str) -> std::result::Result<T, String>);
 
 impl<T: Clone + Send + Sync + 'static> TypedValueParser for Parsed<T> {
     type Value = T;

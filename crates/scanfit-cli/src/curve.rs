@@ -1,21 +1,28 @@
-//! `scanfit curve fit` and `scanfit curve compare`.
+//! `scanfit curve fit` and `scanfit curve compare`, over
+//! [`scanfit::pipeline::curve`].
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
+use anyhow::Result;
 use clap::{Args, Subcommand};
-use scanfit::fit::{self, ApproximationConfig, CurveFit, InterpolationConfig};
 use scanfit::param::Method;
-use scanfit::quality::{curve_quality, CurveQuality, QualityConfig};
-use scanfit::Vector3;
-use scanfit_io::json::{CurveDoc, Provenance, QualityDoc};
+use scanfit::pipeline::curve::{
+    compare, run as fit_curve, CompareConfig, CurveConfig, CurveFitKind, CurveReport, MethodResult,
+};
+use scanfit::quality::CurveQuality;
+use scanfit_io::json::{CurveDoc, QualityDoc};
 use scanfit_io::step::CadItem;
 use scanfit_io::svg::{curve_panels, curve_panels_png, Panel, PanelSize};
 use scanfit_io::{read_points, write_all_atomic, PointTable};
 use serde::Serialize;
 
+use crate::args::{Parsed, Vectors, VECTORS};
+use crate::outputs::provenance;
 use crate::progress::Progress;
 use crate::table::{num, Table};
+
+/// `--param METHOD`: a parameterization method, `name[:a]`.
+const METHOD: Parsed<Method> = Parsed(|s, _| Method::parse(s).map_err(|e| e.to_string()));
 
 /// Curve subcommands.
 #[derive(Subcommand, Debug)]
@@ -48,8 +55,8 @@ pub struct FitArgs {
     pub input: PathBuf,
     /// Parameterization method [default: proposed; centripetal with --closed,
     /// as the basis-maxima methods are defined for open curves only].
-    #[arg(short, long = "param", value_name = "METHOD")]
-    pub param: Option<String>,
+    #[arg(short, long = "param", value_name = "METHOD", value_parser = METHOD)]
+    pub param: Option<Method>,
     /// Degree of the curve.
     #[arg(short, long, default_value_t = 3)]
     pub degree: usize,
@@ -83,9 +90,10 @@ pub struct FitArgs {
         long,
         value_name = "D0;D1",
         conflicts_with_all = ["ctrl", "closed"],
-        allow_negative_numbers = true
+        allow_hyphen_values = true,
+        value_parser = VECTORS
     )]
-    pub end_tangents: Option<String>,
+    pub end_tangents: Option<Vectors>,
     /// Write the curve as JSON (schema scanfit/1) to this file.
     #[arg(short, long, value_name = "OUT.json")]
     pub output: Option<PathBuf>,
@@ -139,41 +147,13 @@ pub fn run(cmd: CurveCommand) -> Result<()> {
     }
 }
 
-/// Reads the input, with a file-level error message.
-fn load(path: &Path) -> Result<PointTable> {
-    Ok(read_points(path)?)
-}
-
 /// Adds `file:line` to library errors that name point indices.
-fn locate(e: scanfit::Error, table: &PointTable) -> anyhow::Error {
-    use scanfit::Error as E;
+fn locate(e: &scanfit::Error, table: &PointTable) -> anyhow::Error {
     let at = |i: usize| table.locate(i);
-    let place = match &e {
-        E::NonFinite { index, .. } => Some(format!("point {index} is at {}", at(*index))),
-        E::DuplicatePoints { first, second, .. }
-        | E::CoincidentParameters { first, second, .. } => Some(format!(
-            "points {first} and {second} are at {} and {}",
-            at(*first),
-            at(*second)
-        )),
-        _ => None,
-    };
-    match place {
-        Some(p) => anyhow::anyhow!("{e} ({p})"),
-        None => anyhow::anyhow!("{e}"),
-    }
-}
-
-fn parse_vec(s: &str) -> Result<Vector3> {
-    let v: Vec<f64> = s
-        .split(',')
-        .map(|x| x.trim().parse::<f64>())
-        .collect::<std::result::Result<_, _>>()
-        .with_context(|| format!("'{s}' is not a vector dx,dy,dz"))?;
-    match v.as_slice() {
-        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Vector3::new(*x, *y, *z)),
-        [x, y] if v.iter().all(|c| c.is_finite()) => Ok(Vector3::new(*x, *y, 0.0)),
-        _ => bail!("'{s}' is not a finite vector dx,dy,dz"),
+    match e.point_indices()[..] {
+        [i] => anyhow::anyhow!("{e} (point {i} is at {})", at(i)),
+        [i, j, ..] => anyhow::anyhow!("{e} (points {i} and {j} are at {} and {})", at(i), at(j)),
+        [] => anyhow::anyhow!("{e}"),
     }
 }
 
@@ -191,122 +171,111 @@ struct FitReport<'a> {
     output: Option<String>,
 }
 
+impl FitArgs {
+    /// The pipeline's settings.
+    fn config(&self) -> Result<CurveConfig> {
+        let mut c = CurveConfig::default();
+        c.degree = self.degree;
+        c.method = self.param;
+        c.closed = self.closed;
+        c.kind = match self.ctrl {
+            Some(n) => CurveFitKind::LeastSquares {
+                ctrl_count: n,
+                fix_ends: !self.free_ends,
+                smoothing: self.smooth,
+            },
+            None => CurveFitKind::Interpolation {
+                end_derivatives: match self.end_tangents.as_ref().map(|v| &v.0[..]) {
+                    None => None,
+                    Some(&[d0, d1]) => Some((d0, d1)),
+                    Some(v) => anyhow::bail!(
+                        "--end-tangents needs two vectors separated by ';' (start; end), {} given",
+                        v.len()
+                    ),
+                },
+            },
+        };
+        Ok(c)
+    }
+
+    /// The curve document with provenance and quality.
+    fn doc(&self, r: &CurveReport, point_count: usize) -> CurveDoc {
+        let mut doc = CurveDoc::new(&r.fit.curve);
+        let mut settings = std::collections::BTreeMap::new();
+        settings.insert("degree".to_string(), self.degree.into());
+        settings.insert("closed".to_string(), self.closed.into());
+        if let Some(n) = self.ctrl {
+            settings.insert("ctrl".to_string(), n.into());
+            settings.insert("smoothing".to_string(), self.smooth.into());
+            settings.insert("fix_ends".to_string(), (!self.free_ends).into());
+        }
+        let kind = if self.ctrl.is_some() {
+            "least squares"
+        } else {
+            "interpolation"
+        };
+        doc.provenance = Some(provenance(
+            format!("curve fit ({kind})"),
+            Some(r.fit.method.to_string()),
+            &self.input,
+            point_count,
+            settings,
+        ));
+        doc.params = Some(r.fit.params.clone());
+        doc.quality = Some(QualityDoc::from(&r.quality));
+        doc
+    }
+}
+
 fn fit_cmd(a: FitArgs) -> Result<()> {
-    let default = if a.closed { "centripetal" } else { "proposed" };
-    let method = Method::parse(a.param.as_deref().unwrap_or(default))?;
+    let config = a.config()?;
     let progress = Progress::spinner(a.quiet);
     progress.stage(format!("reading {}", a.input.display()));
-    let table = load(&a.input)?;
+    let table = read_points(&a.input)?;
     let pts = &table.points;
-    progress.stage(format!("fitting {} points", pts.len()));
-    let (fit, kind) = match a.ctrl {
-        Some(n) => {
-            let cfg = ApproximationConfig {
-                degree: a.degree,
-                ctrl_count: n,
-                method,
-                fix_ends: !a.free_ends,
-                smoothing: a.smooth,
-                weights: None,
-                closed: a.closed,
-            };
-            (fit::approximate(pts, &cfg), "least squares")
-        }
-        None => {
-            let end_derivatives = match &a.end_tangents {
-                Some(s) => {
-                    let (d0, d1) = s
-                        .split_once(';')
-                        .context("--end-tangents needs two vectors separated by ';'")?;
-                    Some((parse_vec(d0)?, parse_vec(d1)?))
-                }
-                None => None,
-            };
-            let cfg = InterpolationConfig {
-                degree: a.degree,
-                method,
-                end_derivatives,
-                closed: a.closed,
-            };
-            (fit::interpolate(pts, &cfg), "interpolation")
-        }
-    };
-    let fit = fit.map_err(|e| locate(e, &table))?;
-    progress.stage("measuring");
-    let used = &pts[..fit.params.len()];
-    let q = curve_quality(&fit.curve, used, &fit.params, &QualityConfig::default());
+    let r = fit_curve(pts, &config, &progress).map_err(|e| locate(&e, &table))?;
     progress.finish();
-
-    let mut doc = CurveDoc::new(&fit.curve);
-    let mut settings = std::collections::BTreeMap::new();
-    settings.insert("degree".to_string(), a.degree.into());
-    settings.insert("closed".to_string(), a.closed.into());
-    if let Some(n) = a.ctrl {
-        settings.insert("ctrl".to_string(), n.into());
-        settings.insert("smoothing".to_string(), a.smooth.into());
-        settings.insert("fix_ends".to_string(), (!a.free_ends).into());
-    }
-    doc.provenance = Some(Provenance {
-        tool: format!("scanfit {}", env!("CARGO_PKG_VERSION")),
-        operation: format!("curve fit ({kind})"),
-        parameterization: Some(method.to_string()),
-        input: Some(a.input.display().to_string()),
-        point_count: Some(pts.len()),
-        settings,
-    });
-    doc.params = Some(fit.params.clone());
-    doc.quality = Some(QualityDoc::from(&q));
+    let kind = config.kind.label();
+    let doc = a.doc(&r, pts.len());
     // outputs are built first and written together, atomically, only after
     // everything succeeded: a failed run leaves no file behind
     let mut files: Vec<(&Path, Vec<u8>)> = Vec::new();
     if let Some(out) = &a.output {
         files.push((out, doc.to_json().into_bytes()));
     }
+    let panel = || Panel {
+        title: format!("{} ({kind}, degree {})", r.fit.method, a.degree),
+        subtitle: summary(&r.quality),
+        points: &pts[..r.fitted_points],
+        curve: Some(&r.fit.curve),
+    };
     if let Some(svg) = &a.svg {
-        let panel = Panel {
-            title: format!("{method} ({kind}, degree {})", a.degree),
-            subtitle: summary(&q),
-            points: used,
-            curve: Some(&fit.curve),
-        };
-        files.push((
-            svg,
-            curve_panels(&[panel], 1, "", PanelSize::SINGLE).into_bytes(),
-        ));
+        let bytes = curve_panels(&[panel()], 1, "", PanelSize::SINGLE).into_bytes();
+        files.push((svg, bytes));
     }
     if let Some(png) = &a.png {
-        let panel = Panel {
-            title: format!("{method} ({kind}, degree {})", a.degree),
-            subtitle: summary(&q),
-            points: used,
-            curve: Some(&fit.curve),
-        };
-        files.push((png, curve_panels_png(&[panel], 1, "", PanelSize::SINGLE)?));
+        files.push((png, curve_panels_png(&[panel()], 1, "", PanelSize::SINGLE)?));
     }
-    files.extend(crate::cad::cad_files(
-        &a.step,
-        &a.iges,
-        CadItem::Curve(&fit.curve),
-        &a.input,
-    )?);
+    let cad = CadItem::Curve(&r.fit.curve);
+    files.extend(crate::cad::cad_files(&a.step, &a.iges, cad, &a.input)?);
     write_all_atomic(&files)?;
     if a.json {
         let report = FitReport {
             input: a.input.display().to_string(),
             point_count: pts.len(),
             fit: kind,
-            parameterization: method.to_string(),
+            parameterization: r.fit.method.to_string(),
             degree: a.degree,
-            control_points: fit.curve.control_points().len(),
+            control_points: r.fit.curve.control_points().len(),
             closed: a.closed,
-            condition: fit.condition,
-            quality: QualityDoc::from(&q),
+            condition: r.fit.condition,
+            quality: QualityDoc::from(&r.quality),
             output: a.output.as_ref().map(|p| p.display().to_string()),
         };
         println!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
     }
-    print_fit(&a, &fit, &q, kind, pts.len());
+    print_fit(&a, &r, kind, pts.len());
     Ok(())
 }
 
@@ -321,7 +290,8 @@ fn summary(q: &CurveQuality) -> String {
     )
 }
 
-fn print_fit(a: &FitArgs, fit: &CurveFit, q: &CurveQuality, kind: &str, n: usize) {
+fn print_fit(a: &FitArgs, r: &CurveReport, kind: &str, n: usize) {
+    let (fit, q) = (&r.fit, &r.quality);
     let c = &fit.curve;
     println!(
         "{}: {n} points -> {} B-spline of degree {} by {kind}, {} parameterization",
@@ -397,31 +367,13 @@ struct CompareRow {
 }
 
 fn compare_cmd(a: CompareArgs) -> Result<()> {
-    let table = load(&a.input)?;
+    let table = read_points(&a.input)?;
     let pts = &table.points;
     let progress = Progress::bar(a.quiet, Method::ALL.len() as u64);
-    let mut results = Vec::new();
-    for m in Method::ALL {
-        progress.stage(m.to_string());
-        let cfg = InterpolationConfig {
-            degree: a.degree,
-            method: m,
-            ..Default::default()
-        };
-        let r = fit::interpolate(pts, &cfg).map(|f| {
-            let q = curve_quality(&f.curve, pts, &f.params, &QualityConfig::default());
-            (f, q)
-        });
-        results.push((m, r));
-        progress.inc();
-    }
+    let mut config = CompareConfig::default();
+    config.degree = a.degree;
+    let results = compare(pts, &config, &progress).map_err(|e| locate(&e, &table))?;
     progress.finish();
-    // every method failing the same way is an input problem, not a comparison
-    if results.iter().all(|(_, r)| r.is_err()) {
-        if let Some((_, Err(e))) = results.first() {
-            return Err(locate(e.clone(), &table));
-        }
-    }
     let out = a.output.clone().unwrap_or_else(|| {
         let stem = a
             .input
@@ -432,15 +384,15 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
     });
     let panels: Vec<Panel> = results
         .iter()
-        .map(|(m, r)| match r {
+        .map(|m| match &m.result {
             Ok((f, q)) => Panel {
-                title: m.to_string(),
+                title: m.method.to_string(),
                 subtitle: summary(q),
                 points: pts,
                 curve: Some(&f.curve),
             },
             Err(e) => Panel {
-                title: m.to_string(),
+                title: m.method.to_string(),
                 subtitle: format!("error: {e}"),
                 points: pts,
                 curve: None,
@@ -464,41 +416,58 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
         files.push((png, curve_panels_png(&panels, 4, &title, PanelSize::GRID)?));
     }
     write_all_atomic(&files)?;
-
     if a.json {
-        let rows: Vec<CompareRow> = results
-            .iter()
-            .map(|(m, r)| match r {
-                Ok((f, q)) => CompareRow {
-                    method: m.to_string(),
-                    ok: true,
-                    error: None,
-                    quality: Some(q.into()),
-                    condition: Some(f.condition),
-                },
-                Err(e) => CompareRow {
-                    method: m.to_string(),
-                    ok: false,
-                    error: Some(locate(e.clone(), &table).to_string()),
-                    quality: None,
-                    condition: None,
-                },
-            })
-            .collect();
-        let doc = serde_json::json!({
-            "input": a.input.display().to_string(),
-            "point_count": pts.len(),
-            "degree": a.degree,
-            "picture": out.display().to_string(),
-            "methods": rows,
-        });
-        println!("{}", serde_json::to_string_pretty(&doc)?);
-        return Ok(());
+        return print_compare_json(&a, &results, &table, &out);
     }
+    print_compare(&a, &results, &table);
+    println!("wrote picture: {}", out.display());
+    if let Some(png) = &a.png {
+        println!("wrote picture: {}", png.display());
+    }
+    Ok(())
+}
+
+fn print_compare_json(
+    a: &CompareArgs,
+    results: &[MethodResult],
+    table: &PointTable,
+    out: &Path,
+) -> Result<()> {
+    let rows: Vec<CompareRow> = results
+        .iter()
+        .map(|m| match &m.result {
+            Ok((f, q)) => CompareRow {
+                method: m.method.to_string(),
+                ok: true,
+                error: None,
+                quality: Some(q.into()),
+                condition: Some(f.condition),
+            },
+            Err(e) => CompareRow {
+                method: m.method.to_string(),
+                ok: false,
+                error: Some(locate(e, table).to_string()),
+                quality: None,
+                condition: None,
+            },
+        })
+        .collect();
+    let doc = serde_json::json!({
+        "input": a.input.display().to_string(),
+        "point_count": table.points.len(),
+        "degree": a.degree,
+        "picture": out.display().to_string(),
+        "methods": rows,
+    });
+    println!("{}", serde_json::to_string_pretty(&doc)?);
+    Ok(())
+}
+
+fn print_compare(a: &CompareArgs, results: &[MethodResult], table: &PointTable) {
     println!(
         "{}: {} points, degree-{} interpolation with every parameterization\n",
         a.input.display(),
-        pts.len(),
+        table.points.len(),
         a.degree
     );
     let mut t = Table::new(
@@ -514,10 +483,10 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
         &[true, true, false, false, false, false, false],
     );
     let mut errors = Vec::new();
-    for (m, r) in &results {
-        match r {
+    for m in results {
+        match &m.result {
             Ok((f, q)) => t.row(vec![
-                m.to_string(),
+                m.method.to_string(),
                 "ok".into(),
                 num(q.max_curvature),
                 q.curvature_sign_changes.to_string(),
@@ -526,16 +495,10 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
                 format!("{:.1e}", f.condition),
             ]),
             Err(e) => {
-                t.row(vec![
-                    m.to_string(),
-                    "error".into(),
-                    "-".into(),
-                    "-".into(),
-                    "-".into(),
-                    "-".into(),
-                    "-".into(),
-                ]);
-                errors.push(format!("{m}: {}", locate(e.clone(), &table)));
+                let mut row = vec![m.method.to_string(), "error".into()];
+                row.extend(std::iter::repeat_n("-".to_string(), 5));
+                t.row(row);
+                errors.push(format!("{}: {}", m.method, locate(e, table)));
             }
         }
     }
@@ -544,9 +507,4 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
         println!("  {e}");
     }
     println!("\nlength ratio = curve length / data polygon length (1 = tight; large = bulges).");
-    println!("wrote picture: {}", out.display());
-    if let Some(png) = &a.png {
-        println!("wrote picture: {}", png.display());
-    }
-    Ok(())
 }

@@ -286,7 +286,6 @@ pub fn print_written(files: &Files, png: Option<&Path>, exaggeration: f64) {
 /// The JSON quality record of a surface: the library's one assessment
 /// ([`SurfaceQuality`]) in the schema's field names, with the RMSE after each
 /// parameter-correction round (empty when there were none).
-#[allow(dead_code)] // used as the handlers move onto scanfit::pipeline
 pub fn quality_doc(q: &SurfaceQuality, correction_rmse: Vec<f64>) -> SurfaceQualityDoc {
     SurfaceQualityDoc {
         points: q.points,
@@ -308,7 +307,6 @@ pub fn quality_doc(q: &SurfaceQuality, correction_rmse: Vec<f64>) -> SurfaceQual
 
 /// The surface-to-points measures of [`SurfaceQuality`] for `--json`
 /// reports (the surface document's schema has no place for them).
-#[allow(dead_code)] // used as the handlers move onto scanfit::pipeline
 pub fn samples_json(q: &SurfaceQuality) -> serde_json::Value {
     let s = &q.samples_to_points;
     serde_json::json!({
@@ -326,7 +324,6 @@ pub fn samples_json(q: &SurfaceQuality) -> serde_json::Value {
 /// The provenance every command writes into its documents: this tool and
 /// version, what ran (`operation`), how the points got their parameters,
 /// the input file, the point count and the settings.
-#[allow(dead_code)] // used as the handlers move onto scanfit::pipeline
 pub fn provenance(
     operation: impl Into<String>,
     parameterization: Option<String>,
@@ -348,7 +345,6 @@ pub fn provenance(
 /// of the points to the surface, the MBA paper's eq. 17 and the surface
 /// samples' distance to the nearest point with the share beyond
 /// `far_spacings` point spacings. `eq17` labels the eq. 17 row.
-#[allow(dead_code)] // used as the handlers move onto scanfit::pipeline
 pub fn quality_rows(t: &mut Table, q: &SurfaceQuality, eq17: &str) {
     let data = || "data units".to_string();
     t.row(vec![

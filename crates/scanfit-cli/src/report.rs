@@ -7,10 +7,11 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
-use scanfit::bspline::tessellate;
-use scanfit::metrics::{nearest_points, orthogonal_errors};
-use scanfit::project::{InversionConfig, SurfaceInverter};
-use scanfit_io::json::read_surface;
+use scanfit::bspline::{tessellate, Surface};
+use scanfit::metrics::nearest_points;
+use scanfit::pipeline::measure::{run as measure, MeasureConfig, MeasureReport};
+use scanfit::Point3;
+use scanfit_io::json::{read_surface, SurfaceDoc};
 use scanfit_io::read_points;
 use scanfit_io::render::{render_png, render_points_png, Colouring, RenderOptions};
 use scanfit_io::write_atomic;
@@ -70,65 +71,84 @@ fn escape(s: &str) -> String {
         .replace('>', "&gt;")
 }
 
-/// Runs `scanfit report`.
-pub fn run(a: ReportArgs) -> Result<()> {
-    let progress = Progress::spinner(a.quiet);
-    progress.stage("reading");
-    let (doc, surface) = read_surface(&a.surface)?;
-    let table = read_points(&a.input)?;
-    let pts = &table.points;
-    progress.stage(format!("projecting {} points", pts.len()));
-    let inverter = SurfaceInverter::new(&surface, InversionConfig::default())?;
-    let (stats, inv) = orthogonal_errors(&inverter, pts);
-    let mut sorted: Vec<f64> = inv.iter().map(|r| r.distance).collect();
-    sorted.sort_by(f64::total_cmp);
-    let pct = |f: f64| sorted[((sorted.len() - 1) as f64 * f).round() as usize];
-    let (median, p95) = (pct(0.5), pct(0.95));
-    let unconverged = inv.iter().filter(|r| !r.converged).count();
-    // histogram: 24 bins over [0, max]
-    let bins = 24;
-    let mut hist = vec![0usize; bins];
-    for &d in &sorted {
-        let b = if stats.max > 0.0 {
-            ((d / stats.max) * bins as f64) as usize
-        } else {
-            0
-        };
-        hist[b.min(bins - 1)] += 1;
-    }
-    progress.stage("rendering");
+/// The three pictures of the page and the vertical exaggeration used.
+struct Pictures {
+    height: Vec<u8>,
+    deviation: Vec<u8>,
+    points: Vec<u8>,
+    z_scale: f64,
+}
+
+fn pictures(
+    a: &ReportArgs,
+    surface: &Surface,
+    pts: &[Point3],
+    r: &MeasureReport,
+) -> Result<Pictures> {
     let (cu, cv) = surface.counts();
-    let mesh = tessellate(&surface, (cu * 4).clamp(32, 300), (cv * 4).clamp(32, 300));
+    let mesh = tessellate(surface, (cu * 4).clamp(32, 300), (cv * 4).clamp(32, 300));
     let near = nearest_points(pts, &mesh.vertices)?;
+    let inv = &r.assessment.inversions;
     let local: Vec<f64> = near.iter().map(|&(i, _)| inv[i].distance).collect();
     let base = RenderOptions {
         width: 900,
         height: 650,
         ..a.view.options(pts)?
     };
-    let z_scale = base.z_scale;
     let shown: Vec<_> = pts
         .iter()
         .step_by((pts.len() / 5000).max(1))
         .copied()
         .collect();
-    let img_height = render_png(&mesh, Some(&shown), Colouring::Height, &base)?;
-    let img_dev = render_png(
-        &mesh,
-        None,
-        Colouring::Scalar {
-            values: &local,
-            range: (0.0, stats.max),
-        },
-        &base,
-    )?;
-    let img_points = render_points_png(pts, &base)?;
-    progress.finish();
+    let max = r.assessment.quality.orthogonal.max;
+    let deviation = Colouring::Scalar {
+        values: &local,
+        range: (0.0, max),
+    };
+    Ok(Pictures {
+        height: render_png(&mesh, Some(&shown), Colouring::Height, &base)?,
+        deviation: render_png(&mesh, None, deviation, &base)?,
+        points: render_points_png(pts, &base)?,
+        z_scale: base.z_scale,
+    })
+}
 
-    let out = a
-        .output
-        .clone()
-        .unwrap_or_else(|| a.surface.with_extension("html"));
+/// The five distance figures of the table and the page.
+fn figures(r: &MeasureReport) -> [(&'static str, f64); 5] {
+    let s = &r.assessment.quality.orthogonal;
+    [
+        ("mean", s.mean),
+        ("median", r.median),
+        ("95th percentile", r.p95),
+        ("max", s.max),
+        ("RMSE", s.rmse),
+    ]
+}
+
+/// One line on the surface samples' distance to the points.
+fn samples_line(r: &MeasureReport) -> String {
+    let s = &r.assessment.quality.samples_to_points;
+    format!(
+        "surface samples to nearest point ({} samples): mean {}, max {}, RMSE {}; {:.1}% farther than {} point spacings ({})",
+        s.stats.count,
+        num(s.stats.mean),
+        num(s.stats.max),
+        num(s.stats.rmse),
+        100.0 * s.far_share,
+        s.far_spacings,
+        num(s.spacing)
+    )
+}
+
+/// The self-contained HTML page.
+fn page(
+    a: &ReportArgs,
+    doc: &SurfaceDoc,
+    surface: &Surface,
+    r: &MeasureReport,
+    pic: &Pictures,
+) -> String {
+    let q = &r.assessment.quality;
     let mut html = String::new();
     let title = format!(
         "scanfit report: {} against {}",
@@ -140,15 +160,10 @@ pub fn run(a: ReportArgs) -> Result<()> {
         "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>{t}</title><style>body{{font-family:sans-serif;max-width:1000px;margin:2em auto;color:#222}}table{{border-collapse:collapse}}td,th{{padding:3px 10px;border-bottom:1px solid #ddd;text-align:left}}td.n{{text-align:right;font-family:monospace}}img{{max-width:100%;border:1px solid #ccc}}</style></head><body><h1>{t}</h1>",
         t = escape(&title)
     );
-    let (p, q) = surface.degrees();
-    let _ = write!(html, "<h2>Deviation of the points from the surface</h2><p>{} points, orthogonal distances (point inversion){}.</p><table>", pts.len(), if unconverged > 0 { format!(", {unconverged} inversions not converged") } else { String::new() });
-    for (k, v) in [
-        ("mean", stats.mean),
-        ("median", median),
-        ("95th percentile", p95),
-        ("max", stats.max),
-        ("RMSE", stats.rmse),
-    ] {
+    let (p, qd) = surface.degrees();
+    let (cu, cv) = surface.counts();
+    let _ = write!(html, "<h2>Deviation of the points from the surface</h2><p>{} points, orthogonal distances (point inversion){}.</p><table>", q.points, if q.unconverged > 0 { format!(", {} inversions not converged", q.unconverged) } else { String::new() });
+    for (k, v) in figures(r) {
         let _ = write!(
             html,
             "<tr><td>{k}</td><td class=n>{}</td><td>data units</td></tr>",
@@ -157,10 +172,11 @@ pub fn run(a: ReportArgs) -> Result<()> {
     }
     let _ = write!(
         html,
-        "</table><h3>Histogram</h3>{}",
-        histogram_svg(&hist, stats.max)
+        "</table><p>{}.</p><h3>Histogram</h3>{}",
+        escape(&samples_line(r)),
+        histogram_svg(&r.histogram, q.orthogonal.max)
     );
-    let _ = write!(html, "<h2>Surface</h2><table><tr><td>degrees</td><td class=n>{p} x {q}</td></tr><tr><td>control points</td><td class=n>{cu} x {cv}</td></tr><tr><td>periodic</td><td class=n>{:?}</td></tr>", surface.periodic());
+    let _ = write!(html, "<h2>Surface</h2><table><tr><td>degrees</td><td class=n>{p} x {qd}</td></tr><tr><td>control points</td><td class=n>{cu} x {cv}</td></tr><tr><td>periodic</td><td class=n>{:?}</td></tr>", surface.periodic());
     if let Some(pv) = &doc.provenance {
         let _ = write!(
             html,
@@ -183,37 +199,59 @@ pub fn run(a: ReportArgs) -> Result<()> {
             );
         }
     }
-    let ex = if z_scale != 1.0 {
-        format!(" (vertical exaggeration {z_scale}x)")
+    let ex = if pic.z_scale != 1.0 {
+        format!(" (vertical exaggeration {}x)", pic.z_scale)
     } else {
         String::new()
     };
     let _ = write!(html, "</table><h2>Pictures{}</h2>", escape(&ex));
     for (cap, img) in [
-        ("The surface, coloured by height, with iso-parameter lines and the input points", &img_height),
-        ("The surface coloured by the local fit error (orthogonal distance of the nearest point)", &img_dev),
-        ("The input points, coloured by height", &img_points),
+        ("The surface, coloured by height, with iso-parameter lines and the input points", &pic.height),
+        ("The surface coloured by the local fit error (orthogonal distance of the nearest point)", &pic.deviation),
+        ("The input points, coloured by height", &pic.points),
     ] {
         let _ = write!(html, "<figure><img src=\"data:image/png;base64,{}\"><figcaption>{}</figcaption></figure>", base64(img), escape(cap));
     }
     html.push_str("</body></html>\n");
-    write_atomic(&out, html.as_bytes())?;
+    html
+}
 
+/// Runs `scanfit report`.
+pub fn run(a: ReportArgs) -> Result<()> {
+    let progress = Progress::spinner(a.quiet);
+    progress.stage("reading");
+    let (doc, surface) = read_surface(&a.surface)?;
+    let table = read_points(&a.input)?;
+    let pts = &table.points;
+    let r = measure(&surface, pts, &MeasureConfig::default(), &progress)?;
+    progress.stage("rendering");
+    let pic = pictures(&a, &surface, pts, &r)?;
+    progress.finish();
+    let out = a
+        .output
+        .clone()
+        .unwrap_or_else(|| a.surface.with_extension("html"));
+    write_atomic(&out, page(&a, &doc, &surface, &r, &pic).as_bytes())?;
+    let q = &r.assessment.quality;
+    let s = &q.orthogonal;
     if a.json {
         let v = serde_json::json!({
             "surface": a.surface.display().to_string(),
             "input": a.input.display().to_string(),
             "points": pts.len(),
-            "mean": stats.mean, "median": median, "p95": p95, "max": stats.max, "rmse": stats.rmse,
-            "unconverged": unconverged,
-            "histogram": {"max": stats.max, "counts": hist},
+            "mean": s.mean, "median": r.median, "p95": r.p95, "max": s.max, "rmse": s.rmse,
+            "unconverged": q.unconverged,
+            "histogram": {"max": s.max, "counts": r.histogram},
+            "samples_to_points": crate::outputs::samples_json(q),
             "report": out.display().to_string(),
         });
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
+    let (p, qd) = surface.degrees();
+    let (cu, cv) = surface.counts();
     println!(
-        "{}: {} points against {} ({p} x {q} degrees, {cu} x {cv} control points)\n",
+        "{}: {} points against {} ({p} x {qd} degrees, {cu} x {cv} control points)\n",
         a.input.display(),
         pts.len(),
         a.surface.display()
@@ -222,18 +260,13 @@ pub fn run(a: ReportArgs) -> Result<()> {
         &["orthogonal distance", "value", "unit"],
         &[true, false, true],
     );
-    for (k, v) in [
-        ("mean", stats.mean),
-        ("median", median),
-        ("95th percentile", p95),
-        ("max", stats.max),
-        ("RMSE", stats.rmse),
-    ] {
+    for (k, v) in figures(&r) {
         t.row(vec![k.into(), num(v), "data units".into()]);
     }
     print!("{}", t.render());
-    if unconverged > 0 {
-        println!("note: {unconverged} point inversions did not converge");
+    println!("{}", samples_line(&r));
+    if q.unconverged > 0 {
+        println!("note: {} point inversions did not converge", q.unconverged);
     }
     println!("wrote {}", out.display());
     Ok(())

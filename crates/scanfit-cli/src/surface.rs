@@ -1,23 +1,22 @@
-//! `scanfit fit`: a least-squares B-spline surface through scattered points.
+//! `scanfit fit`: a least-squares B-spline surface through scattered points,
+//! over [`scanfit::pipeline::surface_fit`].
 
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use anyhow::{bail, Result};
-use clap::Args;
-use scanfit::base::plane_parameters;
-use scanfit::bspline::Surface;
-use scanfit::fit::correction::{correct_parameters, CorrectionConfig, CorrectionRound};
-use scanfit::fit::surface::{fit_surface, KnotPlacement, SurfaceFitConfig};
-use scanfit::metrics::{
-    grid_rmse, orthogonal_errors, parameterization_quality, parametric_distances, ErrorStats,
-    ParamQuality,
-};
-use scanfit::project::{InversionConfig, SurfaceInverter};
-use scanfit_io::json::{Provenance, SurfaceDoc, SurfaceQualityDoc};
-use scanfit_io::{read_points, write_all_atomic};
+use clap::{Args, ValueEnum};
+use scanfit::fit::surface::KnotPlacement;
+use scanfit::pipeline::surface_fit::{run as fit, FitConfig, FitReport, ParameterSource};
+use scanfit::PointCloud;
+use scanfit_io::json::SurfaceDoc;
+use scanfit_io::{read_points, write_all_atomic, PointTable};
 
-use crate::args::NXM;
-use crate::outputs::{check_extensions, points_file, print_written, Deviation, Picture};
+use crate::args::{choice, NXM};
+use crate::outputs::{
+    check_extensions, points_file, print_written, provenance, quality_doc, quality_rows,
+    samples_json, Deviation, Picture,
+};
 use crate::progress::Progress;
 use crate::table::{num, Table};
 
@@ -32,24 +31,49 @@ height-field-like patches) or from columns named u and v in the input
 the parameters, true orthogonal distances, the MBA paper's grid RMSE (eq. 17)
 and the parameterization's fold-overs and stretch.";
 
+/// `--params`: where the parameters come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ParamsArg {
+    /// The best-fit plane of the points.
+    Plane,
+    /// Columns named u and v in the input.
+    UvColumns,
+}
+
+/// `--knots`: knot placement.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum KnotsArg {
+    /// Interior knots follow the parameter distribution.
+    Distribution,
+    /// Equally spaced interior knots.
+    Uniform,
+}
+
+/// The value's name as typed on the command line.
+fn name<T: ValueEnum>(v: &T) -> String {
+    v.to_possible_value()
+        .map(|p| p.get_name().to_string())
+        .unwrap_or_default()
+}
+
 /// Arguments of `scanfit fit`.
 #[derive(Args, Debug)]
 #[command(after_help = EXAMPLES)]
 pub struct FitArgs {
     /// Input point file (XYZ, CSV or TXT).
     pub input: PathBuf,
-    /// Where the parameters come from: `plane` (best-fit plane) or `uv-columns`.
-    #[arg(long, default_value = "plane", value_name = "SOURCE")]
-    pub params: String,
+    /// Where the parameters come from.
+    #[arg(long, default_value = "plane", value_name = "SOURCE", value_parser = choice::<ParamsArg>())]
+    pub params: ParamsArg,
     /// Degrees, "PxQ" or "P".
     #[arg(long, default_value = "3x3", value_name = "PxQ", value_parser = NXM)]
     pub degree: (usize, usize),
     /// Control net, "NUxNV" or "N".
     #[arg(long, default_value = "16x16", value_name = "NUxNV", value_parser = NXM)]
     pub ctrl: (usize, usize),
-    /// Knot placement: `distribution` (follows the parameters) or `uniform`.
-    #[arg(long, default_value = "distribution", value_name = "PLACEMENT")]
-    pub knots: String,
+    /// Knot placement.
+    #[arg(long, default_value = "distribution", value_name = "PLACEMENT", value_parser = choice::<KnotsArg>())]
+    pub knots: KnotsArg,
     /// Thin-plate smoothing weight λ on ∫∫ S_uu² + 2 S_uv² + S_vv² (0 = none).
     #[arg(
         long,
@@ -77,137 +101,116 @@ pub struct FitArgs {
     pub quiet: bool,
 }
 
+impl FitArgs {
+    /// The pipeline's settings.
+    fn config(&self) -> FitConfig {
+        let mut c = FitConfig::default();
+        c.params = match self.params {
+            ParamsArg::Plane => ParameterSource::Plane,
+            ParamsArg::UvColumns => ParameterSource::uv_attributes(),
+        };
+        c.fit.degree = self.degree;
+        c.fit.ctrl = self.ctrl;
+        c.fit.periodic_u = self.periodic_u;
+        c.fit.knots = match self.knots {
+            KnotsArg::Distribution => KnotPlacement::Distribution,
+            KnotsArg::Uniform => KnotPlacement::Uniform,
+        };
+        c.fit.smoothing = self.smooth;
+        c.correction_rounds = self.correct;
+        c
+    }
+
+    /// The settings recorded in the surface document.
+    fn settings(&self) -> BTreeMap<String, serde_json::Value> {
+        let mut s = BTreeMap::new();
+        s.insert(
+            "degree".into(),
+            serde_json::json!([self.degree.0, self.degree.1]),
+        );
+        s.insert("ctrl".into(), serde_json::json!([self.ctrl.0, self.ctrl.1]));
+        s.insert("knots".into(), name(&self.knots).into());
+        s.insert("smoothing".into(), self.smooth.into());
+        s.insert("periodic_u".into(), self.periodic_u.into());
+        s.insert("correction_rounds".into(), self.correct.into());
+        s
+    }
+}
+
+/// The points of `table` as a cloud, with its u and v columns as attributes
+/// when the parameters come from them.
+fn cloud_of(a: &FitArgs, table: &PointTable) -> Result<PointCloud> {
+    if a.params == ParamsArg::Plane && a.periodic_u {
+        bail!("--periodic-u needs parameters that go around (--params uv-columns); a plane cannot close");
+    }
+    let cloud = PointCloud::new(table.points.clone()).map_err(|e| locate(e, table))?;
+    if a.params == ParamsArg::Plane {
+        return Ok(cloud);
+    }
+    let (Some(u), Some(v)) = (table.column("u"), table.column("v")) else {
+        bail!(
+            "{} has no columns named u and v (its columns: {}); use --params plane or add them",
+            a.input.display(),
+            table.columns.join(", ")
+        );
+    };
+    Ok(cloud
+        .with_attribute("u", u.to_vec())?
+        .with_attribute("v", v.to_vec())?)
+}
+
+/// The library's error with the file and line of the point it names.
+fn locate(e: scanfit::Error, table: &PointTable) -> anyhow::Error {
+    let file = table.path.display();
+    match e.point_indices().first() {
+        Some(&i) => anyhow::anyhow!("{file}: {e} ({})", table.locate(i)),
+        None => anyhow::anyhow!("{file}: {e}"),
+    }
+}
+
 /// Runs `scanfit fit`.
 pub fn run(a: FitArgs) -> Result<()> {
-    let (degree, ctrl) = (a.degree, a.ctrl);
-    let knots = match a.knots.as_str() {
-        "distribution" => KnotPlacement::Distribution,
-        "uniform" => KnotPlacement::Uniform,
-        k => bail!("unknown knot placement '{k}'; use distribution or uniform"),
-    };
     a.out.check()?;
     check_extensions(&[(&a.points_out, "--points-out", &["ply", "xyz"][..])])?;
     let progress = Progress::spinner(a.quiet);
     progress.stage(format!("reading {}", a.input.display()));
     let table = read_points(&a.input)?;
-    let pts = &table.points;
-    progress.stage("parameterizing");
-    let mut uv: Vec<[f64; 2]> = match a.params.as_str() {
-        "plane" => {
-            if a.periodic_u {
-                bail!("--periodic-u needs parameters that go around (--params uv-columns); a plane cannot close");
-            }
-            plane_parameters(pts)
-                .map_err(|e| anyhow::anyhow!("{}: {e}", a.input.display()))?
-                .uv
-        }
-        "uv-columns" => {
-            let (Some(u), Some(v)) = (table.column("u"), table.column("v")) else {
-                bail!(
-                    "{} has no columns named u and v (its columns: {}); use --params plane or add them",
-                    a.input.display(),
-                    table.columns.join(", ")
-                );
-            };
-            u.iter().zip(v).map(|(&u, &v)| [u, v]).collect()
-        }
-        s => bail!("unknown parameter source '{s}'; use plane or uv-columns"),
-    };
-    let cfg = SurfaceFitConfig {
-        degree,
-        ctrl,
-        periodic_u: a.periodic_u,
-        knots,
-        smoothing: a.smooth,
-        weights: None,
-    };
-    // point indices in the library's errors map to lines of the file
-    let locate = |e: scanfit::Error| -> anyhow::Error {
-        match e.point_indices().first() {
-            Some(&i) => anyhow::anyhow!("{e} ({})", table.locate(i)),
-            None => anyhow::anyhow!("{e}"),
-        }
-    };
-    progress.stage(format!(
-        "fitting {} x {} control points to {} points",
-        ctrl.0,
-        ctrl.1,
-        pts.len()
-    ));
-    let (surface, rounds): (Surface, Vec<CorrectionRound>) = if a.correct > 0 {
-        let cc = CorrectionConfig {
-            max_rounds: a.correct,
-            ..Default::default()
-        };
-        correct_parameters(pts, &mut uv, |t| fit_surface(pts, t, &cfg), &cc).map_err(locate)?
-    } else {
-        (fit_surface(pts, &uv, &cfg).map_err(locate)?, Vec::new())
-    };
-    progress.stage("measuring");
-    let resid = parametric_distances(&surface, pts, &uv);
-    let par = ErrorStats::of(&resid);
-    let inverter = SurfaceInverter::new(&surface, InversionConfig::default())?;
-    let (orth, inv) = orthogonal_errors(&inverter, pts);
-    let unconverged = inv.iter().filter(|r| !r.converged).count();
-    let grid = grid_rmse(&surface, pts, None)?;
-    let pq = parameterization_quality(&surface, pts, &uv).unwrap_or_default();
-    let quality = SurfaceQualityDoc {
-        points: pts.len(),
-        mean_error: par.mean,
-        max_error: par.max,
-        rmse: par.rmse,
-        mean_distance: orth.mean,
-        max_distance: orth.max,
-        rmse_distance: orth.rmse,
-        unconverged,
-        grid_rmse: grid,
-        triangles: pq.triangles,
-        fold_overs: pq.fold_overs,
-        l2_stretch: pq.l2_stretch,
-        max_anisotropy: pq.max_anisotropy,
-        correction_rmse: rounds.iter().map(|r| r.errors.rmse).collect(),
-    };
+    let cloud = cloud_of(&a, &table)?;
+    let r = fit(&cloud, &a.config(), &progress).map_err(|e| locate(e, &table))?;
     progress.stage("writing");
-    let mut doc = SurfaceDoc::new(&surface);
-    let mut settings = std::collections::BTreeMap::new();
-    settings.insert(
-        "degree".to_string(),
-        serde_json::json!([degree.0, degree.1]),
-    );
-    settings.insert("ctrl".to_string(), serde_json::json!([ctrl.0, ctrl.1]));
-    settings.insert("knots".to_string(), a.knots.clone().into());
-    settings.insert("smoothing".to_string(), a.smooth.into());
-    settings.insert("periodic_u".to_string(), a.periodic_u.into());
-    settings.insert("correction_rounds".to_string(), a.correct.into());
-    doc.provenance = Some(Provenance {
-        tool: format!("scanfit {}", env!("CARGO_PKG_VERSION")),
-        operation: "fit (least-squares surface)".into(),
-        parameterization: Some(a.params.clone()),
-        input: Some(a.input.display().to_string()),
-        point_count: Some(pts.len()),
-        settings,
-    });
+    let pts = cloud.points();
+    let q = &r.assessment.quality;
+    let quality = quality_doc(q, r.rounds.iter().map(|r| r.errors.rmse).collect());
+    let mut doc = SurfaceDoc::new(&r.surface);
+    doc.provenance = Some(provenance(
+        "fit (least-squares surface)",
+        Some(name(&a.params)),
+        &a.input,
+        pts.len(),
+        a.settings(),
+    ));
     doc.quality = Some(quality.clone());
-    let dist: Vec<f64> = inv.iter().map(|r| r.distance).collect();
+    let dist = r.assessment.distances();
+    let deviation = Deviation {
+        per_point: &dist,
+        stats: q.orthogonal,
+        name: "orthogonal distance",
+    };
     let (mut files, exaggeration) = a.out.files(
-        &surface,
+        &r.surface,
         &doc,
         pts,
-        &Deviation {
-            per_point: &dist,
-            stats: orth,
-            name: "orthogonal distance",
-        },
+        &deviation,
         &a.input,
         &Picture::default(),
     )?;
     if let Some(pout) = &a.points_out {
-        let u: Vec<f64> = uv.iter().map(|t| t[0]).collect();
-        let v: Vec<f64> = uv.iter().map(|t| t[1]).collect();
+        let u: Vec<f64> = r.uv.iter().map(|t| t[0]).collect();
+        let v: Vec<f64> = r.uv.iter().map(|t| t[1]).collect();
         let attrs: [(&str, &[f64]); 4] = [
             ("u", &u),
             ("v", &v),
-            ("residual", &resid),
+            ("residual", &r.assessment.residuals),
             ("distance", &dist),
         ];
         files.push((pout.clone(), points_file(pout, pts, &attrs)));
@@ -218,39 +221,31 @@ pub fn run(a: FitArgs) -> Result<()> {
         let report = serde_json::json!({
             "input": a.input.display().to_string(),
             "point_count": pts.len(),
-            "degree": [degree.0, degree.1],
-            "control_points": [surface.counts().0, surface.counts().1],
-            "parameters": a.params,
+            "degree": [a.degree.0, a.degree.1],
+            "control_points": [r.surface.counts().0, r.surface.counts().1],
+            "parameters": name(&a.params),
             "quality": quality,
+            "samples_to_points": samples_json(q),
             "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
         });
         println!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
     }
-    print_report(&a, &surface, &par, &orth, unconverged, grid, &pq, &rounds);
+    print_report(&a, &r);
     print_written(&files, a.out.png.as_deref(), exaggeration);
     Ok(())
 }
 
-#[allow(clippy::too_many_arguments)]
-fn print_report(
-    a: &FitArgs,
-    s: &Surface,
-    par: &ErrorStats,
-    orth: &ErrorStats,
-    unconverged: usize,
-    grid: f64,
-    pq: &ParamQuality,
-    rounds: &[CorrectionRound],
-) {
-    let (p, q) = s.degrees();
-    let (cu, cv) = s.counts();
+fn print_report(a: &FitArgs, r: &FitReport) {
+    let q = &r.assessment.quality;
+    let (p, qd) = r.surface.degrees();
+    let (cu, cv) = r.surface.counts();
     println!(
-        "{}: {} points -> B-spline surface of degree {p} x {q}, {cu} x {cv} control points ({} parameters, {} knots{}{})\n",
+        "{}: {} points -> B-spline surface of degree {p} x {qd}, {cu} x {cv} control points ({} parameters, {} knots{}{})\n",
         a.input.display(),
-        par.count,
-        a.params,
-        a.knots,
+        q.points,
+        name(&a.params),
+        name(&a.knots),
         if a.smooth > 0.0 { format!(", smoothing {}", a.smooth) } else { String::new() },
         if a.periodic_u { ", periodic in u" } else { "" },
     );
@@ -258,28 +253,17 @@ fn print_report(
         &["measure", "mean", "max", "RMSE", "unit"],
         &[true, false, false, false, true],
     );
+    let e = &q.at_parameters;
     t.row(vec![
         "|P - S(u,v)| at the parameters (eq. 15)".into(),
-        num(par.mean),
-        num(par.max),
-        num(par.rmse),
+        num(e.mean),
+        num(e.max),
+        num(e.rmse),
         "data units".into(),
     ]);
-    t.row(vec![
-        "orthogonal distance to the surface".into(),
-        num(orth.mean),
-        num(orth.max),
-        num(orth.rmse),
-        "data units".into(),
-    ]);
-    t.row(vec![
-        "grid points to nearest point (MBA eq. 17)".into(),
-        "-".into(),
-        "-".into(),
-        num(grid),
-        "data units".into(),
-    ]);
+    quality_rows(&mut t, q, "grid points to nearest point (MBA eq. 17)");
     print!("{}", t.render());
+    let pq = &q.parameterization;
     println!(
         "\nparameterization: {} fold-overs in {} triangles, L2 stretch {:.3} (1 = uniform), max anisotropy {}",
         pq.fold_overs,
@@ -287,16 +271,19 @@ fn print_report(
         pq.l2_stretch,
         num(pq.max_anisotropy)
     );
-    if unconverged > 0 {
-        println!("note: {unconverged} point inversions did not converge (their distance is the best found)");
+    if q.unconverged > 0 {
+        println!(
+            "note: {} point inversions did not converge (their distance is the best found)",
+            q.unconverged
+        );
     }
-    if !rounds.is_empty() {
+    if !r.rounds.is_empty() {
         println!();
         let mut t = Table::new(
             &["correction round", "RMSE", "max error", "unit"],
             &[false, false, false, true],
         );
-        for r in rounds {
+        for r in &r.rounds {
             t.row(vec![
                 r.round.to_string(),
                 num(r.errors.rmse),

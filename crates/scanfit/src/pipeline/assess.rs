@@ -17,6 +17,9 @@
 //! * **parameterization quality**: fold-overs and stretch of the parameters
 //!   ([`ParamQuality`], Sander et al. 2001).
 //!
+//! [`assess_projected`] does the same for points without parameters (they
+//! get those of their orthogonal projections), as `scanfit report` needs.
+//!
 //! A pipeline whose error at the parameters is measured on another surface
 //! than the one assessed (the PDE route measures eq. 15 on the PDE surface,
 //! before its B-spline conversion) overwrites
@@ -173,6 +176,57 @@ pub fn assess_surface(
             got: uv.len(),
         });
     }
+    check(config)?;
+    let residuals = parametric_distances(surface, points, uv);
+    let inverter = SurfaceInverter::new(surface, config.inversion)?;
+    let inversions = inverter.invert_all(points);
+    finish(surface, points, uv, residuals, inversions, config)
+}
+
+/// Assesses `surface` against `points` that have no parameters of their
+/// own (a surface read from a file and a scan to compare with it): each
+/// point's parameters are those of its orthogonal projection, so the error
+/// at the parameters equals the orthogonal distance.
+///
+/// ```
+/// use scanfit::bspline::{KnotVector, Surface};
+/// use scanfit::pipeline::assess::{assess_projected, AssessConfig};
+/// use scanfit::Point3;
+///
+/// let k = KnotVector::uniform_clamped(1, 2)?;
+/// let c = vec![
+///     Point3::new(0., 0., 0.), Point3::new(0., 1., 0.),
+///     Point3::new(1., 0., 0.), Point3::new(1., 1., 0.),
+/// ];
+/// let s = Surface::new(k.clone(), k, c)?;
+/// let pts: Vec<Point3> = (0..100)
+///     .map(|i| Point3::new((i % 10) as f64 / 9.0, (i / 10) as f64 / 9.0, 0.01 * (i % 3) as f64))
+///     .collect();
+/// let a = assess_projected(&s, &pts, &AssessConfig::default())?;
+/// assert!((a.quality.orthogonal.max - 0.02).abs() < 1e-9);
+/// assert!((a.quality.at_parameters.mean - a.quality.orthogonal.mean).abs() < 1e-12);
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+pub fn assess_projected(
+    surface: &Surface,
+    points: &[Point3],
+    config: &AssessConfig,
+) -> Result<Assessment> {
+    if points.is_empty() {
+        return Err(Error::InvalidInput(
+            "no points to assess the surface against".into(),
+        ));
+    }
+    check(config)?;
+    let inverter = SurfaceInverter::new(surface, config.inversion)?;
+    let inversions = inverter.invert_all(points);
+    let uv: Vec<[f64; 2]> = inversions.iter().map(|r| r.uv).collect();
+    let residuals: Vec<f64> = inversions.iter().map(|r| r.distance).collect();
+    finish(surface, points, &uv, residuals, inversions, config)
+}
+
+/// Rejects settings the assessment cannot use.
+fn check(config: &AssessConfig) -> Result<()> {
     if !(config.far_spacings.is_finite() && config.far_spacings > 0.0) {
         return Err(Error::InvalidSetting {
             setting: "far_spacings",
@@ -180,10 +234,28 @@ pub fn assess_surface(
             hint: "give a positive number of point spacings".into(),
         });
     }
-    let residuals = parametric_distances(surface, points, uv);
+    if let Some((nu, nv)) = config.samples {
+        if !(1..=4096).contains(&nu) || !(1..=4096).contains(&nv) {
+            return Err(Error::InvalidSetting {
+                setting: "samples",
+                value: format!("{nu} x {nv}"),
+                hint: "give 1 to 4096 sample intervals in each direction".into(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The rest of the assessment once the residuals and projections are known.
+fn finish(
+    surface: &Surface,
+    points: &[Point3],
+    uv: &[[f64; 2]],
+    residuals: Vec<f64>,
+    inversions: Vec<Inversion>,
+    config: &AssessConfig,
+) -> Result<Assessment> {
     let at_parameters = ErrorStats::of(&residuals);
-    let inverter = SurfaceInverter::new(surface, config.inversion)?;
-    let inversions = inverter.invert_all(points);
     let dist: Vec<f64> = inversions.iter().map(|r| r.distance).collect();
     let orthogonal = ErrorStats::of(&dist);
     let unconverged = inversions.iter().filter(|r| !r.converged).count();
@@ -230,17 +302,10 @@ fn sample_distances(
     config: &AssessConfig,
 ) -> Result<SampleDistances> {
     let (cu, cv) = surface.counts();
-    let (nu, nv) = match config.samples {
-        Some((nu, nv)) if nu >= 1 && nv >= 1 && nu <= 4096 && nv <= 4096 => (nu, nv),
-        Some((nu, nv)) => {
-            return Err(Error::InvalidSetting {
-                setting: "samples",
-                value: format!("{nu} x {nv}"),
-                hint: "give 1 to 4096 sample intervals in each direction".into(),
-            })
-        }
-        None => ((cu * 4).clamp(32, 200), (cv * 4).clamp(32, 200)),
-    };
+    // checked by `check`
+    let (nu, nv) = config
+        .samples
+        .unwrap_or(((cu * 4).clamp(32, 200), (cv * 4).clamp(32, 200)));
     let ((u0, u1), (v0, v1)) = surface.domain();
     let samples: Vec<Point3> = (0..=nu)
         .flat_map(|i| (0..=nv).map(move |j| (i, j)))

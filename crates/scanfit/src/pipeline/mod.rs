@@ -26,15 +26,30 @@
 //! Modules:
 //!
 //! * [`assess`]: the surface assessment every surface pipeline ends with.
-//! * [`coons`]: one patch to a surface by the Coons paper (B-spline) or the
-//!   PDE paper (thin-plate deformation).
-//! * [`turntable`]: cylinder-like clouds by the virtual turntable.
 //! * [`cloud`]: the point-cloud tools (info, normals, hidden point removal,
 //!   boundary and corners).
+//! * [`coons`]: one patch to a surface by the Coons paper (B-spline) or the
+//!   PDE paper (thin-plate deformation).
+//! * [`curve`]: curve interpolation / least squares and the comparison of
+//!   the curve paper's parameterizations (`scanfit curve fit|compare`).
+//! * [`mba`]: multilevel B-spline approximation (`scanfit mba`), optionally
+//!   with the MBA paper's projection adjustment, with its per-level table.
+//! * [`measure`]: what `scanfit report` measures for a surface and points
+//!   (the assessment of their projections, percentiles, histogram).
+//! * [`surface_fit`]: least-squares surface through scattered points
+//!   (`scanfit fit`): parameters from the best-fit plane or given
+//!   attributes, optional Hoschek parameter correction.
+//! * [`turntable`]: cylinder-like clouds by the virtual turntable.
 
 pub mod assess;
 pub mod cloud;
 pub mod coons;
+pub mod curve;
+pub mod mba;
+pub mod measure;
+pub mod surface_fit;
 pub mod turntable;
 
-pub use assess::{assess_surface, AssessConfig, Assessment, SampleDistances, SurfaceQuality};
+pub use assess::{
+    assess_projected, assess_surface, AssessConfig, Assessment, SampleDistances, SurfaceQuality,
+};

@@ -1,0 +1,274 @@
+//! `scanfit mba` as a library call: a bicubic B-spline surface z = f(x, y)
+//! through scattered 2.5D points by multilevel B-spline approximation (Lee,
+//! Wolberg & Shin 1997), optionally with the MBA paper's projection
+//! adjustment of control points (sections 2.2-2.4, eq. 16), with the
+//! per-level table the command prints and the one surface assessment.
+//!
+//! The parameters of a point are its (x, y) scaled to the unit square of
+//! the data's bounding box ([`Frame::unit`]). The surface's error at the
+//! parameters is by construction the vertical distance `|z - f(x, y)|`, the
+//! residual the level loop fits; eq. 17 is measured on the lattice's own
+//! knot grid ([`knot_grid`]), as the adjustment measures it.
+
+use std::time::Instant;
+
+use crate::bspline::Surface;
+use crate::mba::adjust::{knot_grid, lattice_grid_rmse, mba_adjusted, AdjustConfig};
+use crate::mba::{lattice_surface, mba, Frame, Lattice, MbaConfig};
+use crate::metrics::{rmse_to_cloud, ErrorStats};
+use crate::pipeline::assess::{assess_surface, AssessConfig, Assessment};
+use crate::progress::Progress;
+use crate::{Error, PointCloud, Result};
+
+/// Settings of [`run`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[non_exhaustive]
+pub struct MbaRunConfig {
+    /// The level loop (default [`MbaConfig::default`]: base lattice from the
+    /// aspect ratio, 6 levels, no tolerance, Lee-Wolberg-Shin eq. 4).
+    pub mba: MbaConfig,
+    /// The MBA paper's projection adjustment at every level (default `None`;
+    /// `Some(AdjustConfig::default())` is alpha 1.49 and the turntable
+    /// paper's weight factor eq. 19, up to 5 steps per level).
+    pub adjust: Option<AdjustConfig>,
+    /// The assessment of the final surface (default [`AssessConfig::default`]).
+    pub assess: AssessConfig,
+}
+
+/// The adjustment's effect at one level.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct AdjustedRow {
+    /// RMSE of the vertical residuals after the adjustment.
+    pub vertical_rmse: f64,
+    /// Eq. 17 RMSE after the adjustment.
+    pub grid_rmse: f64,
+    /// Adjustment steps taken.
+    pub steps: usize,
+}
+
+/// One row of the per-level table.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct LevelRow {
+    /// Level number (0 = base lattice).
+    pub level: usize,
+    /// Control net of the level's combined surface, `(m + 3, n + 3)`.
+    pub control_points: (usize, usize),
+    /// Vertical residuals `|z - f(x, y)|` at the data points after the level
+    /// (before any adjustment).
+    pub vertical: ErrorStats,
+    /// Eq. 17 RMSE of the level's combined surface (before any adjustment).
+    pub grid_rmse: f64,
+    /// The adjustment at this level, when it ran.
+    pub adjusted: Option<AdjustedRow>,
+    /// Wall time of the level in seconds.
+    pub seconds: f64,
+}
+
+/// What [`run`] returns.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct MbaReport {
+    /// The final surface (clamped bicubic, x and y linear in u and v).
+    pub surface: Surface,
+    /// The map between data and lattice coordinates.
+    pub frame: Frame,
+    /// Cells `(m, n)` of the final lattice (control net `(m + 3) x (n + 3)`).
+    pub cells: (usize, usize),
+    /// Parameters of the points (x, y scaled to the unit square).
+    pub uv: Vec<[f64; 2]>,
+    /// `|z - f(x, y)|` per point.
+    pub vertical: Vec<f64>,
+    /// One row per level.
+    pub levels: Vec<LevelRow>,
+    /// Wall time of the approximation (without the assessment) in seconds.
+    pub seconds: f64,
+    /// The assessment of the final surface; its `at_parameters` are the
+    /// vertical residuals and its `grid_rmse` is eq. 17 at the lattice's
+    /// knot grid.
+    pub assessment: Assessment,
+}
+
+/// Multilevel B-spline approximation of `cloud` (see the module
+/// documentation).
+///
+/// ```
+/// use scanfit::pipeline::mba::{run, MbaRunConfig};
+/// use scanfit::progress::NoProgress;
+/// use scanfit::{Point3, PointCloud};
+///
+/// let pts: Vec<Point3> = (0..2500)
+///     .map(|k| {
+///         let (x, y) = ((k % 50) as f64, (k / 50) as f64);
+///         Point3::new(x, y, (x / 8.0).sin() * (y / 11.0).cos())
+///     })
+///     .collect();
+/// let mut cfg = MbaRunConfig::default();
+/// cfg.mba.max_levels = 4;
+/// let r = run(&PointCloud::new(pts)?, &cfg, &NoProgress)?;
+/// assert_eq!(r.levels.len(), 4);
+/// // every level lowers the vertical error
+/// assert!(r.levels.windows(2).all(|w| w[1].vertical.rmse < w[0].vertical.rmse));
+/// // the last row is the final surface
+/// let e = r.assessment.quality.at_parameters.rmse;
+/// assert!((r.levels[3].vertical.rmse - e).abs() < 1e-9 && e < 0.1 * r.levels[0].vertical.rmse);
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+pub fn run(
+    cloud: &PointCloud,
+    config: &MbaRunConfig,
+    progress: &dyn Progress,
+) -> Result<MbaReport> {
+    if config.mba.max_levels == 0 {
+        return Err(Error::InvalidSetting {
+            setting: "max_levels",
+            value: "0".into(),
+            hint: "give at least 1 level".into(),
+        });
+    }
+    let pts = cloud.points();
+    let t0 = Instant::now();
+    progress.stage(
+        &format!("multilevel B-spline approximation of {} points", pts.len()),
+        None,
+    );
+    let (result, levels) = match &config.adjust {
+        Some(adjust) => {
+            let r = mba_adjusted(pts, &config.mba, adjust)?;
+            let rows = r
+                .levels
+                .iter()
+                .zip(&r.mba.reports)
+                .map(|(l, rep)| LevelRow {
+                    level: rep.level,
+                    control_points: (l.cells.0 + 3, l.cells.1 + 3),
+                    vertical: l.mba_vertical,
+                    grid_rmse: l.mba_rmse,
+                    adjusted: Some(AdjustedRow {
+                        vertical_rmse: l.adjusted_vertical.rmse,
+                        grid_rmse: l.adjusted_rmse,
+                        steps: l.steps,
+                    }),
+                    seconds: l.seconds,
+                })
+                .collect();
+            (r.mba, rows)
+        }
+        None => {
+            let r = mba(pts, &config.mba)?;
+            let rows = plain_rows(cloud, &r)?;
+            (r, rows)
+        }
+    };
+    let surface = lattice_surface(&result.frame, &result.lattice)?;
+    let seconds = t0.elapsed().as_secs_f64();
+    progress.stage("measuring", None);
+    let frame = result.frame;
+    let uv: Vec<[f64; 2]> = pts.iter().map(|p| frame.unit(p)).collect();
+    let vertical: Vec<f64> = pts
+        .iter()
+        .zip(&uv)
+        .map(|(p, t)| (p.z - surface.point(t[0], t[1]).z).abs())
+        .collect();
+    let mut assessment = assess_surface(&surface, pts, &uv, &config.assess)?;
+    assessment.quality.at_parameters = ErrorStats::of(&vertical);
+    assessment.quality.grid_rmse = rmse_to_cloud(cloud, &knot_grid(&frame, &result.lattice))?;
+    Ok(MbaReport {
+        surface,
+        frame,
+        cells: (result.lattice.m, result.lattice.n),
+        uv,
+        vertical,
+        levels,
+        seconds,
+        assessment,
+    })
+}
+
+/// The rows of a run without adjustment: eq. 17 of each level's combined
+/// lattice (the sum refined level by level).
+fn plain_rows(cloud: &PointCloud, r: &crate::mba::Mba) -> Result<Vec<LevelRow>> {
+    let mut rows = Vec::new();
+    let mut total: Option<Lattice> = None;
+    for (lat, rep) in r.levels.iter().zip(&r.reports) {
+        let mut t = match total.take() {
+            None => lat.clone(),
+            Some(t) => t.refine()?,
+        };
+        if rep.level > 0 {
+            t.add(lat)?;
+        }
+        rows.push(LevelRow {
+            level: rep.level,
+            control_points: (rep.cells.0 + 3, rep.cells.1 + 3),
+            vertical: rep.residual,
+            grid_rmse: lattice_grid_rmse(cloud, &r.frame, &t)?,
+            adjusted: None,
+            seconds: rep.seconds,
+        });
+        total = Some(t);
+    }
+    Ok(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::progress::NoProgress;
+    use crate::Point3;
+
+    fn terrain() -> PointCloud {
+        // scattered, not on a grid: a golden-angle spiral over a 40 x 30 box
+        let pts = (0..3000)
+            .map(|k| {
+                let t = k as f64 * 0.618_033_988_75;
+                let (x, y) = (40.0 * t.fract(), 30.0 * (k as f64 / 3000.0));
+                Point3::new(x, y, 3.0 * (x / 7.0).sin() + (y / 5.0).cos())
+            })
+            .collect();
+        PointCloud::new(pts).unwrap()
+    }
+
+    #[test]
+    fn adjustment_lowers_eq17_at_the_last_level_and_rows_match_the_levels() {
+        let c = terrain();
+        let mut cfg = MbaRunConfig::default();
+        cfg.mba.max_levels = 4;
+        let plain = run(&c, &cfg, &NoProgress).unwrap();
+        assert_eq!(plain.levels.len(), 4);
+        assert!(plain.levels.iter().all(|l| l.adjusted.is_none()));
+        // the final row is the final surface
+        let last = plain.levels[3];
+        assert_eq!(last.control_points, (plain.cells.0 + 3, plain.cells.1 + 3));
+        let q = plain.assessment.quality;
+        assert!(
+            (last.vertical.rmse - q.at_parameters.rmse).abs() < 1e-9 * (1.0 + q.at_parameters.rmse)
+        );
+        assert!((last.grid_rmse - q.grid_rmse).abs() < 1e-12);
+        cfg.adjust = Some(AdjustConfig::default());
+        let adj = run(&c, &cfg, &NoProgress).unwrap();
+        let a = adj.levels[3].adjusted.unwrap();
+        // the adjustment took steps and moved the knot grid onto the data
+        assert!(a.steps > 0);
+        assert!(a.grid_rmse < adj.levels[3].grid_rmse, "{a:?}");
+        assert!((a.grid_rmse - adj.assessment.quality.grid_rmse).abs() < 1e-12);
+    }
+
+    #[test]
+    fn zero_levels_is_a_typed_error() {
+        let mut cfg = MbaRunConfig::default();
+        cfg.mba.max_levels = 0;
+        let e = run(&terrain(), &cfg, &NoProgress).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                Error::InvalidSetting {
+                    setting: "max_levels",
+                    ..
+                }
+            ),
+            "{e}"
+        );
+    }
+}

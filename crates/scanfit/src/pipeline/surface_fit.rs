@@ -1,0 +1,248 @@
+//! `scanfit fit` as a library call: a least-squares B-spline surface through
+//! scattered points.
+//!
+//! The points get their parameters from their best-fit plane
+//! ([`ParameterSource::Plane`], for height-field-like patches) or from two
+//! attributes of the cloud ([`ParameterSource::Attributes`], e.g. the columns
+//! `u` and `v` of the input file); the surface is the least-squares fit of
+//! [`fit_surface`] (NURBS Book eq. 9.63 on a tensor-product basis, optional
+//! thin-plate smoothing), optionally followed by Hoschek's parameter
+//! correction ([`correct_parameters`]); the result is assessed by
+//! [`assess_surface`].
+
+use crate::base::plane_parameters;
+use crate::bspline::Surface;
+use crate::fit::correction::{correct_parameters, CorrectionConfig, CorrectionRound};
+use crate::fit::surface::{fit_surface, SurfaceFitConfig};
+use crate::pipeline::assess::{assess_surface, AssessConfig, Assessment};
+use crate::progress::Progress;
+use crate::{Error, PointCloud, Result};
+
+/// Where the points' parameters come from.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum ParameterSource {
+    /// Orthogonal projection onto the best-fit plane of the points, scaled to
+    /// `[0, 1]^2` (the default).
+    #[default]
+    Plane,
+    /// Two attributes of the cloud hold `u` and `v`.
+    Attributes {
+        /// Name of the `u` attribute.
+        u: String,
+        /// Name of the `v` attribute.
+        v: String,
+    },
+}
+
+impl ParameterSource {
+    /// The attributes named `u` and `v`.
+    pub fn uv_attributes() -> Self {
+        ParameterSource::Attributes {
+            u: "u".into(),
+            v: "v".into(),
+        }
+    }
+}
+
+/// Settings of [`run`].
+#[derive(Debug, Clone, PartialEq, Default)]
+#[non_exhaustive]
+pub struct FitConfig {
+    /// Where the parameters come from (default: the best-fit plane).
+    pub params: ParameterSource,
+    /// The least-squares fit (default [`SurfaceFitConfig::default`]: bicubic,
+    /// 16 x 16 control points, knots from the parameter distribution (NURBS
+    /// Book eq. 9.69), no smoothing, not periodic).
+    pub fit: SurfaceFitConfig,
+    /// Rounds of Hoschek's parameter correction: re-project the points onto
+    /// the surface and refit while the RMSE improves (default 0 = none).
+    pub correction_rounds: usize,
+    /// Stopping rule of the correction (default [`CorrectionConfig::default`];
+    /// its `max_rounds` is replaced by `correction_rounds`).
+    pub correction: CorrectionConfig,
+    /// The assessment of the result (default [`AssessConfig::default`]).
+    pub assess: AssessConfig,
+}
+
+/// What [`run`] returns.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct FitReport {
+    /// The fitted surface.
+    pub surface: Surface,
+    /// The parameters of the points on it (after correction, if any).
+    pub uv: Vec<[f64; 2]>,
+    /// RMSE and maximum error after each correction round (round 0 = the
+    /// first fit; empty without correction).
+    pub rounds: Vec<CorrectionRound>,
+    /// The assessment of `surface` against the points at `uv`.
+    pub assessment: Assessment,
+}
+
+/// Fits a least-squares B-spline surface to `cloud` (see the module
+/// documentation).
+///
+/// Errors: too few points for the control net, parameters outside the
+/// domain or missing attributes, each with the point index or setting as
+/// data ([`Error::point_indices`]).
+///
+/// ```
+/// use scanfit::pipeline::surface_fit::{run, FitConfig};
+/// use scanfit::progress::NoProgress;
+/// use scanfit::{Point3, PointCloud};
+///
+/// // a gentle saddle sampled on a 30 x 30 grid
+/// let pts: Vec<Point3> = (0..900)
+///     .map(|k| {
+///         let (x, y) = ((k % 30) as f64 / 29.0, (k / 30) as f64 / 29.0);
+///         Point3::new(x, y, 0.2 * (x - 0.5) * (y - 0.5))
+///     })
+///     .collect();
+/// let mut cfg = FitConfig::default();
+/// cfg.fit.ctrl = (6, 6);
+/// let r = run(&PointCloud::new(pts)?, &cfg, &NoProgress)?;
+/// assert_eq!(r.surface.counts(), (6, 6));
+/// // a bicubic net reproduces the bilinear saddle
+/// assert!(r.assessment.quality.orthogonal.max < 1e-9);
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+pub fn run(cloud: &PointCloud, config: &FitConfig, progress: &dyn Progress) -> Result<FitReport> {
+    let pts = cloud.points();
+    progress.stage("parameterizing", None);
+    let mut uv: Vec<[f64; 2]> = match &config.params {
+        ParameterSource::Plane => {
+            if config.fit.periodic_u {
+                return Err(Error::InvalidSetting {
+                    setting: "periodic_u",
+                    value: "true".into(),
+                    hint: "a periodic surface needs parameters that go around (ParameterSource::Attributes); a plane cannot close".into(),
+                });
+            }
+            plane_parameters(pts)?.uv
+        }
+        ParameterSource::Attributes { u, v } => {
+            let (Some(us), Some(vs)) = (cloud.attribute(u), cloud.attribute(v)) else {
+                let names: Vec<&str> = cloud.attributes().iter().map(|a| a.name.as_str()).collect();
+                return Err(Error::InvalidSetting {
+                    setting: "params",
+                    value: format!("attributes {u}, {v}"),
+                    hint: format!(
+                        "the cloud has no attributes named {u} and {v} (its attributes: {}); use the plane or add them",
+                        if names.is_empty() { "none".to_string() } else { names.join(", ") }
+                    ),
+                });
+            };
+            us.iter().zip(vs).map(|(&u, &v)| [u, v]).collect()
+        }
+    };
+    let (cu, cv) = config.fit.ctrl;
+    progress.stage(
+        &format!("fitting {cu} x {cv} control points to {} points", pts.len()),
+        None,
+    );
+    let fit = |t: &[[f64; 2]]| fit_surface(pts, t, &config.fit);
+    let (surface, rounds) = if config.correction_rounds > 0 {
+        let cc = CorrectionConfig {
+            max_rounds: config.correction_rounds,
+            ..config.correction
+        };
+        correct_parameters(pts, &mut uv, fit, &cc)?
+    } else {
+        (fit(&uv)?, Vec::new())
+    };
+    progress.stage("measuring", None);
+    let assessment = assess_surface(&surface, pts, &uv, &config.assess)?;
+    Ok(FitReport {
+        surface,
+        uv,
+        rounds,
+        assessment,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::progress::NoProgress;
+    use crate::Point3;
+
+    fn wave(n: usize) -> Vec<Point3> {
+        (0..n * n)
+            .map(|k| {
+                let (x, y) = (
+                    (k % n) as f64 / (n - 1) as f64,
+                    (k / n) as f64 / (n - 1) as f64,
+                );
+                Point3::new(x, y, 0.1 * (4.0 * x).sin() * (3.0 * y).cos())
+            })
+            .collect()
+    }
+
+    #[test]
+    fn correction_lowers_the_error_and_attributes_give_the_parameters() {
+        let cloud = PointCloud::new(wave(40)).unwrap();
+        let mut cfg = FitConfig::default();
+        cfg.fit.ctrl = (5, 5);
+        let plain = run(&cloud, &cfg, &NoProgress).unwrap();
+        assert!(plain.rounds.is_empty());
+        cfg.correction_rounds = 3;
+        let corrected = run(&cloud, &cfg, &NoProgress).unwrap();
+        assert!(!corrected.rounds.is_empty());
+        let (e0, e1) = (
+            plain.assessment.quality.at_parameters.rmse,
+            corrected.assessment.quality.at_parameters.rmse,
+        );
+        assert!(e1 < e0, "{e1} !< {e0}");
+        assert_eq!(corrected.rounds[0].errors.rmse, e0);
+        // the plane's parameters given as attributes reproduce the plain fit
+        let u: Vec<f64> = plain.uv.iter().map(|t| t[0]).collect();
+        let v: Vec<f64> = plain.uv.iter().map(|t| t[1]).collect();
+        let with = cloud
+            .clone()
+            .with_attribute("u", u)
+            .unwrap()
+            .with_attribute("v", v)
+            .unwrap();
+        let mut cfg = FitConfig::default();
+        cfg.fit.ctrl = (5, 5);
+        cfg.params = ParameterSource::uv_attributes();
+        let given = run(&with, &cfg, &NoProgress).unwrap();
+        assert_eq!(given.surface, plain.surface);
+    }
+
+    #[test]
+    fn bad_settings_are_typed_errors() {
+        let cloud = PointCloud::new(wave(10)).unwrap();
+        let mut cfg = FitConfig::default();
+        cfg.fit.periodic_u = true;
+        let e = run(&cloud, &cfg, &NoProgress).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                Error::InvalidSetting {
+                    setting: "periodic_u",
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        let mut cfg = FitConfig::default();
+        cfg.params = ParameterSource::uv_attributes();
+        let e = run(&cloud, &cfg, &NoProgress).unwrap_err();
+        assert!(e.to_string().contains("no attributes named u and v"), "{e}");
+        let cfg = FitConfig::default(); // 16 x 16 > 100 points
+        let e = run(&cloud, &cfg, &NoProgress).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                Error::TooFewPoints {
+                    got: 100,
+                    needed: 256,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+    }
+}
