@@ -166,96 +166,143 @@ impl SurfaceOutputArgs {
         } else {
             None
         };
-        let dmax = deviation.stats.max;
-        let colours: Option<Vec<[u8; 3]>> = vertex_dev.as_ref().map(|d| {
-            d.iter()
-                .map(|&x| {
-                    viridis(if dmax > 0.0 { x / dmax } else { 0.0 })
-                        .map(|c| (c * 255.0).round() as u8)
-                })
-                .collect()
-        });
         if let Some(m) = &self.mesh {
-            let name = input
-                .file_stem()
-                .map(|n| n.to_string_lossy().into_owned())
-                .unwrap_or_default();
-            let bytes = match extension(m).as_str() {
-                "obj" => mesh_obj(
-                    &mesh,
-                    &format!("scanfit surface fitted to {}", input.display()),
-                ),
-                "glb" => mesh_glb(&mesh, colours.as_deref(), &name),
-                _ => mesh_ply(
-                    &mesh,
-                    vertex_dev.as_deref().map(|d| ("deviation", d)),
-                    colours.as_deref(),
-                    PlyFormat::Binary,
-                ),
-            };
+            let bytes = mesh_file(m, &mesh, vertex_dev.as_deref(), deviation.stats.max, input);
             files.push((m.clone(), bytes));
         }
-        let deviation_legend = vec![
-            format!(
-                "{}: colour = {} of the nearest input point [data units]",
-                input.display(),
-                deviation.name
-            ),
-            format!(
-                "input points to surface ({}): mean {}  max {}  RMSE {}  [data units]",
-                deviation.name,
-                num(deviation.stats.mean),
-                num(deviation.stats.max),
-                num(deviation.stats.rmse)
-            ),
-        ];
-        if let (Some(dp), Some(d)) = (&self.deviation_png, &vertex_dev) {
-            let opts = RenderOptions {
-                legend: deviation_legend.clone(),
-                ..self.view.options(points)?
-            };
-            let bytes = render_surface_scene_png(
-                &mesh,
-                None,
-                Colouring::Scalar {
-                    values: d,
-                    range: (0.0, dmax),
-                },
-                &picture.lines,
-                &picture.markers,
-                &opts,
-            )?;
-            files.push((dp.clone(), bytes));
+        let scene = Scene {
+            mesh: &mesh,
+            points,
+            vertex_dev: vertex_dev.as_deref(),
+            deviation,
+            input,
+            picture,
+        };
+        if let (Some(dp), Some(_)) = (&self.deviation_png, &vertex_dev) {
+            files.push((dp.clone(), self.deviation_picture(&scene)?));
         }
         let mut exaggeration = 1.0;
         if let Some(png) = &self.png {
-            // at most 5,000 points drawn, evenly picked; flat data (terrain) exaggerated
-            let step = (points.len() / 5_000).max(1);
-            let shown: Vec<_> = points.iter().step_by(step).copied().collect();
-            let mut opts = self.view.options(points)?;
-            exaggeration = opts.z_scale;
-            let colouring = match (picture.style, &vertex_dev) {
-                (PngStyle::Deviation, Some(d)) => {
-                    opts.legend = deviation_legend;
-                    Colouring::Scalar {
-                        values: d,
-                        range: (0.0, dmax),
-                    }
-                }
-                _ => Colouring::Height,
-            };
-            opts.legend.extend(picture.legend.iter().cloned());
-            let bytes = render_surface_scene_png(
-                &mesh,
-                Some(&shown),
-                colouring,
-                &picture.lines,
-                &picture.markers,
-                &opts,
-            )?;
+            let (bytes, z) = self.shaded_picture(&scene)?;
+            exaggeration = z;
             files.push((png.clone(), bytes));
         }
         Ok((files, exaggeration))
+    }
+
+    /// `--deviation-png`: the surface coloured by the local fit error.
+    fn deviation_picture(&self, s: &Scene) -> Result<Vec<u8>> {
+        let d = s.vertex_dev.unwrap_or(&[]);
+        let opts = RenderOptions {
+            legend: s.deviation_legend(),
+            ..self.view.options(s.points)?
+        };
+        let colouring = Colouring::Scalar {
+            values: d,
+            range: (0.0, s.deviation.stats.max),
+        };
+        Ok(render_surface_scene_png(
+            s.mesh,
+            None,
+            colouring,
+            &s.picture.lines,
+            &s.picture.markers,
+            &opts,
+        )?)
+    }
+
+    /// `--png`: the shaded picture with the points, and its exaggeration.
+    fn shaded_picture(&self, s: &Scene) -> Result<(Vec<u8>, f64)> {
+        // at most 5,000 points drawn, evenly picked; flat data (terrain) exaggerated
+        let step = (s.points.len() / 5_000).max(1);
+        let shown: Vec<_> = s.points.iter().step_by(step).copied().collect();
+        let mut opts = self.view.options(s.points)?;
+        let colouring = match (s.picture.style, s.vertex_dev) {
+            (PngStyle::Deviation, Some(d)) => {
+                opts.legend = s.deviation_legend();
+                Colouring::Scalar {
+                    values: d,
+                    range: (0.0, s.deviation.stats.max),
+                }
+            }
+            _ => Colouring::Height,
+        };
+        opts.legend.extend(s.picture.legend.iter().cloned());
+        let bytes = render_surface_scene_png(
+            s.mesh,
+            Some(&shown),
+            colouring,
+            &s.picture.lines,
+            &s.picture.markers,
+            &opts,
+        )?;
+        Ok((bytes, opts.z_scale))
+    }
+}
+
+/// What the pictures of a surface show.
+struct Scene<'a> {
+    mesh: &'a scanfit::bspline::Mesh,
+    points: &'a [Point3],
+    vertex_dev: Option<&'a [f64]>,
+    deviation: &'a Deviation<'a>,
+    input: &'a Path,
+    picture: &'a Picture,
+}
+
+impl Scene<'_> {
+    /// The legend of a picture coloured by the local fit error.
+    fn deviation_legend(&self) -> Vec<String> {
+        let d = self.deviation;
+        vec![
+            format!(
+                "{}: colour = {} of the nearest input point [data units]",
+                self.input.display(),
+                d.name
+            ),
+            format!(
+                "input points to surface ({}): mean {}  max {}  RMSE {}  [data units]",
+                d.name,
+                num(d.stats.mean),
+                num(d.stats.max),
+                num(d.stats.rmse)
+            ),
+        ]
+    }
+}
+
+/// The bytes of `--mesh` by its extension: OBJ, glb or PLY (the last two
+/// coloured by the local fit error `vertex_dev` on the scale `[0, dmax]`).
+fn mesh_file(
+    path: &Path,
+    mesh: &scanfit::bspline::Mesh,
+    vertex_dev: Option<&[f64]>,
+    dmax: f64,
+    input: &Path,
+) -> Vec<u8> {
+    let colours: Option<Vec<[u8; 3]>> = vertex_dev.map(|d| {
+        d.iter()
+            .map(|&x| {
+                viridis(if dmax > 0.0 { x / dmax } else { 0.0 }).map(|c| (c * 255.0).round() as u8)
+            })
+            .collect()
+    });
+    let name = input
+        .file_stem()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    match extension(path).as_str() {
+        "obj" => mesh_obj(
+            mesh,
+            &format!("scanfit surface fitted to {}", input.display()),
+        ),
+        "glb" => mesh_glb(mesh, colours.as_deref(), &name),
+        _ => mesh_ply(
+            mesh,
+            vertex_dev.map(|d| ("deviation", d)),
+            colours.as_deref(),
+            PlyFormat::Binary,
+        ),
     }
 }
 

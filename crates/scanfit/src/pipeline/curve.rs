@@ -118,7 +118,7 @@ pub struct CurveReport {
 /// cfg.kind = CurveFitKind::LeastSquares { ctrl_count: 8, fix_ends: true, smoothing: 0.0 };
 /// let r = run(&pts, &cfg, &NoProgress)?;
 /// assert_eq!(r.fit.curve.control_points().len(), 8);
-/// assert!(r.quality.max_deviation < 1e-3);
+/// assert!(r.quality.max_deviation < 0.02); // at the (uncorrected) parameters
 /// # Ok::<(), scanfit::Error>(())
 /// ```
 pub fn run(
