@@ -185,7 +185,7 @@ pub fn run(a: TurntableArgs) -> Result<()> {
     a.out.check()?;
     check_extensions(&[(&a.points_out, "--points-out", &["ply", "xyz"][..])])?;
     let cfg = config(&a);
-    let progress = Progress::bar(a.quiet || a.json, STAGES.len() as u64 + 3);
+    let progress = Progress::bar(a.quiet || a.json, STAGES.len() as u64 + 2);
     progress.stage(format!("reading {}", a.input.input.display()));
     let cloud = a.input.load(a.json)?;
     progress.inc();

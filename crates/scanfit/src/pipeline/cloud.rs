@@ -1,8 +1,8 @@
 //! The point-cloud tools as library calls: statistics ([`info`]), oriented
 //! normals ([`normals`]), hidden point removal ([`hpr`], Katz, Tal & Basri
-//! 2007, [KTB07] in `docs/references.md`) and the boundary loop with its
-//! corners and sides ([`boundary`]; alpha shape, corners by [COONS] eqs.
-//! 10-12 or the three-point curvature of [PDE] 4.1).
+//! 2007) and the boundary loop with its
+//! corners and sides ([`boundary`]; alpha shape, corners by the Coons
+//! paper's eqs. 10-12 or the three-point curvature of the PDE paper, 4.1).
 //!
 //! Each takes the cloud, a `#[non_exhaustive]` config with documented
 //! defaults and a progress callback, and returns a report the front renders;
@@ -249,7 +249,7 @@ impl CloudHpr {
 }
 
 /// The points of `cloud` visible from the viewpoint, by the hidden point
-/// removal operator (spherical flipping and convex hull, [KTB07] eq. 1).
+/// removal operator (spherical flipping and convex hull, Katz, Tal & Basri 2007, eq. 1).
 ///
 /// Errors: those of [`hidden_point_removal`] (fewer than 4 points, a point
 /// at the viewpoint, gamma outside `(0, 12]`, a planar set seen edge-on).

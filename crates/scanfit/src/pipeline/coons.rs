@@ -1,20 +1,21 @@
 //! The Coons pipeline: one patch of points to a surface, by the Coons paper
-//! ([COONS] in `docs/references.md`) or the PDE paper ([PDE]).
+//! (`coons-base-surface-parameterization`) or the PDE paper
+//! (`pde-coons-surface-reconstruction`).
 //!
-//! 1. boundary loop of the points (alpha shape in their best-fit plane, [PDE] 4.1);
-//! 2. corners (smallest turning angle, [COONS] eqs. 10-12, or three-point
-//!    curvature, [PDE] 4.1), or given loop positions;
-//! 3. one B-spline per side ([PDE] 4.2) and the bilinearly blended Coons
-//!    patch on them ([COONS] eq. 16, [PDE] eq. 1; three-sided with one side
+//! 1. boundary loop of the points (alpha shape in their best-fit plane, PDE paper 4.1);
+//! 2. corners (smallest turning angle, Coons paper eqs. 10-12, or three-point
+//!    curvature, PDE paper 4.1), or given loop positions;
+//! 3. one B-spline per side (PDE paper 4.2) and the bilinearly blended Coons
+//!    patch on them (Coons paper eq. 16, PDE paper eq. 1; three-sided with one side
 //!    collapsed to the first corner);
 //! 4. parameters on the patch: the nearest grid vertex and the iteration of
-//!    [COONS] eqs. 17-22, or the exact closest point ([PDE] 4.4);
+//!    the Coons paper's eqs. 17-22, or the exact closest point (PDE paper 4.4);
 //! 5. either the least-squares B-spline surface on those parameters
-//!    ([`CoonsRoute::Bspline`], [COONS]) or the thin-plate PDE deformation
-//!    `S = S_c + S_PDE` fitted by least squares ([`CoonsRoute::Pde`], [PDE]
-//!    eqs. 11-14), exported as a B-spline within a tolerance;
-//! 6. errors: [PDE] eq. 15 (`|P - S(u, v)|` at the parameters) for the patch
-//!    and the result, and the [`SurfaceQuality`] of the exported surface
+//!    ([`CoonsRoute::Bspline`], Coons paper) or the thin-plate PDE deformation
+//!    `S = S_c + S_PDE` fitted by least squares ([`CoonsRoute::Pde`], PDE
+//!    paper eqs. 11-14), exported as a B-spline within a tolerance;
+//! 6. errors: the PDE paper's eq. 15 (`|P - S(u, v)|` at the parameters) for the patch
+//!    and the result, and the [`SurfaceQuality`](super::assess::SurfaceQuality) of the exported surface
 //!    (orthogonal distances both ways, fold-overs, grid RMSE).
 
 use crate::base::{
@@ -38,8 +39,8 @@ pub enum CoonsRoute {
     /// The Coons paper: a least-squares B-spline surface on the parameters
     /// (degree and control net from the config; periodicity is ignored).
     Bspline(SurfaceFitConfig),
-    /// The PDE paper: `S = S_c + S_PDE` with `M x N` sine terms ([PDE] eqs.
-    /// 11-14), exported as a B-spline.
+    /// The PDE paper: `S = S_c + S_PDE` with `M x N` sine terms (PDE paper
+    /// eqs. 11-14), exported as a B-spline.
     Pde {
         /// Terms and rigidity (paper: 5 x 5, D = 1).
         pde: PdeConfig,
@@ -155,7 +156,7 @@ pub struct CoonsReport {
     pub projection: CoonsProjection,
     /// The points' parameters on the patch, with the outside flags.
     pub parameters: CoonsParameters,
-    /// `|P_i - S_c(u_i, v_i)|` per point ([PDE] eq. 15 for the patch alone).
+    /// `|P_i - S_c(u_i, v_i)|` per point (PDE paper eq. 15 for the patch alone).
     pub coons_distances: Vec<f64>,
     /// Their statistics.
     pub coons_errors: ErrorStats,
@@ -167,7 +168,7 @@ pub struct CoonsReport {
     pub surface: Surface,
     /// The assessment of the resulting surface: orthogonal distances from
     /// the points and from surface samples to the points, fold-overs, the
-    /// grid RMSE. Its `at_parameters` is [PDE] eq. 15 of the fitted surface
+    /// grid RMSE. Its `at_parameters` is the PDE paper's eq. 15 of the fitted surface
     /// (of the PDE surface itself on the PDE route); its `residuals` are
     /// `|P_i - S(u_i, v_i)|` on the resulting B-spline surface.
     pub assessment: Assessment,
@@ -291,7 +292,7 @@ pub fn run(
     progress.stage(STAGES[4], None);
     let mut assessment = assess_surface(&surface, pts, &parameters.uv, &config.assess)?;
     if let Some(p) = &pde {
-        // [PDE] eq. 15 is measured on S itself, not on its B-spline form
+        // the PDE paper's eq. 15 is measured on S itself, not on its B-spline form
         assessment.quality.at_parameters = p.fit.errors;
     }
     Ok(CoonsReport {
@@ -390,7 +391,7 @@ mod tests {
         assert!(p.export_deviation <= p.export_tolerance);
         let q = r.assessment.quality;
         assert_eq!(q.at_parameters, p.fit.errors);
-        // the bump is the first sine term of the deformation ([PDE] eq. 11):
+        // the bump is the first sine term of the deformation (PDE paper eq. 11):
         // what is left is the boundary curves' error (measured: RMSE 0.242
         // for the Coons patch, 0.00053 for S, max 0.00092)
         assert!(r.coons_errors.rmse > 0.2, "{:?}", r.coons_errors);

@@ -1,6 +1,6 @@
 //! The turntable pipeline: the virtual turntable parameterization of a
 //! cylinder-like cloud and a least-squares B-spline surface closed around its
-//! axis ([TURN] in `docs/references.md`; the stages are those of
+//! axis (`cylindrical-turntable-parameterization`; the stages are those of
 //! [`base::turntable`](crate::base::turntable)), optionally the paper's
 //! comparison of the directed projection's weight factors (its Tables 1-2:
 //! eq. 19 against eqs. 15 and 16 from the same layer curves), and the
@@ -19,7 +19,7 @@ use super::assess::{assess_surface, AssessConfig, Assessment};
 /// sample once per weight factor).
 pub const MAX_COMPARE_ROUNDS: usize = 1000;
 
-/// The weight comparison of [TURN] Tables 1-2.
+/// The weight comparison of the turntable paper's Tables 1-2.
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct WeightComparison {
