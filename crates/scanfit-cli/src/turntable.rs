@@ -51,7 +51,8 @@ pub enum WeightArg {
     Aza04,
     /// Eq. 16 (Azariadis & Sapidis 2005).
     As05,
-    /// The distance to the projection axis only (not in the paper).
+    /// `1 / |(p_d - p) x n|^4`, the MBA paper's eq. 15 as printed (not in
+    /// the turntable paper; accepted, not listed).
     #[value(hide = true)]
     Axis4,
 }

@@ -51,7 +51,8 @@ pub enum CoonsRoute {
 }
 
 impl CoonsRoute {
-    /// The Coons paper's route: bicubic, 20 x 20 control points.
+    /// The Coons paper's route with degrees `degree` and a `ctrl` control
+    /// net (the default route is bicubic, 20 x 20).
     pub fn bspline(degree: (usize, usize), ctrl: (usize, usize)) -> Self {
         Self::Bspline(SurfaceFitConfig {
             degree,
