@@ -437,11 +437,22 @@ fn normals(a: NormalsArgs) -> Result<()> {
     }
     write_all_atomic(&files)?;
     progress.finish();
+    print_normals(&a, cloud.len(), &r, secs, &files)
+}
+
+/// The report of `cloud normals`: JSON or a table, then the files written.
+fn print_normals(
+    a: &NormalsArgs,
+    points: usize,
+    r: &scanfit::pipeline::cloud::CloudNormals,
+    secs: f64,
+    files: &Files,
+) -> Result<()> {
     let n = &r.normals;
     if a.json {
         let report = serde_json::json!({
             "file": a.input.input.display().to_string(),
-            "points": cloud.len(),
+            "points": points,
             "k": a.k,
             "orientation": a.orient.to_string(),
             "components": n.components,
@@ -453,7 +464,7 @@ fn normals(a: NormalsArgs) -> Result<()> {
         return Ok(());
     }
     let mut t = Table::new(&["normals", "value"], &[true]);
-    t.row(vec!["points".into(), cloud.len().to_string()]);
+    t.row(vec!["points".into(), points.to_string()]);
     t.row(vec!["neighbours k".into(), a.k.to_string()]);
     t.row(vec!["orientation".into(), a.orient.to_string()]);
     t.row(vec!["connected parts".into(), n.components.to_string()]);
@@ -464,7 +475,7 @@ fn normals(a: NormalsArgs) -> Result<()> {
     t.row(vec!["mean surface variation".into(), num(r.mean_variation)]);
     t.row(vec!["time (s)".into(), format!("{secs:.3}")]);
     print!("{}", t.render());
-    print_files(&files);
+    print_files(files);
     Ok(())
 }
 
