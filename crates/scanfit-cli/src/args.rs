@@ -240,6 +240,19 @@ fn vectors(s: &str, what: &str) -> std::result::Result<Vectors, String> {
         .map(Vectors)
 }
 
+/// " (option --alpha)" when `e` is about a library setting that `options`
+/// maps to a command-line option (`(setting, option)` pairs), else "".
+pub fn option_note(e: &scanfit::Error, options: &[(&str, &str)]) -> String {
+    match e {
+        scanfit::Error::InvalidSetting { setting, .. } => options
+            .iter()
+            .find(|(s, _)| s == setting)
+            .map(|(_, o)| format!(" (option {o})"))
+            .unwrap_or_default(),
+        _ => String::new(),
+    }
+}
+
 /// The format of a point file, `--format`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum FormatArg {

@@ -16,7 +16,7 @@ use scanfit_io::svg::{curve_panels, curve_panels_png, Panel, PanelSize};
 use scanfit_io::{read_points, write_all_atomic, PointTable};
 use serde::Serialize;
 
-use crate::args::{Parsed, Vectors, VECTORS};
+use crate::args::{option_note, Parsed, Vectors, VECTORS};
 use crate::outputs::provenance;
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -153,7 +153,13 @@ fn locate(e: &scanfit::Error, table: &PointTable) -> anyhow::Error {
     match e.point_indices()[..] {
         [i] => anyhow::anyhow!("{e} (point {i} is at {})", at(i)),
         [i, j, ..] => anyhow::anyhow!("{e} (points {i} and {j} are at {} and {})", at(i), at(j)),
-        [] => anyhow::anyhow!("{e}"),
+        [] => {
+            let options = [
+                ("smoothing", "--smooth"),
+                ("end_derivatives", "--end-tangents"),
+            ];
+            anyhow::anyhow!("{e}{}", option_note(e, &options))
+        }
     }
 }
 

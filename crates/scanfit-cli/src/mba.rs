@@ -14,7 +14,7 @@ use scanfit::project::{DirectedConfig, WeightFactor};
 use scanfit_io::json::SurfaceDoc;
 use scanfit_io::write_all_atomic;
 
-use crate::args::{choice, InputArgs, NXM};
+use crate::args::{choice, option_note, InputArgs, NXM};
 use crate::outputs::{
     print_written, provenance, quality_doc, quality_rows, samples_json, Deviation, Picture,
     SurfaceOutputArgs,
@@ -199,8 +199,14 @@ pub fn run(a: MbaArgs) -> Result<()> {
     progress.stage(format!("reading {}", a.input.input.display()));
     let cloud = a.input.load(a.json)?;
     let input = &a.input.input;
+    let options = [
+        ("base", "--base"),
+        ("max_levels", "--levels"),
+        ("tolerance", "--tolerance"),
+        ("alpha", "--alpha"),
+    ];
     let r = mba(&cloud, &a.config(), &progress)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
+        .map_err(|e| anyhow::anyhow!("{}: {e}{}", input.display(), option_note(&e, &options)))?;
     progress.stage("writing");
     let pts = cloud.points();
     let q = &r.assessment.quality;

@@ -12,7 +12,7 @@ use scanfit::PointCloud;
 use scanfit_io::json::SurfaceDoc;
 use scanfit_io::{read_points, write_all_atomic, PointTable};
 
-use crate::args::{choice, NXM};
+use crate::args::{choice, option_note, NXM};
 use crate::outputs::{
     check_extensions, points_file, print_written, provenance, quality_doc, quality_rows,
     samples_json, Deviation, Picture,
@@ -162,9 +162,10 @@ fn cloud_of(a: &FitArgs, table: &PointTable) -> Result<PointCloud> {
 /// The library's error with the file and line of the point it names.
 fn locate(e: scanfit::Error, table: &PointTable) -> anyhow::Error {
     let file = table.path.display();
+    let options = [("smoothing", "--smooth"), ("periodic_u", "--periodic-u")];
     match e.point_indices().first() {
         Some(&i) => anyhow::anyhow!("{file}: {e} ({})", table.locate(i)),
-        None => anyhow::anyhow!("{file}: {e}"),
+        None => anyhow::anyhow!("{file}: {e}{}", option_note(&e, &options)),
     }
 }
 

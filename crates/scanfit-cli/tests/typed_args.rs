@@ -81,3 +81,78 @@ fn typed_values_are_refused_with_the_option_named() {
     assert_eq!(o.status.code(), Some(2));
     let _ = examples();
 }
+
+#[test]
+fn library_errors_carry_their_point_and_option() {
+    let d = tmpdir("typed", "context");
+    let input = d.join("s.xyz");
+    sheet(&input);
+    let f = input.to_str().unwrap();
+    // a point the library refuses: its line in the file is named (from the
+    // error's point index, not from its text)
+    let huge = d.join("huge.xyz");
+    let mut text = std::fs::read_to_string(&input).unwrap();
+    text = text.replacen("0 0 0\n", "0 0 1e300\n", 1);
+    std::fs::write(&huge, text).unwrap();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec!["fit", huge.to_str().unwrap(), "--ctrl", "6"],
+            "point 0 has a coordinate of magnitude 1e300",
+        ),
+        (vec!["fit", huge.to_str().unwrap(), "--ctrl", "6"], "huge.xyz:1)"),
+        (
+            vec!["fit", f, "--ctrl", "6", "--smooth", "-1"],
+            "(option --smooth)",
+        ),
+        (
+            vec!["mba", f, "--adjust", "--alpha", "-1"],
+            "alpha = -1: the adjustment's alpha must be a positive number (the paper uses 1.49) (option --alpha)",
+        ),
+        (vec!["mba", f, "--base", "0x2"], "(option --base)"),
+    ];
+    for (args, needle) in cases {
+        let o = run(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: '{needle}' not in {err}");
+    }
+}
+
+#[test]
+fn fit_reports_the_surface_samples_far_from_the_data() {
+    // data on an L-shaped region: the fitted surface spans the whole square,
+    // a quarter of it with no points (the surface-to-points direction sees it)
+    let d = tmpdir("typed", "lshape");
+    let input = d.join("l.xyz");
+    let mut s = String::new();
+    for i in 0..40 {
+        for j in 0..40 {
+            if i >= 20 && j >= 20 {
+                continue;
+            }
+            let (x, y) = (i as f64 / 39.0, j as f64 / 39.0);
+            s += &format!("{x} {y} {}\n", 0.1 * x * y);
+        }
+    }
+    std::fs::write(&input, s).unwrap();
+    // (smoothing holds the control points over the empty quarter)
+    let out = ok(&run(&[
+        "fit",
+        input.to_str().unwrap(),
+        "--ctrl",
+        "6",
+        "--smooth",
+        "1e-6",
+        "--json",
+    ]));
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let far = v["samples_to_points"]["far_share"].as_f64().unwrap();
+    // samples farther than 3 spacings (3/39) from the L: x, y > 20/39 + 3/39
+    // roughly, (1 - 23/39)^2 = 0.17 of the square
+    assert!(far > 0.12 && far < 0.2, "{far}");
+    let spacing = v["samples_to_points"]["point_spacing"].as_f64().unwrap();
+    // the grid step, a little more in 3D where z rises
+    assert!(spacing > 1.0 / 39.0 && spacing < 1.01 / 39.0, "{spacing}");
+    // points to surface: the fit is good where the points are
+    assert!(v["quality"]["max_distance"].as_f64().unwrap() < 0.01);
+}

@@ -87,22 +87,28 @@ pub(crate) fn validate_weights_and_smoothing(
 ) -> Result<()> {
     if let Some(w) = weights {
         if w.len() != points {
-            return Err(Error::InvalidInput(format!(
-                "{} weights for {points} points",
-                w.len()
-            )));
+            return Err(Error::LengthMismatch {
+                what: "weights",
+                expected: points,
+                got: w.len(),
+            });
         }
         if let Some(i) = w.iter().position(|&x| !(x.is_finite() && x >= 0.0)) {
-            return Err(Error::InvalidInput(format!(
-                "weight of point {i} is {}; weights must be finite and non-negative",
-                w[i]
-            )));
+            return Err(Error::BadPoint {
+                index: i,
+                problem: format!(
+                    "has weight {}; weights must be finite and non-negative",
+                    w[i]
+                ),
+            });
         }
     }
     if !(smoothing.is_finite() && smoothing >= 0.0) {
-        return Err(Error::InvalidInput(format!(
-            "smoothing weight {smoothing} must be finite and non-negative"
-        )));
+        return Err(Error::InvalidSetting {
+            setting: "smoothing",
+            value: smoothing.to_string(),
+            hint: format!("smoothing weight {smoothing} must be finite and non-negative"),
+        });
     }
     Ok(())
 }

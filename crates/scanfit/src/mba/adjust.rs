@@ -95,16 +95,19 @@ pub fn lattice_grid_rmse(cloud: &PointCloud, frame: &Frame, lattice: &Lattice) -
 impl AdjustConfig {
     fn validate(&self) -> Result<()> {
         if !(self.alpha.is_finite() && self.alpha > 0.0) {
-            return Err(Error::InvalidInput(format!(
-                "adjustment alpha {} must be a positive number (the paper uses 1.49)",
-                self.alpha
-            )));
+            return Err(Error::InvalidSetting {
+                setting: "alpha",
+                value: self.alpha.to_string(),
+                hint: "the adjustment's alpha must be a positive number (the paper uses 1.49)"
+                    .into(),
+            });
         }
         if !(self.tolerance.is_finite() && self.tolerance >= 0.0) {
-            return Err(Error::InvalidInput(format!(
-                "adjustment tolerance {} must be a finite number >= 0",
-                self.tolerance
-            )));
+            return Err(Error::InvalidSetting {
+                setting: "tolerance",
+                value: self.tolerance.to_string(),
+                hint: "the adjustment tolerance must be a finite number >= 0".into(),
+            });
         }
         Ok(())
     }

@@ -189,16 +189,19 @@ impl MbaRun {
     pub(crate) fn new(frame: Frame, config: &MbaConfig) -> Result<Self> {
         let base = config.base.unwrap_or_else(|| frame.default_base());
         if base.0 == 0 || base.1 == 0 {
-            return Err(Error::InvalidInput(format!(
-                "the base lattice needs at least 1 x 1 cells, got {} x {}",
-                base.0, base.1
-            )));
+            return Err(Error::InvalidSetting {
+                setting: "base",
+                value: format!("{} x {}", base.0, base.1),
+                hint: "the base lattice needs at least 1 x 1 cells".into(),
+            });
         }
         if let Some(t) = config.tolerance {
             if !(t.is_finite() && t >= 0.0) {
-                return Err(Error::InvalidInput(format!(
-                    "MBA tolerance {t} must be a finite number >= 0"
-                )));
+                return Err(Error::InvalidSetting {
+                    setting: "tolerance",
+                    value: t.to_string(),
+                    hint: "the MBA tolerance must be a finite number >= 0".into(),
+                });
             }
         }
         // the last level's lattice must fit (it doubles per level)
@@ -210,13 +213,17 @@ impl MbaRun {
             .and_then(|(m, n)| (m.checked_add(3)?).checked_mul(n.checked_add(3)?))
             .is_some_and(|len| len <= lattice::MAX_LATTICE_VALUES);
         if !fits {
-            return Err(Error::InvalidInput(format!(
-                "{} levels on a {} x {} base lattice would need more than {} control values at the last level (a lattice doubles per level); lower --levels or --base",
-                config.max_levels,
-                base.0,
-                base.1,
-                lattice::MAX_LATTICE_VALUES
-            )));
+            return Err(Error::InvalidSetting {
+                setting: "max_levels",
+                value: config.max_levels.to_string(),
+                hint: format!(
+                    "{} levels on a {} x {} base lattice would need more than {} control values at the last level (a lattice doubles per level); lower the levels or the base lattice",
+                    config.max_levels,
+                    base.0,
+                    base.1,
+                    lattice::MAX_LATTICE_VALUES
+                ),
+            });
         }
         Ok(Self {
             frame,
