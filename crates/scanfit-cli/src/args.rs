@@ -343,18 +343,6 @@ pub fn value_name<T: ValueEnum>(v: &T) -> String {
         .unwrap_or_default()
 }
 
-/// A library error with the option that set the offending setting named
-/// first (`--compare-rounds: compare_weights.rounds = 0: ...`); `options`
-/// pairs the config's setting names with the command's options.
-pub fn name_option(e: scanfit::Error, options: &[(&str, &str)]) -> anyhow::Error {
-    if let scanfit::Error::InvalidSetting { setting, .. } = &e {
-        if let Some((_, option)) = options.iter().find(|(s, _)| s == setting) {
-            return anyhow::anyhow!("{option}: {e}");
-        }
-    }
-    e.into()
-}
-
 impl InputArgs {
     /// Reads the file like [`InputArgs::load`] and returns the cloud with
     /// the number of non-finite points dropped, telling nothing (for reports

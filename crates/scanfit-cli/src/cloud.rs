@@ -24,7 +24,7 @@ use scanfit_io::{cloud_bytes, write_all_atomic, WriteFormat};
 
 pub use crate::args::InputArgs;
 use crate::args::{
-    choice, name_option, value_name, Angles, Indices, Parsed, ANGLES, INDICES, VECTOR3,
+    choice, option_note, value_name, Angles, Indices, Parsed, ANGLES, INDICES, VECTOR3,
 };
 use crate::outputs::{check_extensions, extension, Files};
 use crate::progress::Progress;
@@ -793,7 +793,10 @@ fn boundary(a: BoundaryArgs) -> Result<()> {
     progress.stage(format!("alpha shape of {} points", cloud.len()));
     let t0 = Instant::now();
     let r = find_boundary(&cloud, &cfg, &progress)
-        .map_err(|e| name_option(e, &[("corner_positions", "--corner-at")]))
+        .map_err(|e| {
+            let note = option_note(&e, &[("corner_positions", "--corner-at")]);
+            anyhow::anyhow!("{e}{note}")
+        })
         .with_context(|| format!("boundary of {}", a.input.input.display()))?;
     let secs = t0.elapsed().as_secs_f64();
     let doc = boundary_doc(&a, &cloud, &r, secs);

@@ -20,7 +20,7 @@ use scanfit_io::json::SurfaceDoc;
 use scanfit_io::render::{Marker, Polyline};
 use scanfit_io::write_all_atomic;
 
-use crate::args::{choice, name_option, value_name as name, InputArgs, Parsed, INDICES, NXM};
+use crate::args::{choice, option_note, value_name as name, InputArgs, Parsed, INDICES, NXM};
 use crate::cloud::CriterionArg;
 use crate::outputs::{
     check_extensions, points_file, print_written, provenance, quality_doc, samples_json, Deviation,
@@ -266,7 +266,10 @@ pub fn run(a: CoonsArgs) -> Result<()> {
     progress.stage(format!("reading {input}"));
     let cloud = a.input.load(a.json)?;
     let r = coons(&cloud, &cfg, &progress)
-        .map_err(|e| name_option(e, &[("export_tolerance", "--export-tolerance")]))
+        .map_err(|e| {
+            let note = option_note(&e, &[("export_tolerance", "--export-tolerance")]);
+            anyhow::anyhow!("{e}{note}")
+        })
         .with_context(|| format!("Coons patch of {input} ({} sides)", a.sides.count()))?;
     let secs = t0.elapsed().as_secs_f64();
     progress.stage("writing");

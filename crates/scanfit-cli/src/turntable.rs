@@ -18,7 +18,7 @@ use scanfit::{PointCloud, Vector3};
 use scanfit_io::json::SurfaceDoc;
 use scanfit_io::write_all_atomic;
 
-use crate::args::{choice, name_option, InputArgs, Parsed, NXM};
+use crate::args::{choice, option_note, InputArgs, Parsed, NXM};
 use crate::outputs::{
     check_extensions, print_written, provenance, quality_doc, samples_json, Deviation, Files,
     Picture, PngStyle, SurfaceOutputArgs,
@@ -192,7 +192,10 @@ pub fn run(a: TurntableArgs) -> Result<()> {
     progress.inc();
     let t0 = Instant::now();
     let r = turntable(&cloud, &cfg, &progress)
-        .map_err(|e| name_option(e, &[("compare_weights.rounds", "--compare-rounds")]))
+        .map_err(|e| {
+            let note = option_note(&e, &[("compare_weights.rounds", "--compare-rounds")]);
+            anyhow::anyhow!("{e}{note}")
+        })
         .with_context(|| a.input.input.display().to_string())?;
     let seconds = t0.elapsed().as_secs_f64();
     progress.stage("writing");
