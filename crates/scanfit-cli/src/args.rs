@@ -31,7 +31,7 @@ use clap::builder::{PossibleValue, TypedValueParser};
 use clap::error::ErrorKind;
 use clap::{Arg, Args, Command, ValueEnum};
 use scanfit::{PointCloud, Vector3};
-use scanfit_io::{read_cloud, Format, NonFinite, ReadOptions};
+use scanfit_io::{read_cloud, Format, NonFinite, PointTable, ReadOptions};
 
 /// The option's name as the user typed it (`--ctrl`), for messages.
 fn option_name(arg: Option<&Arg>) -> String {
@@ -299,6 +299,13 @@ impl InputArgs {
     /// attribute; tells on stderr how many non-finite points were dropped
     /// (unless `quiet`, e.g. when JSON is printed).
     pub fn load(&self, quiet: bool) -> Result<PointCloud> {
+        Ok(self.table(quiet)?.into_cloud()?)
+    }
+
+    /// Reads the file as a table (points, columns, and where each point is
+    /// in the file, for messages); tells about dropped points as
+    /// [`InputArgs::load`] does.
+    pub fn table(&self, quiet: bool) -> Result<PointTable> {
         let options = ReadOptions {
             format: self.format.map(Format::from),
             non_finite: if self.drop_non_finite {
@@ -309,7 +316,7 @@ impl InputArgs {
         };
         let table = read_cloud(&self.input, &options)?;
         note_dropped(table.dropped_non_finite, quiet);
-        Ok(table.into_cloud()?)
+        Ok(table)
     }
 }
 

@@ -10,9 +10,9 @@ use scanfit::fit::surface::KnotPlacement;
 use scanfit::pipeline::surface_fit::{run as fit, FitConfig, FitReport, ParameterSource};
 use scanfit::PointCloud;
 use scanfit_io::json::SurfaceDoc;
-use scanfit_io::{read_points, write_all_atomic, PointTable};
+use scanfit_io::{write_all_atomic, PointTable};
 
-use crate::args::{choice, option_note, NXM};
+use crate::args::{choice, option_note, InputArgs, NXM};
 use crate::outputs::{
     check_extensions, points_file, print_written, provenance, quality_doc, quality_rows,
     samples_json, Deviation, Picture,
@@ -60,8 +60,8 @@ fn name<T: ValueEnum>(v: &T) -> String {
 #[derive(Args, Debug)]
 #[command(after_help = EXAMPLES)]
 pub struct FitArgs {
-    /// Input point file (XYZ, CSV or TXT).
-    pub input: PathBuf,
+    #[command(flatten)]
+    pub input: InputArgs,
     /// Where the parameters come from.
     #[arg(long, default_value = "plane", value_name = "SOURCE", value_parser = choice::<ParamsArg>())]
     pub params: ParamsArg,
@@ -150,7 +150,7 @@ fn cloud_of(a: &FitArgs, table: &PointTable) -> Result<PointCloud> {
     let (Some(u), Some(v)) = (table.column("u"), table.column("v")) else {
         bail!(
             "{} has no columns named u and v (its columns: {}); use --params plane or add them",
-            a.input.display(),
+            a.input.input.display(),
             table.columns.join(", ")
         );
     };
@@ -174,8 +174,8 @@ pub fn run(a: FitArgs) -> Result<()> {
     a.out.check()?;
     check_extensions(&[(&a.points_out, "--points-out", &["ply", "xyz"][..])])?;
     let progress = Progress::spinner(a.quiet);
-    progress.stage(format!("reading {}", a.input.display()));
-    let table = read_points(&a.input)?;
+    progress.stage(format!("reading {}", a.input.input.display()));
+    let table = a.input.table(a.json)?;
     let cloud = cloud_of(&a, &table)?;
     let r = fit(&cloud, &a.config(), &progress).map_err(|e| locate(e, &table))?;
     progress.stage("writing");
@@ -186,7 +186,7 @@ pub fn run(a: FitArgs) -> Result<()> {
     doc.provenance = Some(provenance(
         "fit (least-squares surface)",
         Some(name(&a.params)),
-        &a.input,
+        &a.input.input,
         pts.len(),
         a.settings(),
     ));
@@ -202,7 +202,7 @@ pub fn run(a: FitArgs) -> Result<()> {
         &doc,
         pts,
         &deviation,
-        &a.input,
+        &a.input.input,
         &Picture::default(),
     )?;
     if let Some(pout) = &a.points_out {
@@ -220,7 +220,7 @@ pub fn run(a: FitArgs) -> Result<()> {
     progress.finish();
     if a.json {
         let report = serde_json::json!({
-            "input": a.input.display().to_string(),
+            "input": a.input.input.display().to_string(),
             "point_count": pts.len(),
             "degree": [a.degree.0, a.degree.1],
             "control_points": [r.surface.counts().0, r.surface.counts().1],
@@ -243,7 +243,7 @@ fn print_report(a: &FitArgs, r: &FitReport) {
     let (cu, cv) = r.surface.counts();
     println!(
         "{}: {} points -> B-spline surface of degree {p} x {qd}, {cu} x {cv} control points ({} parameters, {} knots{}{})\n",
-        a.input.display(),
+        a.input.input.display(),
         q.points,
         name(&a.params),
         name(&a.knots),

@@ -156,3 +156,33 @@ fn fit_reports_the_surface_samples_far_from_the_data() {
     // points to surface: the fit is good where the points are
     assert!(v["quality"]["max_distance"].as_f64().unwrap() < 0.01);
 }
+
+#[test]
+fn fit_takes_the_shared_input_group() {
+    let d = tmpdir("typed", "input");
+    let input = d.join("s.xyz");
+    sheet(&input);
+    let nan = d.join("nan.txt");
+    let text = std::fs::read_to_string(&input).unwrap();
+    std::fs::write(&nan, text.replacen("0 0 0\n", "0 0 nan\n", 1)).unwrap();
+    let n = nan.to_str().unwrap();
+    // refused by default, with its line
+    let o = run(&["fit", n, "--ctrl", "6"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("nan.txt:1"));
+    // dropped on request, told once
+    let o = run(&["fit", n, "--ctrl", "6", "--drop-non-finite"]);
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    let out = ok(&o);
+    assert_eq!(
+        err.matches("1 points with NaN or infinite coordinates dropped")
+            .count(),
+        1,
+        "{err}"
+    );
+    assert!(out.contains("899 points"), "{out}");
+    let o = run(&["fit", n, "--format", "stl"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr)
+        .contains("unknown --format 'stl'; use ply, pcd, las or text"));
+}

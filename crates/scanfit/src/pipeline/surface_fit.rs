@@ -227,8 +227,10 @@ mod tests {
             ),
             "{e}"
         );
-        let mut cfg = FitConfig::default();
-        cfg.params = ParameterSource::uv_attributes();
+        let cfg = FitConfig {
+            params: ParameterSource::uv_attributes(),
+            ..Default::default()
+        };
         let e = run(&cloud, &cfg, &NoProgress).unwrap_err();
         assert!(e.to_string().contains("no attributes named u and v"), "{e}");
         let cfg = FitConfig::default(); // 16 x 16 > 100 points
