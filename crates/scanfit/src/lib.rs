@@ -24,6 +24,8 @@
 //! * [`metrics`]: surface error measures and parameterization quality.
 //! * [`project`]: point inversion (orthogonal projection onto surfaces).
 //! * [`quality`]: per-curve quality report (deviation, curvature, loops, length).
+//! * [`topology`]: multi-patch models: vertices, shared edge curves, faces
+//!   and their checks (gaps along edges, enclosed volume).
 
 pub mod base;
 pub mod bspline;
@@ -38,6 +40,7 @@ pub mod pde;
 pub mod progress;
 pub mod project;
 pub mod quality;
+pub mod topology;
 
 pub use cloud::PointCloud;
 pub use error::{Error, Result};
