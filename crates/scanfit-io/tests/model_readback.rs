@@ -487,3 +487,75 @@ fn a_model_with_a_gap_is_refused() {
         "{e}"
     );
 }
+
+/// The shipped multi-patch samples (examples/data/make_multipatch.py) read
+/// through scanfit's own reader: the label property, the patch counts, and
+/// the vessel's true volume document.
+#[test]
+fn shipped_multipatch_samples_are_labelled() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/data");
+    for (file, n, labels) in [
+        ("vessel_30k.ply", 30_000, 14),
+        ("umbrella_20k.ply", 20_000, 8),
+    ] {
+        let path = data.join(file);
+        assert!(
+            std::fs::metadata(&path).unwrap().len() < 1 << 20,
+            "{file} is over 1 MB"
+        );
+        let t = scanfit_io::read_cloud(&path, &scanfit_io::ReadOptions::default()).unwrap();
+        assert_eq!(t.points.len(), n, "{file}");
+        let c = t.columns.iter().position(|c| c == "label").unwrap() - 3;
+        let mut count = std::collections::BTreeMap::new();
+        for &l in &t.extra[c] {
+            assert_eq!(l, l.round(), "{file}: label {l} is not an integer");
+            *count.entry(l as i64).or_insert(0usize) += 1;
+        }
+        assert_eq!(
+            count.keys().copied().collect::<Vec<_>>(),
+            (1..=labels).collect::<Vec<i64>>(),
+            "{file}"
+        );
+        // every patch has enough points to be fitted (at least 4% of the cloud)
+        assert!(count.values().all(|&k| k * 25 > n), "{file}: {count:?}");
+    }
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(data.join("vessel_30k.json")).unwrap())
+            .unwrap();
+    let (v, vm) = (
+        doc["true_volume"].as_f64().unwrap(),
+        doc["true_volume_mesh"].as_f64().unwrap(),
+    );
+    // the analytic volume, recomputed here from the shape parameters
+    let s = &doc["shape"];
+    let (h, a, b, c, d) = (
+        s["H"].as_f64().unwrap(),
+        s["A"].as_f64().unwrap(),
+        s["B"].as_f64().unwrap(),
+        s["C"].as_f64().unwrap(),
+        s["D"].as_f64().unwrap(),
+    );
+    let pi = std::f64::consts::PI;
+    // Simpson's rule on pi r(z)^2, independent of the closed form in the script
+    let r = |z: f64| a + b * (pi * z / h).sin() + c * z / h;
+    let n = 2000;
+    let side: f64 = (0..=n)
+        .map(|i| {
+            let z = h * i as f64 / n as f64;
+            let w = if i == 0 || i == n {
+                1.0
+            } else if i % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
+            w * pi * r(z) * r(z)
+        })
+        .sum::<f64>()
+        * h
+        / n as f64
+        / 3.0;
+    let dome = pi * r(h) * r(h) * d / 2.0;
+    assert!((side + dome - v).abs() < 1e-9 * v, "{} vs {v}", side + dome);
+    assert!((vm - v).abs() < 1e-5 * v, "mesh {vm} vs analytic {v}");
+}
