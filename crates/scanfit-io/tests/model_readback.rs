@@ -559,3 +559,156 @@ fn shipped_multipatch_samples_are_labelled() {
     assert!((side + dome - v).abs() < 1e-9 * v, "{} vs {v}", side + dome);
     assert!((vm - v).abs() < 1e-5 * v, "mesh {vm} vs analytic {v}");
 }
+
+/// The shipped vessel's topology (examples/data/make_multipatch.py, the PDE
+/// paper's Fig. 9 labelling) built from its true boundary curves: 4 sectors x
+/// 3 bands on the side, each a Coons patch of two rim arcs and two
+/// meridians, and two four-sided caps whose 4 corners are where the sector
+/// boundaries reach the rim (so each cap corner has a straight angle). The
+/// lid is flat here (Coons patches of planar arcs are planar).
+fn vessel() -> PatchComplex {
+    use scanfit::base::coons::{reversed, CoonsPatch};
+    use scanfit::fit::{interpolate, InterpolationConfig};
+    let (h, a, b, c) = (100.0, 40.0, 14.0, -4.0);
+    let pi = std::f64::consts::PI;
+    let r = |z: f64| a + b * (pi * z / h).sin() + c * z / h;
+    let sector = |k: usize| (20.0 + 90.0 * (k % 4) as f64).to_radians();
+    let levels = [0.0, h / 3.0, 2.0 * h / 3.0, h];
+    let cfg = InterpolationConfig::default();
+    let fit = |pts: Vec<Point3>| interpolate(&pts, &cfg).unwrap().curve;
+    // arcs[l][k]: level l, from sector boundary k to k + 1 (counter-clockwise)
+    let arcs: Vec<Vec<_>> = levels
+        .iter()
+        .map(|&z| {
+            (0..4)
+                .map(|k| {
+                    let (t0, t1) = (sector(k), sector(k) + pi / 2.0);
+                    fit((0..=8)
+                        .map(|i| {
+                            let t = t0 + (t1 - t0) * i as f64 / 8.0;
+                            Point3::new(r(z) * t.cos(), r(z) * t.sin(), z)
+                        })
+                        .collect())
+                })
+                .collect()
+        })
+        .collect();
+    // meridians[band][k]: at sector boundary k, from level band up to band + 1
+    let meridians: Vec<Vec<_>> = (0..3)
+        .map(|band| {
+            (0..4)
+                .map(|k| {
+                    let t = sector(k);
+                    fit((0..=8)
+                        .map(|i| {
+                            let z =
+                                levels[band] + (levels[band + 1] - levels[band]) * i as f64 / 8.0;
+                            Point3::new(r(z) * t.cos(), r(z) * t.sin(), z)
+                        })
+                        .collect())
+                })
+                .collect()
+        })
+        .collect();
+    let mut verts: Vec<Point3> = Vec::new();
+    for &z in &levels {
+        for k in 0..4 {
+            verts.push(Point3::new(
+                r(z) * sector(k).cos(),
+                r(z) * sector(k).sin(),
+                z,
+            ));
+        }
+    }
+    let scale = 200.0;
+    let vid = |p: Point3| {
+        verts
+            .iter()
+            .position(|q| (q - p).norm() < 1e-9 * scale)
+            .unwrap()
+    };
+    let corners_of = |s: &Surface| {
+        [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)].map(|(u, v)| vid(s.point(u, v)))
+    };
+    let mut fc = Vec::new();
+    for band in 0..3 {
+        for k in 0..4 {
+            // u along the arc (counter-clockwise), v up: normal e_theta x e_z = e_r
+            let s = CoonsPatch::new(
+                &arcs[band][k],
+                &arcs[band + 1][k],
+                &meridians[band][k],
+                &meridians[band][(k + 1) % 4],
+            )
+            .unwrap()
+            .to_bspline()
+            .unwrap();
+            fc.push(FaceCorners {
+                id: 1 + 4 * band as i64 + k as i64,
+                corners: corners_of(&s),
+                surface: s,
+            });
+        }
+    }
+    // lid (normal +z): P(u,0) = arc 0, P(1,v) = arc 1, P(u,1) = arc 2 backwards,
+    // P(0,v) = arc 3 backwards; the bottom is the same with u and v swapped
+    let rev = |c: &scanfit::bspline::Curve| reversed(c).unwrap();
+    let lid = &arcs[3];
+    let s = CoonsPatch::new(&lid[0], &rev(&lid[2]), &rev(&lid[3]), &lid[1])
+        .unwrap()
+        .to_bspline()
+        .unwrap();
+    let bot = &arcs[0];
+    let sb = CoonsPatch::new(&rev(&bot[3]), &bot[1], &bot[0], &rev(&bot[2]))
+        .unwrap()
+        .to_bspline()
+        .unwrap();
+    fc.push(FaceCorners {
+        id: 13,
+        corners: corners_of(&sb),
+        surface: sb,
+    });
+    fc.push(FaceCorners {
+        id: 14,
+        corners: corners_of(&s),
+        surface: s,
+    });
+    PatchComplex::assemble(verts, fc).unwrap()
+}
+
+#[test]
+fn vessel_of_fourteen_patches_is_one_solid() {
+    let m = vessel();
+    assert_eq!(
+        (m.vertices.len(), m.edges.len(), m.faces.len()),
+        (16, 28, 14)
+    );
+    m.validate().unwrap();
+    assert!(m.is_closed());
+    let gap = m.max_boundary_gap().unwrap();
+    assert!(gap < 1e-12 * m.scale(), "gap {gap}");
+    let mesh = mesh_volume(&m, 200);
+    let quad = m.signed_volume();
+    assert!(
+        (quad - mesh).abs() < 1e-4 * mesh,
+        "quadrature {quad}, mesh {mesh}"
+    );
+    // the true flat-lid vessel: pi * int_0^H r(z)^2 dz (closed form, see
+    // make_multipatch.py); the Coons patches approximate it to well under 1%
+    let pi = std::f64::consts::PI;
+    let (h, a, b, c) = (100.0f64, 40.0f64, 14.0f64, -4.0f64);
+    let truth = pi
+        * (a * a * h
+            + b * b * h / 2.0
+            + c * c * h / 3.0
+            + 4.0 * a * b * h / pi
+            + a * c * h
+            + 2.0 * b * c * h / pi);
+    assert!(
+        (mesh - truth).abs() < 0.01 * truth,
+        "model {mesh}, true {truth}"
+    );
+    if let Some(r) = check(&m, "vessel") {
+        assert_closed(&r, &m, "vessel", mesh);
+    }
+}
