@@ -184,7 +184,8 @@ fn umbrella() -> PatchComplex {
 }
 
 /// The tetrahedron (0,0,0), e_x, e_y, e_z scaled by 3: four three-sided
-/// bilinear faces with side 3 collapsed.
+/// bilinear faces; face `i` has its side `3 - i` collapsed (every position
+/// of the degenerate side occurs once).
 fn tetrahedron() -> PatchComplex {
     let v = vec![
         Point3::new(0.0, 0.0, 0.0),
@@ -196,10 +197,14 @@ fn tetrahedron() -> PatchComplex {
     let fc = tris
         .iter()
         .enumerate()
-        .map(|(i, t)| FaceCorners {
-            id: i as i64,
-            surface: quad([v[t[0]], v[t[1]], v[t[2]], v[t[0]]]),
-            corners: [t[0], t[1], t[2], t[0]],
+        .map(|(i, t)| {
+            let mut c = [t[0], t[1], t[2], t[0]];
+            c.rotate_right(i);
+            FaceCorners {
+                id: i as i64,
+                surface: quad(c.map(|k| v[k])),
+                corners: c,
+            }
         })
         .collect();
     PatchComplex::assemble(v, fc).unwrap()
@@ -441,6 +446,12 @@ fn cube_sphere_of_bicubic_patches_has_the_right_volume() {
 fn tetrahedron_of_three_sided_faces_is_a_valid_solid() {
     let m = tetrahedron();
     m.validate().unwrap();
+    let collapsed: Vec<usize> = m
+        .faces
+        .iter()
+        .map(|f| f.sides.iter().position(|s| s.is_none()).unwrap())
+        .collect();
+    assert_eq!(collapsed, vec![3, 0, 1, 2]);
     let step = step_shell_file(&m, "tetrahedron").unwrap();
     assert_eq!(step.kind, ShellKind::Closed);
     // the collapsed sides are not written: three oriented edges per face
