@@ -723,3 +723,45 @@ fn vessel_of_fourteen_patches_is_one_solid() {
         assert_closed(&r, &m, "vessel", mesh);
     }
 }
+
+/// A model whose faces miss their edges by a small gap (here 1e-6 on a body
+/// of size 35, about 3e-8 relative: a model that went through a text format
+/// with 7 digits) is still written as one closed shell: the file's
+/// uncertainty covers the measured gap, and OpenCASCADE sews it without
+/// raising any tolerance beyond that.
+#[test]
+fn small_gaps_are_sewn_within_the_files_uncertainty() {
+    let mut m = cube_sphere();
+    let s = &m.faces[0].surface;
+    let (_, nv) = s.counts();
+    let ctrl: Vec<Point3> = s
+        .control_points()
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            if k < nv {
+                Point3::from(p.coords * (1.0 + 1e-7))
+            } else {
+                *p
+            }
+        })
+        .collect();
+    m.faces[0].surface = Surface::new(bezier(3), bezier(3), ctrl).unwrap();
+    let gap = m.max_boundary_gap().unwrap();
+    assert!(gap > 0.9e-6 && gap < 1.1e-6, "gap {gap}");
+    assert!(m.validate().is_ok());
+    let step = step_shell_file(&m, "gappy").unwrap();
+    assert!((step.max_gap - gap).abs() < 1e-15);
+    // the uncertainty written is twice the gap
+    let t = &step.text;
+    let at = t.find("LENGTH_MEASURE(").unwrap() + "LENGTH_MEASURE(".len();
+    let unc: f64 = t[at..at + t[at..].find(')').unwrap()].parse().unwrap();
+    assert!(
+        (unc - 2.0 * gap).abs() < 1e-15 * unc.max(1.0),
+        "uncertainty {unc}"
+    );
+    if let Some(r) = check(&m, "gappy") {
+        let quad = m.signed_volume();
+        assert_closed(&r, &m, "gappy cube-sphere", quad);
+    }
+}
