@@ -152,9 +152,14 @@ pub fn distance_to_curve(curve: &Curve, p: &Point3) -> (f64, f64) {
 }
 
 impl PatchComplex {
-    /// Measured gaps of every edge (see the module doc of [`super::gaps`]:
-    /// sampled, geometric). Needs [`PatchComplex::validate_structure`] to hold
-    /// for the indices; an out-of-range use is skipped.
+    /// Measured gaps of every edge: for each face side that uses it, the
+    /// two-sided Hausdorff distance between the side (the surface's boundary
+    /// iso-curve, [`super::Face::side_curve`]) and the edge's curve, and
+    /// between the two sides sharing it; estimated from dense samples (8 per
+    /// knot span of either curve, at least 33) projected onto the other curve
+    /// by Newton's iteration (NURBS Book eq. 6.3), so independent of how the
+    /// curves are parameterized. Needs [`PatchComplex::validate_structure`]
+    /// to hold for the indices; an out-of-range use is skipped.
     pub fn boundary_gaps(&self) -> Result<Vec<EdgeGap>> {
         let users = self.edge_faces();
         let mut out = Vec::with_capacity(self.edges.len());
