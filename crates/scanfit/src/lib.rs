@@ -26,6 +26,8 @@
 //! * [`pipeline`]: every pipeline of the command line as one call (config,
 //!   progress, report), and the one surface assessment [`pipeline::SurfaceQuality`].
 //! * [`quality`]: per-curve quality report (deviation, curvature, loops, length).
+//! * [`topology`]: multi-patch models: vertices, shared edge curves, faces
+//!   and their checks (gaps along edges, enclosed volume).
 
 pub mod base;
 pub mod bspline;
@@ -41,6 +43,7 @@ pub mod pipeline;
 pub mod progress;
 pub mod project;
 pub mod quality;
+pub mod topology;
 
 pub use cloud::PointCloud;
 pub use error::{Error, Result};
