@@ -171,7 +171,11 @@ pub fn run(a: TurntableArgs) -> Result<()> {
                 &t.loops,
                 &cfg.layers,
                 a.compare_rounds,
-                &[WeightFactor::Moon, WeightFactor::Aza04, WeightFactor::As05],
+                &[
+                    WeightFactor::DistanceOffset,
+                    WeightFactor::PointDistance,
+                    WeightFactor::DampedDistanceOffset,
+                ],
             )
             .map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?,
         )
@@ -400,10 +404,10 @@ pub fn run(a: TurntableArgs) -> Result<()> {
             .iter()
             .map(|(w, _)| {
                 match w {
-                    WeightFactor::Moon => "eq. 19 (moon)",
-                    WeightFactor::Aza04 => "eq. 15 (aza04)",
-                    WeightFactor::As05 => "eq. 16 (as05)",
-                    WeightFactor::Axis4 => "axis4",
+                    WeightFactor::DistanceOffset => "eq. 19 (moon)",
+                    WeightFactor::PointDistance => "eq. 15 (aza04)",
+                    WeightFactor::DampedDistanceOffset => "eq. 16 (as05)",
+                    WeightFactor::LineOffset => "axis4",
                 }
                 .to_string()
             })

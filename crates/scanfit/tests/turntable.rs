@@ -216,7 +216,11 @@ fn weight_factor_comparison_starts_equal_and_eq_19_is_not_worse() {
         &t.loops,
         &cfg.layers,
         5,
-        &[WeightFactor::Moon, WeightFactor::Aza04, WeightFactor::As05],
+        &[
+            WeightFactor::DistanceOffset,
+            WeightFactor::PointDistance,
+            WeightFactor::DampedDistanceOffset,
+        ],
     )
     .unwrap();
     for (w, r) in &runs {

@@ -1,6 +1,6 @@
 //! Multilevel B-spline approximation (MBA) of scattered 2.5D data
-//! (Lee, Wolberg & Shin 1997, as summarised in the MBA paper section 2.1 and
-//! the turntable paper section 2.1), with the MBA paper's projection
+//! ([LWS97], as summarised in [MBA18] section 2.1 and
+//! [TURN17] section 2.1), with [MBA18]'s projection
 //! adjustment of control points (sections 2.2-2.4, [`adjust`]).
 //!
 //! The data `(x, y, z)` are mapped to the lattice rectangle: `x` from the
@@ -22,6 +22,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
+use crate::bspline::ops::greville;
 use crate::bspline::{KnotVector, Surface};
 use crate::metrics::ErrorStats;
 use crate::{validate_points, Error, Point3, Result};
@@ -330,18 +331,20 @@ fn uniform_knots(cells: usize) -> Result<KnotVector> {
 /// abscissae (which reproduce the linear maps exactly), z the control values.
 pub fn lattice_surface(frame: &Frame, lattice: &Lattice) -> Result<Surface> {
     let (m, n) = (lattice.m, lattice.n);
-    let greville = |a: usize, cells: usize| (a as f64 - 1.0) / cells as f64;
+    let (ku, kv) = (uniform_knots(m)?, uniform_knots(n)?);
+    // (a - 1) / cells on these knots, up to rounding
+    let (xi, eta) = (greville(&ku), greville(&kv));
     let mut ctrl = Vec::with_capacity(lattice.phi.len());
-    for a in 0..m + 3 {
-        for b in 0..n + 3 {
+    for (a, x) in xi.iter().enumerate() {
+        for (b, y) in eta.iter().enumerate() {
             ctrl.push(Point3::new(
-                frame.x0 + frame.width * greville(a, m),
-                frame.y0 + frame.height * greville(b, n),
+                frame.x0 + frame.width * x,
+                frame.y0 + frame.height * y,
                 frame.z0 + lattice.get(a, b),
             ));
         }
     }
-    Surface::new(uniform_knots(m)?, uniform_knots(n)?, ctrl)?.to_clamped()
+    Surface::new(ku, kv, ctrl)?.to_clamped()
 }
 
 #[cfg(test)]

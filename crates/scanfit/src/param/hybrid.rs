@@ -1,4 +1,4 @@
-//! The hybrid parameterization, the method the curve paper improves on
+//! The hybrid parameterization, the method [CURVE12] improves on
 //! (its reference [9]; section 3.1, eq. 3.1):
 //!
 //! ```text
