@@ -48,6 +48,7 @@ pub mod project;
 pub mod quality;
 pub mod spatial;
 pub mod surface;
+pub mod testdata;
 
 pub use cloud::PointCloud;
 pub use error::{Error, Result};

@@ -169,13 +169,8 @@ mod tests {
 
     #[test]
     fn queries_agree_with_brute_force() {
-        let mut s = 5u64;
-        let mut rnd = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::testdata::Lcg::new(5);
+        let mut rnd = || rng.next_f64();
         let pts: Vec<Point3> = (0..500).map(|_| Point3::new(rnd(), rnd(), rnd())).collect();
         let tree = KdTree::new(&pts, "points").unwrap();
         assert_eq!(tree.len(), 500);

@@ -331,13 +331,8 @@ mod tests {
 
     /// A bumpy terrain-like height field on a jittered grid.
     fn terrain(n: usize) -> Vec<Point3> {
-        let mut s = 5u64;
-        let mut rnd = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::testdata::Lcg::new(5);
+        let mut rnd = || rng.next_f64();
         (0..n)
             .map(|_| {
                 let (x, y) = (rnd() * 10.0, rnd() * 8.0);

@@ -351,22 +351,11 @@ pub fn lattice_surface(frame: &Frame, lattice: &Lattice) -> Result<Surface> {
 mod tests {
     use super::*;
 
-    fn franke(x: f64, y: f64) -> f64 {
-        let (x9, y9) = (9.0 * x, 9.0 * y);
-        0.75 * (-((x9 - 2.0).powi(2) + (y9 - 2.0).powi(2)) / 4.0).exp()
-            + 0.75 * (-(x9 + 1.0).powi(2) / 49.0 - (y9 + 1.0) / 10.0).exp()
-            + 0.5 * (-((x9 - 7.0).powi(2) + (y9 - 3.0).powi(2)) / 4.0).exp()
-            - 0.2 * (-(x9 - 4.0).powi(2) - (y9 - 7.0).powi(2)).exp()
-    }
+    use crate::testdata::franke;
 
     fn random_points(n: usize, f: impl Fn(f64, f64) -> f64, offset: [f64; 2]) -> Vec<Point3> {
-        let mut s = 99u64;
-        let mut rnd = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::testdata::Lcg::new(99);
+        let mut rnd = || rng.next_f64();
         (0..n)
             .map(|_| {
                 let (x, y) = (rnd(), rnd());

@@ -409,13 +409,8 @@ mod tests {
     /// Samples of z = f(x, y) on a jittered grid over [-1, 1]^2.
     fn height_field(n: usize, f: impl Fn(f64, f64) -> f64) -> PointCloud {
         let mut p = Vec::new();
-        let mut s = 12345u64;
-        let mut rnd = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rng = crate::testdata::Lcg::new(12345);
+        let mut rnd = || rng.next_f64() - 0.5;
         let h = 2.0 / (n - 1) as f64;
         for i in 0..n {
             for j in 0..n {
