@@ -73,8 +73,9 @@ fn table_1_on_the_jacksboro_terrain() {
             100.0 * (after - before) / before
         );
         eprintln!("{net} x {net}: one paper-literal step {before:.2} -> {lit:.2}");
-        // the paper's claim, for its own step without our guard
-        assert!(lit < before, "{net}: paper step {before} -> {lit}");
+        // the paper's claim, for its own step without our guard (measured:
+        // -10% at 35 x 35 to -19% at 11 x 11)
+        assert!(lit < 0.92 * before, "{net}: paper step {before} -> {lit}");
         // and the guarded loop's gain the README quotes (14-26%)
         assert!(after < 0.9 * before, "{net}: {before} -> {after}");
         // and MBA itself improves with the lattice
