@@ -162,6 +162,22 @@ pub fn offset_lattice(lattice: &Lattice, dd: &[f64], alpha: f64) -> Result<Latti
 /// [MBA18]'s adjustment step exactly as the paper states it (section 2.4):
 /// the grid offsets and `phi* = phi + alpha dd` once, with no check of the
 /// result (what [`adjust_lattice`] adds is the guard).
+///
+/// ```
+/// use scanfit::cloud::PointCloud;
+/// use scanfit::mba::adjust::{lattice_grid_rmse, paper_step, AdjustConfig};
+/// use scanfit::mba::{mba, MbaConfig};
+/// use scanfit::testdata::scattered;
+/// // a smooth height field, MBA to 2 levels, then one literal step
+/// let p = scattered(4000, 3, [0.0, 0.0, 10.0, 8.0], |x, y| (1.3 * x).sin() * (0.9 * y).cos());
+/// let cloud = PointCloud::new(p.clone()).unwrap();
+/// let r = mba(&p, &MbaConfig { max_levels: 2, ..Default::default() }).unwrap();
+/// let cfg = AdjustConfig::default();
+/// let stepped = paper_step(&cloud, &r.frame, &r.lattice, cfg.alpha, &cfg.projection).unwrap();
+/// let before = lattice_grid_rmse(&cloud, &r.frame, &r.lattice).unwrap();
+/// let after = lattice_grid_rmse(&cloud, &r.frame, &stepped).unwrap();
+/// assert!(after < before, "{before} -> {after}");
+/// ```
 pub fn paper_step(
     cloud: &PointCloud,
     frame: &Frame,
