@@ -27,6 +27,10 @@ use clap::{Parser, Subcommand};
     after_help = "Examples:\n  scanfit curve compare examples/data/dataset5.csv\n  scanfit curve fit examples/data/dataset6.csv --ctrl 20 -o curve.json\n  scanfit cloud boundary examples/data/patch_20k.ply --png boundary.png\n  scanfit mba examples/data/terrain_50k.xyz --levels 6 --adjust -o terrain.json\n  scanfit coons examples/data/patch_20k.ply --pde 5x5 --png patch.png"
 )]
 struct Cli {
+    /// Threads for the parallel loops (0: one per core). Results are
+    /// bit-identical for every count; only the time changes.
+    #[arg(long, global = true, default_value_t = 0, value_name = "N")]
+    threads: usize,
     #[command(subcommand)]
     command: Command,
 }
@@ -79,7 +83,19 @@ fn main() {
         }
         Err(e) => e.exit(),
     };
-    let result = match cli.command {
+    let threads = scanfit::par::Threads::from_count(cli.threads);
+    let result = scanfit::par::with_threads(threads, || dispatch(cli.command))
+        .map_err(anyhow::Error::from)
+        .and_then(|r| r);
+    if let Err(e) = result {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+/// Runs one command.
+fn dispatch(command: Command) -> anyhow::Result<()> {
+    match command {
         Command::Cloud(c) => cloud::run(c),
         Command::Coons(a) => coons::run(a),
         Command::Curve(c) => curve::run(c),
@@ -88,9 +104,5 @@ fn main() {
         Command::Mba(a) => mba::run(a),
         Command::Report(a) => report::run(a),
         Command::Turntable(a) => turntable::run(a),
-    };
-    if let Err(e) = result {
-        eprintln!("error: {e:#}");
-        std::process::exit(1);
     }
 }

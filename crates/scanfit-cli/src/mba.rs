@@ -53,10 +53,10 @@ pub enum WeightArg {
 impl From<WeightArg> for WeightFactor {
     fn from(w: WeightArg) -> Self {
         match w {
-            WeightArg::Aza04 => WeightFactor::Aza04,
-            WeightArg::As05 => WeightFactor::As05,
-            WeightArg::Axis4 => WeightFactor::Axis4,
-            WeightArg::Moon => WeightFactor::Moon,
+            WeightArg::Aza04 => WeightFactor::PointDistance,
+            WeightArg::As05 => WeightFactor::DampedDistanceOffset,
+            WeightArg::Axis4 => WeightFactor::LineOffset,
+            WeightArg::Moon => WeightFactor::DistanceOffset,
         }
     }
 }

@@ -60,10 +60,10 @@ pub enum WeightArg {
 impl From<WeightArg> for WeightFactor {
     fn from(w: WeightArg) -> Self {
         match w {
-            WeightArg::Moon => Self::Moon,
-            WeightArg::Aza04 => Self::Aza04,
-            WeightArg::As05 => Self::As05,
-            WeightArg::Axis4 => Self::Axis4,
+            WeightArg::Moon => Self::DistanceOffset,
+            WeightArg::Aza04 => Self::PointDistance,
+            WeightArg::As05 => Self::DampedDistanceOffset,
+            WeightArg::Axis4 => Self::LineOffset,
         }
     }
 }
@@ -422,9 +422,9 @@ fn print_report(a: &TurntableArgs, cloud: &PointCloud, r: &TurntableReport, seco
         let names: Vec<String> = cmp
             .iter()
             .map(|w| match w.weight {
-                WeightFactor::Moon => "eq. 19 (moon)".to_string(),
-                WeightFactor::Aza04 => "eq. 15 (aza04)".to_string(),
-                WeightFactor::As05 => "eq. 16 (as05)".to_string(),
+                WeightFactor::DistanceOffset => "eq. 19 (moon)".to_string(),
+                WeightFactor::PointDistance => "eq. 15 (aza04)".to_string(),
+                WeightFactor::DampedDistanceOffset => "eq. 16 (as05)".to_string(),
                 other => other.name().to_string(),
             })
             .collect();

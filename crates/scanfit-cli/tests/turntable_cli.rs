@@ -96,6 +96,29 @@ fn weight_comparison_table_on_the_blob() {
     let cells: Vec<&str> = row0.split_whitespace().collect();
     assert_eq!(cells.len(), 4);
     assert!(cells[1] == cells[2] && cells[2] == cells[3], "{row0}");
+    // the paper's claim (Tables 1-2): after the last round the modified
+    // weight eq. 19 has a lower RMSE than eqs. 15 and 16 (columns in the
+    // order of the header: eq. 19, eq. 15, eq. 16)
+    let header = out.lines().find(|l| l.contains("eq. 19 (moon)")).unwrap();
+    let (p19, p15, p16) = (
+        header.find("eq. 19").unwrap(),
+        header.find("eq. 15").unwrap(),
+        header.find("eq. 16").unwrap(),
+    );
+    assert!(p19 < p15 && p15 < p16, "{header}");
+    let last = out
+        .lines()
+        .find(|l| l.trim_start().starts_with("3 "))
+        .unwrap();
+    let v: Vec<f64> = last
+        .split_whitespace()
+        .skip(1)
+        .map(|x| x.parse().unwrap())
+        .collect();
+    assert!(
+        v[0] < v[1] && v[0] < v[2],
+        "eq. 19 not best after 3 rounds: {last}"
+    );
 }
 
 #[test]

@@ -11,13 +11,8 @@ use scanfit::{Point3, PointCloud, Vector3};
 /// A jittered terrain-like sheet of `n` points over [0, 100]^2.
 fn sheet(n: usize) -> Vec<Point3> {
     let side = (n as f64).sqrt().ceil() as usize;
-    let mut s = 7u64;
-    let mut rnd = || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (s >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = scanfit::testdata::Lcg::new(7);
+    let mut rnd = || rng.next_f64();
     (0..n)
         .map(|i| {
             let x = (i % side) as f64 + rnd();

@@ -12,13 +12,8 @@ use scanfit::mba::{mba, MbaConfig};
 use scanfit::Point3;
 
 fn scattered(n: usize) -> Vec<Point3> {
-    let mut s = 11u64;
-    let mut rnd = || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (s >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = scanfit::testdata::Lcg::new(11);
+    let mut rnd = || rng.next_f64();
     (0..n)
         .map(|_| {
             let (x, y) = (rnd() * 1000.0, rnd() * 800.0);

@@ -17,13 +17,8 @@ use scanfit::Point3;
 
 /// 10^6 points of a smooth bumpy sheet with small deterministic noise, and their parameters.
 pub fn data(n: usize) -> (Vec<Point3>, Vec<[f64; 2]>) {
-    let mut state = 42u64;
-    let mut rnd = || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = scanfit::testdata::Lcg::new(42);
+    let mut rnd = || rng.next_f64();
     let uv: Vec<[f64; 2]> = (0..n).map(|_| [rnd(), rnd()]).collect();
     let pts = uv
         .iter()

@@ -7,12 +7,15 @@
 //! equation it follows) and a function that takes data + config and returns a
 //! result struct with diagnostics.
 //!
+//! Citations are by key, `[PDE23] eq. 14`: the keys are listed with full
+//! references in `docs/references.md` of the repository.
+//!
 //! * [`bspline`]: knot vectors, basis functions and derivatives, curves and
 //!   tensor-product surfaces (rational weights carried), knot insertion/refinement.
 //! * [`base`]: base surfaces that give points their parameters (best-fit plane,
 //!   bilinearly blended Coons patches from boundary curves).
-//! * [`pde`]: thin-plate PDE deformation surfaces on a Coons patch (PDE paper).
-//! * [`param`]: the seven curve parameterization methods of the curve paper and
+//! * [`pde`]: thin-plate PDE deformation surfaces on a Coons patch ([PDE23]).
+//! * [`param`]: the seven curve parameterization methods of [CURVE12] and
 //!   knot placement.
 //! * [`fit`]: curve interpolation (open, with end tangents, closed/periodic) and
 //!   least-squares approximation with optional bending-energy smoothing, on banded
@@ -20,7 +23,7 @@
 //! * [`cloud`]: point clouds with named attributes and KD-tree neighbour
 //!   queries, normals, hidden point removal, boundary loops, corners.
 //! * [`mba`]: multilevel B-spline approximation of 2.5D data (Lee, Wolberg &
-//!   Shin 1997) and the MBA paper's projection adjustment of control points.
+//!   Shin 1997) and [MBA18]'s projection adjustment of control points.
 //! * [`metrics`]: surface error measures and parameterization quality.
 //! * [`project`]: point inversion (orthogonal projection onto surfaces).
 //! * [`pipeline`]: every pipeline of the command line as one call (config,
@@ -28,6 +31,10 @@
 //! * [`quality`]: per-curve quality report (deviation, curvature, loops, length).
 //! * [`topology`]: multi-patch models: vertices, shared edge curves, faces
 //!   and their checks (gaps along edges, enclosed volume).
+//! * [`surface`]: capability traits, [`surface::ParametricSurface`] (B-spline,
+//!   Coons, PDE) and [`surface::ParametricCurve`].
+//! * [`spatial`]: the one KD-tree every neighbour query uses.
+//! * [`par`]: the thread-count knob and the deterministic parallel sums.
 
 pub mod base;
 pub mod bspline;
@@ -37,6 +44,7 @@ pub mod fit;
 mod geom;
 pub mod mba;
 pub mod metrics;
+pub mod par;
 pub mod param;
 pub mod pde;
 pub mod pipeline;
@@ -44,6 +52,9 @@ pub mod progress;
 pub mod project;
 pub mod quality;
 pub mod topology;
+pub mod spatial;
+pub mod surface;
+pub mod testdata;
 
 pub use cloud::PointCloud;
 pub use error::{Error, Result};

@@ -1,5 +1,5 @@
-//! PDE deformation surfaces on a Coons patch (PDE paper,
-//! `pde-coons-surface-reconstruction`, §4.5).
+//! PDE deformation surfaces on a Coons patch ([PDE23],
+//! §4.5).
 //!
 //! The thin-plate equation `D (w_uuuu + 2 w_uuvv + w_vvvv) = q_w` (eq. 4,
 //! `w = x, y, z`) with the lateral force a sine series
@@ -29,9 +29,9 @@ use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 use rayon::prelude::*;
 
-use crate::base::coons::{missing_knots, refine_to};
 use crate::base::CoonsPatch;
-use crate::bspline::{KnotVector, Surface};
+use crate::bspline::ops::{knot_union, refine_surface_to};
+use crate::bspline::Surface;
 use crate::fit::interpolate_with;
 use crate::metrics::ErrorStats;
 use crate::{Error, Point3, Result, Vector3};
@@ -103,6 +103,51 @@ impl PdeDeformation {
     /// The lateral force coefficient `q_wmn` (eq. 5) of term `(m, n)`.
     pub fn q_coefficient(&self, m: usize, n: usize) -> Option<Vector3> {
         self.w_coefficient(m, n).map(|w| w * factor(self.d, m, n))
+    }
+
+    /// The partial derivative `d^(k+l) S_PDE / du^k dv^l` at `(u, v)` in
+    /// `[0, 1]^2` (eq. 11 differentiated term by term:
+    /// `d^k/du^k sin(m pi u) = (m pi)^k sin(m pi u + k pi / 2)`).
+    ///
+    /// ```
+    /// # use scanfit::base::CoonsPatch;
+    /// # use scanfit::bspline::{Curve, KnotVector};
+    /// # use scanfit::pde::{fit_pde, PdeConfig};
+    /// # use scanfit::Point3;
+    /// # let line = |a: [f64; 3], b: [f64; 3]| Curve::new(KnotVector::uniform_clamped(1, 2).unwrap(), vec![Point3::from(a), Point3::from(b)]).unwrap();
+    /// # let c = CoonsPatch::new(&line([0., 0., 0.], [1., 0., 0.]), &line([0., 1., 0.], [1., 1., 0.]), &line([0., 0., 0.], [0., 1., 0.]), &line([1., 0., 0.], [1., 1., 0.])).unwrap();
+    /// // points on z = 0.1 sin(pi u) sin(pi v) over the unit square
+    /// let uv: Vec<[f64; 2]> = (0..100).map(|i| [(i % 10) as f64 / 9.0, (i / 10) as f64 / 9.0]).collect();
+    /// let pts: Vec<Point3> = uv.iter().map(|t| {
+    ///     let s = |x: f64| (std::f64::consts::PI * x).sin();
+    ///     Point3::new(t[0], t[1], 0.1 * s(t[0]) * s(t[1]))
+    /// }).collect();
+    /// let fit = fit_pde(&c, &pts, &uv, &PdeConfig::default()).unwrap();
+    /// // d/du at the centre vanishes, d/du at u = 0 is 0.1 pi sin(pi v)
+    /// let d = &fit.surface.deformation;
+    /// assert!(d.derivative(0.5, 0.5, 1, 0).z.abs() < 1e-9);
+    /// assert!((d.derivative(0.0, 0.5, 1, 0).z - 0.1 * std::f64::consts::PI).abs() < 1e-9);
+    /// ```
+    pub fn derivative(&self, u: f64, v: f64, k: usize, l: usize) -> Vector3 {
+        let der = |j: usize, order: usize, t: f64| {
+            let w = j as f64 * PI;
+            let f = match order % 4 {
+                0 => sin_k_pi(j, t),
+                1 => (w * t).cos(),
+                2 => -sin_k_pi(j, t),
+                _ => -(w * t).cos(),
+            };
+            w.powi(order as i32) * f
+        };
+        let su: Vec<f64> = (1..=self.m).map(|m| der(m, k, u)).collect();
+        let sv: Vec<f64> = (1..=self.n).map(|n| der(n, l, v)).collect();
+        let mut out = Vector3::zeros();
+        for (a, &x) in su.iter().enumerate() {
+            for (b, &y) in sv.iter().enumerate() {
+                out += self.w[a * self.n + b] * (x * y);
+            }
+        }
+        out
     }
 
     /// `S_PDE(u, v)` (eq. 11), zero on the boundary of `[0, 1]^2`.
@@ -210,10 +255,13 @@ impl PdeSurface {
                 .reduce(|| 0.0, f64::max);
             if dev * 1.2 <= cfg.tolerance {
                 let (ku, kv) = (
-                    union(base.knots_u(), w.knots_u())?,
-                    union(base.knots_v(), w.knots_v())?,
+                    knot_union(base.knots_u(), w.knots_u())?,
+                    knot_union(base.knots_v(), w.knots_v())?,
                 );
-                let (a, b) = (refine_to(&base, &ku, &kv)?, refine_to(&w, &ku, &kv)?);
+                let (a, b) = (
+                    refine_surface_to(&base, &ku, &kv)?,
+                    refine_surface_to(&w, &ku, &kv)?,
+                );
                 let ctrl = a
                     .control_points()
                     .iter()
@@ -263,14 +311,6 @@ impl PdeSurface {
             .collect::<Result<_>>()?;
         Surface::new(ku, kv, rows.concat())
     }
-}
-
-/// The union of two clamped knot vectors of one degree on `[0, 1]`.
-fn union(a: &KnotVector, b: &KnotVector) -> Result<KnotVector> {
-    let mut k = a.as_slice().to_vec();
-    k.extend(missing_knots(a, b));
-    k.sort_by(f64::total_cmp);
-    KnotVector::new(k, a.degree())
 }
 
 /// A fitted PDE surface with its errors.
@@ -354,10 +394,7 @@ pub fn fit_pde(
     }
     // offsets wbar_i = P_i - S_c(u_i, v_i) (eq. 12)
     let base: Vec<Point3> = uv.par_iter().map(|t| coons.point(t[0], t[1])).collect();
-    // normal equations (eq. 13) for w_mn, assembled block by block (blocks in
-    // parallel, summed in order: the result does not depend on the threads)
-    // a group of as many blocks as threads at a time, so that memory stays at
-    // (threads) Gram matrices however many points there are
+    // normal equations (eq. 13) for w_mn, assembled block by block
     let block = |b: usize| {
         let r = b * BLOCK..((b + 1) * BLOCK).min(points.len());
         let rows = r.len();
@@ -383,20 +420,33 @@ pub fn fit_pde(
         let at = a.as_ref().transpose();
         (at * a.as_ref(), at * rhs.as_ref())
     };
-    let nblocks = points.len().div_ceil(BLOCK);
-    let group = rayon::current_num_threads().max(1);
-    let mut g = Mat::<f64>::zeros(kk, kk);
-    let mut rhs = Mat::<f64>::zeros(kk, 3);
-    for start in (0..nblocks).step_by(group) {
-        let blocks: Vec<(Mat<f64>, Mat<f64>)> = (start..(start + group).min(nblocks))
-            .into_par_iter()
-            .map(block)
-            .collect();
-        for (bg, br) in &blocks {
-            g += bg;
-            rhs += br;
-        }
-    }
+    // one partial per block of BLOCK points, merged in block order
+    // (crate::par): bit-identical for every thread count; at most as many
+    // kk x kk partials at a time as fit in 256 MiB
+    let max_partials = (256usize << 20) / (8 * kk * kk).max(1);
+    let (g, rhs) = crate::par::accumulate_bounded(
+        points.len().div_ceil(BLOCK),
+        1,
+        max_partials,
+        || None,
+        |acc: &mut Option<(Mat<f64>, Mat<f64>)>, blocks| {
+            // a chunk is one block: its partial is the block's product
+            *acc = blocks.map(&block).reduce(|(mut g, mut r), (bg, br)| {
+                g += &bg;
+                r += &br;
+                (g, r)
+            });
+        },
+        |total, part| {
+            if let Some((bg, br)) = part {
+                let (g, r) = total
+                    .get_or_insert_with(|| (Mat::<f64>::zeros(kk, kk), Mat::<f64>::zeros(kk, 3)));
+                *g += &bg;
+                *r += &br;
+            }
+        },
+    )
+    .unwrap_or_else(|| (Mat::<f64>::zeros(kk, kk), Mat::<f64>::zeros(kk, 3)));
     let llt = g.llt(Side::Lower).map_err(|_| Error::Singular {
         what: format!("PDE deformation least squares (eq. 13, {mm} x {nn} terms)"),
         condition: f64::INFINITY,
@@ -468,7 +518,7 @@ pub fn fit_pde(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bspline::Curve;
+    use crate::bspline::{Curve, KnotVector};
 
     fn flat_square() -> CoonsPatch {
         let c = |a: [f64; 2], b: [f64; 2]| {

@@ -1,6 +1,6 @@
 //! Quality report of a fitted curve: how far it is from the data, how much it
 //! bends, whether it wiggles or loops, and how much longer than the data
-//! polygon it is. These are the properties the curve paper judges its figures
+//! polygon it is. These are the properties [CURVE12] judges its figures
 //! by ("bulky", "small loop", "cusp", "inflection point").
 
 use crate::bspline::{BasisWorkspace, Curve};

@@ -143,3 +143,31 @@ fn hybrid_is_bulky_at_the_ends_of_dataset_1() {
         assert!(hybrid.length_ratio > 1.3 * other.length_ratio);
     }
 }
+
+#[test]
+fn hybrid_blows_up_on_the_dense_dataset_6() {
+    // documented in param/hybrid.rs: on the dense, nearly evenly spaced data
+    // set 6 the interior basis maxima are almost equal, so the increments
+    // sqrt|B_i - B_{i-1}| put almost all of [0, 1] at the ends and the
+    // interior parameters nearly coincide; the interpolant passes through
+    // every point but oscillates wildly between them (measured: length
+    // ratio 7615, 538 self-intersections, condition 7.3e6)
+    let (fit, q) = run(6, Method::Hybrid).unwrap();
+    assert!(q.max_deviation < 1e-6, "{}", q.max_deviation);
+    assert!(q.length_ratio > 1000.0, "{}", q.length_ratio);
+    assert!(q.self_intersections > 100, "{}", q.self_intersections);
+    assert!(fit.condition > 1e6, "{}", fit.condition);
+    // the parameters: the largest gap dwarfs the smallest
+    let gaps: Vec<f64> = fit.params.windows(2).map(|w| w[1] - w[0]).collect();
+    let (lo, hi) = gaps
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(a, b), &g| (a.min(g), b.max(g)));
+    eprintln!("hybrid ds6 parameter gaps: {lo:e} .. {hi:e}");
+    assert!(hi > 1e3 * lo, "{lo} {hi}");
+    // while every other method is tight on the same data
+    for m in Method::ALL.into_iter().filter(|m| *m != Method::Hybrid) {
+        let (_, other) = run(6, m).unwrap();
+        assert!(other.length_ratio < 1.01, "{m}: {}", other.length_ratio);
+        assert_eq!(other.self_intersections, 0, "{m}");
+    }
+}

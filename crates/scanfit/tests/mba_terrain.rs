@@ -3,13 +3,15 @@
 //! at lattice sizes 4x4 .. 35x35 control points, then the projection
 //! adjustment at the same lattice. Prints the table (run with
 //! `cargo test -p scanfit --test mba_terrain -- --nocapture`) that the
-//! README quotes, and asserts what the issue asks: the adjustment never
-//! raises the eq. 17 RMSE at equal lattice size.
+//! README quotes, and asserts its figures: the paper-literal step (alpha
+//! 1.49, no guard) lowers the eq. 17 RMSE at every lattice size, the guarded
+//! loop by more than 10%, and the vertical error gets worse on every lattice
+//! but the finest.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use scanfit::cloud::PointCloud;
-use scanfit::mba::adjust::{adjust_lattice, lattice_grid_rmse, AdjustConfig};
+use scanfit::mba::adjust::{adjust_lattice, lattice_grid_rmse, paper_step, AdjustConfig};
 use scanfit::mba::{mba, MbaConfig};
 use scanfit::Point3;
 
@@ -48,7 +50,10 @@ fn table_1_on_the_jacksboro_terrain() {
         .unwrap();
         let mut lattice = r.lattice.clone();
         let before = lattice_grid_rmse(&cloud, &r.frame, &lattice).unwrap();
-        adjust_lattice(&cloud, &r.frame, &mut lattice, &AdjustConfig::default()).unwrap();
+        let cfg = AdjustConfig::default();
+        let literal = paper_step(&cloud, &r.frame, &lattice, cfg.alpha, &cfg.projection).unwrap();
+        let lit = lattice_grid_rmse(&cloud, &r.frame, &literal).unwrap();
+        adjust_lattice(&cloud, &r.frame, &mut lattice, &cfg).unwrap();
         let after = lattice_grid_rmse(&cloud, &r.frame, &lattice).unwrap();
         let vertical = |l: &scanfit::mba::Lattice| {
             let s: f64 = p
@@ -67,8 +72,12 @@ fn table_1_on_the_jacksboro_terrain() {
             "| {net} x {net} | {before:.2} | {after:.2} | {:+.1}% | {vb:.2} | {va:.2} |",
             100.0 * (after - before) / before
         );
-        // the issue's requirement: never worse at equal lattice size
-        assert!(after <= before, "{net}: {before} -> {after}");
+        eprintln!("{net} x {net}: one paper-literal step {before:.2} -> {lit:.2}");
+        // the paper's claim, for its own step without our guard (measured:
+        // -10% at 35 x 35 to -19% at 11 x 11)
+        assert!(lit < 0.92 * before, "{net}: paper step {before} -> {lit}");
+        // and the guarded loop's gain the README quotes (14-26%)
+        assert!(after < 0.9 * before, "{net}: {before} -> {after}");
         // and MBA itself improves with the lattice
         assert!(before < last_mba, "{net}: {before} after {last_mba}");
         last_mba = before;
@@ -77,6 +86,8 @@ fn table_1_on_the_jacksboro_terrain() {
         // (see the README), which eq. 17 does not show
         if net == 35 {
             assert!(vb < 50.0 && va < 0.9 * vb, "{vb} {va}");
+        } else {
+            assert!(va > vb, "{net}: vertical {vb} -> {va}");
         }
     }
 }

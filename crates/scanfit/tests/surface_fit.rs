@@ -96,13 +96,8 @@ fn known() -> Surface {
 }
 
 fn sample(s: &Surface, n: usize, seed: u64) -> (Vec<Point3>, Vec<[f64; 2]>) {
-    let mut state = seed;
-    let mut rnd = || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = scanfit::testdata::Lcg::new(seed);
+    let mut rnd = || rng.next_f64();
     let uv: Vec<[f64; 2]> = (0..n).map(|_| [rnd(), rnd()]).collect();
     (uv.iter().map(|t| s.point(t[0], t[1])).collect(), uv)
 }

@@ -9,18 +9,8 @@ use scanfit::base::turntable::{
     compare_weights, turntable, AxisChoice, Ends, Turntable, TurntableConfig,
 };
 use scanfit::project::WeightFactor;
+use scanfit::testdata::Lcg;
 use scanfit::{Point3, PointCloud, Vector3};
-
-struct Lcg(u64);
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
 
 /// An open tube of radius 10 and height 40 around `axis` (through `centre`),
 /// with a gentle waist, uniformly random.
@@ -28,11 +18,11 @@ fn tube(n: usize, centre: Point3, axis: Vector3) -> Vec<Point3> {
     let a = axis.normalize();
     let e1 = a.cross(&Vector3::new(0.3, 0.5, 0.7)).normalize();
     let e2 = a.cross(&e1);
-    let mut r = Lcg(7);
+    let mut r = Lcg::new(7);
     (0..n)
         .map(|_| {
-            let t = 2.0 * PI * r.next();
-            let h = -20.0 + 40.0 * r.next();
+            let t = 2.0 * PI * r.next_f64();
+            let h = -20.0 + 40.0 * r.next_f64();
             let rad = 10.0 - 1.5 * (PI * h / 40.0).cos();
             centre + h * a + rad * (t.cos() * e1 + t.sin() * e2)
         })
@@ -41,11 +31,11 @@ fn tube(n: usize, centre: Point3, axis: Vector3) -> Vec<Point3> {
 
 /// An ellipsoid with semi-axes 12, 25, 9 (long axis y), uniform directions.
 fn ellipsoid(n: usize) -> Vec<Point3> {
-    let mut r = Lcg(11);
+    let mut r = Lcg::new(11);
     (0..n)
         .map(|_| {
-            let z = 2.0 * r.next() - 1.0;
-            let t = 2.0 * PI * r.next();
+            let z = 2.0 * r.next_f64() - 1.0;
+            let t = 2.0 * PI * r.next_f64();
             let s = (1.0 - z * z).sqrt();
             Point3::new(12.0 * s * t.cos(), 25.0 * z, 9.0 * s * t.sin())
         })
@@ -216,7 +206,11 @@ fn weight_factor_comparison_starts_equal_and_eq_19_is_not_worse() {
         &t.loops,
         &cfg.layers,
         5,
-        &[WeightFactor::Moon, WeightFactor::Aza04, WeightFactor::As05],
+        &[
+            WeightFactor::DistanceOffset,
+            WeightFactor::PointDistance,
+            WeightFactor::DampedDistanceOffset,
+        ],
     )
     .unwrap();
     for (w, r) in &runs {

@@ -1,15 +1,15 @@
 //! Bilinearly blended Coons patches from four (or three) boundary curves.
 //!
-//! * Boundary curves ([`fit_boundary_curve`]): the PDE paper
-//!   (`pde-coons-surface-reconstruction`, §4.2) fits each side's points by a
+//! * Boundary curves ([`fit_boundary_curve`]): [PDE23]
+//!   (§4.2) fits each side's points by a
 //!   least-squares B-spline that passes through the side's two end points,
 //!   with chord-length parameters and a clamped knot vector whose interior
-//!   knots are uniform; the Coons paper (`coons-base-surface-parameterization`,
+//!   knots are uniform; [COONS19] (`coons-base-surface-parameterization`,
 //!   §II eqs. 3-6 and §III) uses the same end-pinned least squares (NURBS Book
 //!   eq. 9.63-9.67). [`BoundaryFit::Interpolation`] interpolates every side
 //!   point instead (chord length, averaging knots; a cubic is C2, more than the
 //!   C1 a base surface needs).
-//! * The patch ([`CoonsPatch`]): Coons paper eq. 16 = PDE paper eq. 1,
+//! * The patch ([`CoonsPatch`]): [COONS19] eq. 16 = [PDE23] eq. 1,
 //!
 //!   ```text
 //!   S_c(u, v) = [1-u  u  1] | -P00  -P01  P(0,v) | [1-v]
@@ -17,9 +17,9 @@
 //!                           | P(u,0) P(u,1)  0   | [ 1 ]
 //!   ```
 //!
-//!   (both OCR texts print the matrix legibly; the Coons paper names the second
+//!   (both OCR texts print the matrix legibly; [COONS19] names the second
 //!   parameter `w`). `P00` is where `P(u,0)` meets `P(0,v)`, and so on.
-//! * Three sides (PDE paper §5.2, Fig. 10): the side `P(0, v)` degenerates to
+//! * Three sides ([PDE23] §5.2, Fig. 10): the side `P(0, v)` degenerates to
 //!   the corner shared by the first and last curve.
 //! * Exact B-spline form ([`CoonsPatch::to_bspline`]): the opposite curves are
 //!   refined to common knots; a function linear in one parameter is a B-spline
@@ -29,7 +29,10 @@
 //!   every term of eq. 16 is a tensor-product B-spline on the same knots and
 //!   their sum is exact to rounding.
 
-use crate::bspline::{BasisWorkspace, Curve, Direction, KnotVector, Surface};
+/// Moved to [`crate::bspline::ops`]; re-exported here for existing callers.
+pub use crate::bspline::ops::{greville, missing_knots, reversed};
+use crate::bspline::ops::{make_compatible, to_unit_domain};
+use crate::bspline::{Curve, KnotVector, Surface};
 use crate::fit::{interpolate, least_squares_with, InterpolationConfig, LeastSquaresOptions};
 use crate::param::{self, Method};
 use crate::{Error, Point3, Result, Vector3};
@@ -38,7 +41,7 @@ use crate::{Error, Point3, Result, Vector3};
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BoundaryFit {
     /// End-pinned least squares, chord-length parameters, clamped knots with
-    /// uniform interior knots (PDE paper §4.2; Coons paper eqs. 3-6).
+    /// uniform interior knots ([PDE23] §4.2; [COONS19] eqs. 3-6).
     /// `ctrl_count: None` picks `round(sqrt(n))` control points for a side of
     /// `n` points, clamped to `[degree + 1, 30]` (the papers do not say).
     LeastSquares {
@@ -98,7 +101,7 @@ fn densify(points: &[Point3], needed: usize) -> Vec<Point3> {
 }
 
 /// Fits one side's points (in order, first and last = the corners) by a
-/// B-spline through the two end points: PDE paper §4.2 / Coons paper §III.
+/// B-spline through the two end points: [PDE23] §4.2 / [COONS19] §III.
 /// The curve's first and last control points are the side's end points
 /// exactly. A side with fewer than `degree + 1` points is densified by chord
 /// midpoints first.
@@ -206,45 +209,6 @@ fn with_ends(curve: &Curve, a: Point3, b: Point3) -> Result<Curve> {
     Curve::new(curve.knots().clone(), ctrl)
 }
 
-/// Checks a curve can be blended: clamped, non-rational, non-periodic; returns
-/// it reparameterized to `[0, 1]` (affine map of the knots).
-fn normalized(curve: &Curve, what: &str) -> Result<Curve> {
-    if curve.is_rational() || curve.is_periodic() || !curve.knots().is_clamped() {
-        return Err(Error::InvalidInput(format!(
-            "{what} must be a clamped, non-rational B-spline curve (clamp it with to_clamped first)"
-        )));
-    }
-    let (a, b) = curve.domain();
-    if a == 0.0 && b == 1.0 {
-        return Ok(curve.clone());
-    }
-    let k: Vec<f64> = curve
-        .knots()
-        .as_slice()
-        .iter()
-        .map(|&t| ((t - a) / (b - a)).clamp(0.0, 1.0))
-        .collect();
-    Curve::new(
-        KnotVector::new(k, curve.degree())?,
-        curve.control_points().to_vec(),
-    )
-}
-
-/// The curve run backwards: `C_r(t) = C(1 - t)` on `[0, 1]`.
-pub fn reversed(curve: &Curve) -> Result<Curve> {
-    let c = normalized(curve, "a reversed curve")?;
-    let k: Vec<f64> = c
-        .knots()
-        .as_slice()
-        .iter()
-        .rev()
-        .map(|&t| 1.0 - t)
-        .collect();
-    let mut ctrl = c.control_points().to_vec();
-    ctrl.reverse();
-    Curve::new(KnotVector::new(k, c.degree())?, ctrl)
-}
-
 /// The constant curve `C(t) = a` of degree `p` (a degenerate side).
 fn point_curve(a: Point3, p: usize) -> Result<Curve> {
     Curve::new(KnotVector::uniform_clamped(p, p + 1)?, vec![a; p + 1])
@@ -259,7 +223,7 @@ pub enum Sides {
     Three,
 }
 
-/// A bilinearly blended Coons patch on `[0, 1]^2` (Coons paper eq. 16, PDE
+/// A bilinearly blended Coons patch on `[0, 1]^2` ([COONS19] eq. 16, PDE
 /// paper eq. 1). The four curves are `P(u, 0)`, `P(u, 1)`, `P(0, v)` and
 /// `P(1, v)`; their ends meet exactly at the corners.
 #[derive(Debug, Clone, PartialEq)]
@@ -277,10 +241,10 @@ impl CoonsPatch {
     /// `1e-9` x the patch size are made identical (the average); farther
     /// apart is an error naming the two curves.
     pub fn new(bottom: &Curve, top: &Curve, left: &Curve, right: &Curve) -> Result<Self> {
-        let b = normalized(bottom, "P(u,0)")?;
-        let t = normalized(top, "P(u,1)")?;
-        let l = normalized(left, "P(0,v)")?;
-        let r = normalized(right, "P(1,v)")?;
+        let b = to_unit_domain(bottom, "P(u,0)")?;
+        let t = to_unit_domain(top, "P(u,1)")?;
+        let l = to_unit_domain(left, "P(0,v)")?;
+        let r = to_unit_domain(right, "P(1,v)")?;
         let ends = |c: &Curve| {
             let cp = c.control_points();
             (cp[0], cp[cp.len() - 1])
@@ -324,7 +288,7 @@ impl CoonsPatch {
     /// curves `C0 -> C1 -> C2 -> C3 -> C0` give `P(u,0) = C0->C1`,
     /// `P(1,v) = C1->C2`, `P(u,1) = C3->C2`, `P(0,v) = C0->C3`; three curves
     /// `A -> B -> C -> A` give `P(u,0) = A->B`, `P(1,v) = B->C`, `P(u,1) = A->C`
-    /// and the degenerate `P(0,v) = A` (PDE paper §5.2). Ends closer than
+    /// and the degenerate `P(0,v) = A` ([PDE23] §5.2). Ends closer than
     /// `1e-9` x the loop size are snapped together.
     pub fn from_loop(curves: &[Curve]) -> Result<Self> {
         if !(3..=4).contains(&curves.len()) {
@@ -336,7 +300,7 @@ impl CoonsPatch {
         let fwd: Vec<Curve> = curves
             .iter()
             .enumerate()
-            .map(|(k, c)| normalized(c, &format!("boundary curve {k}")))
+            .map(|(k, c)| to_unit_domain(c, &format!("boundary curve {k}")))
             .collect::<Result<_>>()?;
         let rev: Vec<Curve> = fwd.iter().map(reversed).collect::<Result<_>>()?;
         let start = |c: &Curve| c.control_points()[0];
@@ -471,22 +435,35 @@ impl CoonsPatch {
         Point3::from(row0 * (1.0 - u) + row1 * u + row2)
     }
 
-    /// `(S_c, dS_c/du, dS_c/dv)` at `(u, v)` (eq. 16 differentiated).
+    /// `(S_c, dS_c/du, dS_c/dv)` at `(u, v)` (eq. 16 differentiated; the
+    /// general derivatives are [`crate::surface::ParametricSurface::derivatives`]).
+    ///
+    /// ```
+    /// use scanfit::base::CoonsPatch;
+    /// use scanfit::bspline::{Curve, KnotVector};
+    /// use scanfit::Point3;
+    /// let line = |a: [f64; 3], b: [f64; 3]| {
+    ///     let k = KnotVector::uniform_clamped(1, 2).unwrap();
+    ///     Curve::new(k, vec![Point3::from(a), Point3::from(b)]).unwrap()
+    /// };
+    /// // the unit square
+    /// let c = CoonsPatch::new(
+    ///     &line([0., 0., 0.], [1., 0., 0.]),
+    ///     &line([0., 1., 0.], [1., 1., 0.]),
+    ///     &line([0., 0., 0.], [0., 1., 0.]),
+    ///     &line([1., 0., 0.], [1., 1., 0.]),
+    /// )
+    /// .unwrap();
+    /// let (p, su, sv) = c.derivatives(0.25, 0.5);
+    /// assert!((p - Point3::new(0.25, 0.5, 0.0)).norm() < 1e-15);
+    /// assert!((su.x - 1.0).abs() < 1e-15 && (sv.y - 1.0).abs() < 1e-15);
+    /// ```
     pub fn derivatives(&self, u: f64, v: f64) -> (Point3, Vector3, Vector3) {
-        let (u, v) = (u.clamp(0.0, 1.0), v.clamp(0.0, 1.0));
-        let d = |c: &Curve, t: f64| {
-            let mut ws = BasisWorkspace::new(c.degree(), 1);
-            let mut out = [Vector3::zeros(); 2];
-            c.derivatives_into(t, &mut ws, &mut out);
-            (out[0], out[1])
-        };
-        let [p00, p10, p11, p01] = self.corners().map(|p| p.coords);
-        let ((b, db), (t, dt)) = (d(&self.bottom, u), d(&self.top, u));
-        let ((l, dl), (r, dr)) = (d(&self.left, v), d(&self.right, v));
-        let s = self.point(u, v);
-        let su = db * (1.0 - v) + dt * v - l + r - ((p10 - p00) * (1.0 - v) + (p11 - p01) * v);
-        let sv = t - b + dl * (1.0 - u) + dr * u - ((p01 - p00) * (1.0 - u) + (p11 - p10) * u);
-        (s, su, sv)
+        use crate::surface::ParametricSurface;
+        let mut ws = self.workspace(1);
+        let mut d = [Vector3::zeros(); 4];
+        ParametricSurface::derivatives(self, u, v, 1, &mut ws, &mut d);
+        (Point3::from(d[0]), d[2], d[1])
     }
 
     /// The patch as a tensor-product B-spline surface, exact to rounding:
@@ -496,8 +473,8 @@ impl CoonsPatch {
     /// `B_i, T_i` (of `P(u,0), P(u,1)`) and `L_j, R_j`:
     /// `P_ij = (1-eta_j) B_i + eta_j T_i + (1-xi_i) L_j + xi_i R_j - bilinear(xi_i, eta_j)`.
     pub fn to_bspline(&self) -> Result<Surface> {
-        let (bottom, top) = compatible(&self.bottom, &self.top, "P(u,0) and P(u,1)")?;
-        let (left, right) = compatible(&self.left, &self.right, "P(0,v) and P(1,v)")?;
+        let (bottom, top) = make_compatible(&self.bottom, &self.top, "P(u,0) and P(u,1)")?;
+        let (left, right) = make_compatible(&self.left, &self.right, "P(0,v) and P(1,v)")?;
         let ku = bottom.knots().clone();
         let kv = left.knots().clone();
         let (xi, eta) = (greville(&ku), greville(&kv));
@@ -528,56 +505,6 @@ impl CoonsPatch {
         }
         Surface::new(ku, kv, ctrl)
     }
-}
-
-/// Greville abscissae `(t_{i+1} + ... + t_{i+p}) / p` of a clamped knot vector.
-pub fn greville(kv: &KnotVector) -> Vec<f64> {
-    let p = kv.degree();
-    let t = kv.as_slice();
-    (0..kv.basis_count())
-        .map(|i| {
-            if p == 0 {
-                t[i]
-            } else {
-                t[i + 1..=i + p].iter().sum::<f64>() / p as f64
-            }
-        })
-        .collect()
-}
-
-/// The knots (with multiplicity) that `a` lacks to contain every knot of `b`.
-pub fn missing_knots(a: &KnotVector, b: &KnotVector) -> Vec<f64> {
-    let (ta, tb) = (a.as_slice(), b.as_slice());
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < tb.len() {
-        let x = tb[i];
-        let mb = tb[i..].iter().take_while(|&&y| y == x).count();
-        let ma = ta.iter().filter(|&&y| y == x).count();
-        out.extend(std::iter::repeat_n(x, mb.saturating_sub(ma)));
-        i += mb;
-    }
-    out
-}
-
-/// Two curves of the same degree refined to the union of their knots.
-fn compatible(a: &Curve, b: &Curve, what: &str) -> Result<(Curve, Curve)> {
-    if a.degree() != b.degree() {
-        return Err(Error::InvalidInput(format!(
-            "{what} have degrees {} and {}; opposite boundary curves must have the same degree for the B-spline form (fit them with one degree)",
-            a.degree(),
-            b.degree()
-        )));
-    }
-    let ra = a.refine(&missing_knots(a.knots(), b.knots()))?;
-    let rb = b.refine(&missing_knots(b.knots(), a.knots()))?;
-    Ok((ra, rb))
-}
-
-/// Refines `s` to knot vectors containing `ku` and `kv` (same degrees).
-pub(crate) fn refine_to(s: &Surface, ku: &KnotVector, kv: &KnotVector) -> Result<Surface> {
-    let s = s.refine(Direction::U, &missing_knots(s.knots_u(), ku))?;
-    s.refine(Direction::V, &missing_knots(s.knots_v(), kv))
 }
 
 #[cfg(test)]

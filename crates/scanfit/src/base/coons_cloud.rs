@@ -1,7 +1,7 @@
 //! From a patch of points to its Coons base surface: boundary loop (alpha
-//! shape, PDE paper §4.1), corners (Coons paper eqs. 10-12 or the PDE paper's
+//! shape, [PDE23] §4.1), corners ([COONS19] eqs. 10-12 or [PDE23]'s
 //! three-point curvature), the loop split into 4 (or 3) sides, one B-spline
-//! per side (PDE paper §4.2), and the bilinearly blended Coons patch (eq. 16 /
+//! per side ([PDE23] §4.2), and the bilinearly blended Coons patch (eq. 16 /
 //! eq. 1) on them.
 //!
 //! The sides run along the outer loop, which is counter-clockwise about the

@@ -1,10 +1,10 @@
 //! Parameters of points on a Coons base surface, by either paper's scheme:
 //!
-//! * [`CoonsProjection::GridIteration`], the Coons paper (§IV.B, eqs. 17-22):
+//! * [`CoonsProjection::GridIteration`], [COONS19] (§IV.B, eqs. 17-22):
 //!   nearest vertex of a grid of step `h` (0.001) over the patch, found with a
 //!   KD-tree over the grid, then the iterative refinement with `epsilon`
 //!   (0.01) — [`crate::project::grid_iteration`];
-//! * [`CoonsProjection::Inversion`], the PDE paper (§4.4): the exact closest
+//! * [`CoonsProjection::Inversion`], [PDE23] (§4.4): the exact closest
 //!   point. The paper uses the geometric method of its ref. 42; we use the
 //!   library's Newton point inversion ([`crate::project::SurfaceInverter`]),
 //!   which finds the same closest point (to rounding) from grid starts.
@@ -27,16 +27,16 @@ use crate::{Error, Point3, Result, Vector3};
 /// Which projection gives the parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum CoonsProjection {
-    /// The Coons paper's grid + iteration (eqs. 17-22; h = 0.001, epsilon = 0.01).
+    /// [COONS19]'s grid + iteration (eqs. 17-22; h = 0.001, epsilon = 0.01).
     GridIteration(GridIterationConfig),
-    /// Exact closest point (PDE paper §4.4).
+    /// Exact closest point ([PDE23] §4.4).
     Inversion(InversionConfig),
 }
 
 /// Settings of [`coons_parameters`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CoonsParamConfig {
-    /// The projection (default: the Coons paper's grid iteration).
+    /// The projection (default: [COONS19]'s grid iteration).
     pub projection: CoonsProjection,
     /// Tangential offset beyond the boundary above which a point counts as
     /// outside the patch; `None` (default): `1e-3` x the diagonal of the

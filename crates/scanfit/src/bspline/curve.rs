@@ -1,6 +1,6 @@
 //! B-spline (and NURBS) curves: evaluation, derivatives, knot insertion.
 //!
-//! Algorithms from Piegl & Tiller, *The NURBS Book*: A3.1 (point), A3.2
+//! Algorithms from Piegl & Tiller, [NURBS97]: A3.1 (point), A3.2
 //! (derivatives), A4.2 (rational derivatives), A5.1 (knot insertion).
 
 use super::basis::{basis_funs, BasisWorkspace};

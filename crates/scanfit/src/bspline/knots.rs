@@ -1,6 +1,6 @@
 //! Knot vectors: validation, span search, multiplicity.
 //!
-//! Conventions follow Piegl & Tiller, *The NURBS Book* (2nd ed.), chapter 2:
+//! Conventions follow Piegl & Tiller, [NURBS97] (2nd ed.), chapter 2:
 //! a knot vector `U = {t_0, ..., t_m}` of degree `p` carries `n + 1 = m - p`
 //! basis functions, and the curve's domain is `[t_p, t_{m-p}]`.
 

@@ -1,9 +1,12 @@
-//! The B-spline kernel: knot vectors, basis functions, curves and surfaces.
+//! The B-spline kernel: knot vectors, basis functions, curves and surfaces,
+//! and the operations on them ([`ops`]: Greville abscissae, knot union and
+//! compatibility, refinement to given knots, reversal).
 
 mod basis;
 mod clamp;
 mod curve;
 mod knots;
+pub mod ops;
 mod surface;
 mod tessellate;
 

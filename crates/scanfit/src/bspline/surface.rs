@@ -1,7 +1,7 @@
 //! Tensor-product B-spline (and NURBS) surfaces: evaluation, partial derivatives,
 //! knot insertion in either direction.
 //!
-//! Algorithms from *The NURBS Book*: A3.5 (point), A3.6 (derivatives), A4.4
+//! Algorithms from [NURBS97]: A3.5 (point), A3.6 (derivatives), A4.4
 //! (rational derivatives), A5.3 (surface knot insertion, done here as A5.1 on
 //! every row or column of the control net).
 

@@ -1,7 +1,7 @@
 //! Boundary loops of a sheet-like patch from its alpha shape.
 //!
 //! The PDE/Coons reconstruction paper (Zhu et al.,
-//! `pde-coons-surface-reconstruction`, §4.1) extracts the boundary of each
+//! §4.1) extracts the boundary of each
 //! segmented subset with alpha shapes (Edelsbrunner, ref. 29 there) and
 //! tunes the alpha parameter when the boundary has outliers or too few
 //! points. For a patch that is a height field over its best-fit plane this
@@ -131,7 +131,7 @@ impl HasPosition for Vertex {
 }
 
 /// The boundary loops of a sheet-like patch: alpha shape of its projection
-/// on the best-fit plane (PDE paper §4.1, alpha shapes after Edelsbrunner).
+/// on the best-fit plane ([PDE23] §4.1, alpha shapes after Edelsbrunner).
 ///
 /// Points that project onto the same spot are represented by the first of
 /// them (smallest index); the others are on no loop.

@@ -7,14 +7,14 @@
 //! scanned data measures the noise rather than the shape):
 //!
 //! * [`CornerCriterion::TurningAngle`], Coons base-surface paper
-//!   (`coons-base-surface-parameterization`, §III, eqs. 10–12):
+//!   (§III, eqs. 10–12):
 //!   `d1 = P[n-m] - P[n]` (eq. 10), `d2 = P[n+m] - P[n]` (eq. 11),
 //!   `theta_n = acos(d1 . d2 / (|d1| |d2|))` (eq. 12; the OCR text splits
 //!   the fraction over two lines and prints the dot as `d1.d2`). A straight
 //!   run gives `theta = pi`, a sharp turn a small angle; "four points where
 //!   this angle comes out to be least are selected".
 //! * [`CornerCriterion::ThreePointCurvature`], PDE/Coons reconstruction
-//!   paper (`pde-coons-surface-reconstruction`, §4.1, the unnumbered
+//!   paper (§4.1, the unnumbered
 //!   equation after ref. 30, Belyaev's three-point curvature):
 //!   `k = 4 S / (a b c)`, `S` the area of the triangle `A = P[n-m]`,
 //!   `B = P[n]`, `C = P[n+m]`, `a = |AB|`, `b = |BC|`, `c = |AC|` (the
@@ -33,11 +33,11 @@ use crate::{validate_points, Error, Point3, Result};
 /// The corner measure.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum CornerCriterion {
-    /// Smallest angle between the vectors to the neighbours (Coons paper
+    /// Smallest angle between the vectors to the neighbours ([COONS19]
     /// eqs. 10–12). Values in radians, `[0, pi]`.
     #[default]
     TurningAngle,
-    /// Largest three-point curvature `k = 4 S / (a b c)` (PDE paper §4.1).
+    /// Largest three-point curvature `k = 4 S / (a b c)` ([PDE23] §4.1).
     /// Values in 1 / (units of the points).
     ThreePointCurvature,
 }
@@ -48,7 +48,7 @@ pub struct CornerConfig {
     /// The corner measure. Default [`CornerCriterion::TurningAngle`].
     pub criterion: CornerCriterion,
     /// Number of corners (and sides): 4 for a four-sided Coons patch, 3 for
-    /// a three-sided one (PDE paper §4.1, §5). Default 4; at least 2.
+    /// a three-sided one ([PDE23] §4.1, §5). Default 4; at least 2.
     pub count: usize,
     /// Neighbour offset `m` (in loop positions). `None` (default):
     /// `max(1, round(n / 100))` for a loop of `n` points, i.e. neighbours
@@ -91,7 +91,7 @@ pub struct Corners {
 
 /// The criterion's value at every position of the closed loop `points`
 /// (first point not repeated at the end), with neighbour offset `offset`:
-/// Coons paper eqs. 10–12 or the PDE paper's `k = 4S/(abc)` (§4.1).
+/// [COONS19] eqs. 10–12 or [PDE23]'s `k = 4S/(abc)` (§4.1).
 ///
 /// Errors: `offset >= n / 2` (rounded up), `offset == 0`, coincident points at a
 /// position and its neighbour (remove duplicates), non-finite points.
@@ -146,7 +146,7 @@ pub fn corner_values(
 
 /// Finds `config.count` corners on the closed loop `points` (first point not
 /// repeated at the end) and splits the loop into sides between them. See the
-/// module documentation for the two criteria (Coons paper eqs. 10–12, PDE
+/// module documentation for the two criteria ([COONS19] eqs. 10–12, PDE
 /// paper §4.1).
 ///
 /// For a [`Boundary`](super::boundary::Boundary) loop `lp` of a cloud, pass

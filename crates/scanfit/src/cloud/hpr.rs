@@ -1,5 +1,5 @@
 //! Hidden point removal: which points of a cloud are visible from a
-//! viewpoint, without a surface or normals (Katz, Tal & Basri 2007, "Direct
+//! viewpoint, without a surface or normals ([Katz07], "Direct
 //! visibility of point sets", ACM TOG 26(3)).
 //!
 //! The operator has two steps (Katz et al. §2):
@@ -43,7 +43,7 @@ pub struct HprConfig {
     /// `gamma` of the flipping radius `R = max|p - C| * 10^gamma` (Katz et
     /// al. 2007, §2; their reference code calls it `param`). Must be in
     /// `(0, 12]` so that `R` exceeds every distance and the flipped points
-    /// still resolve the distances in f64. Default `2.0` (the turntable paper
+    /// still resolve the distances in f64. Default `2.0` ([TURN17]
     /// §3.2 uses the operator without giving `R`).
     pub gamma: f64,
 }
@@ -60,7 +60,7 @@ impl Default for HprConfig {
 pub const VIEWPOINT_TOLERANCE: f64 = 1e-12;
 
 /// Indices (sorted ascending) of the `points` visible from `viewpoint`, by
-/// the hidden point removal operator of Katz, Tal & Basri 2007 (spherical
+/// the hidden point removal operator of [Katz07] (spherical
 /// flipping, eq. 1, then the convex hull of the flipped points and the
 /// viewpoint). Exact duplicates of a visible point are visible too.
 ///

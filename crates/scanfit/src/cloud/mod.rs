@@ -2,8 +2,9 @@
 //!
 //! [`PointCloud`] holds the positions of a scan and any per-point attributes
 //! read with it (normals, colours, labels, parameters...) as named `f64`
-//! columns, and answers neighbour queries over a KD-tree (kiddo's
-//! `ImmutableKdTree`, built once on first use and shared by all queries).
+//! columns, and answers neighbour queries over the library's KD-tree
+//! ([`crate::spatial::KdTree`], built once on first use and shared by all
+//! queries).
 //!
 //! * [`neighbours`]: k-nearest and radius queries, one at a time or in
 //!   parallel batches.
@@ -11,7 +12,7 @@
 //!   or over a minimum spanning tree (Hoppe et al. 1992).
 //! * [`hull`]: 3D convex hull (quickhull on exact orientation predicates).
 //! * [`hpr`]: hidden point removal, the points visible from a viewpoint
-//!   (Katz, Tal & Basri 2007).
+//!   ([Katz07]).
 //! * [`boundary`]: boundary loops of a sheet-like patch from the alpha shape
 //!   of its projection on the best-fit plane.
 //! * [`corners`]: corners of a closed boundary loop (smallest turning angle or
@@ -28,7 +29,7 @@ pub(crate) mod testutil;
 
 use std::sync::OnceLock;
 
-use kiddo::ImmutableKdTree;
+use crate::spatial::KdTree;
 
 use crate::{validate_points, Error, Point3, Result, Vector3};
 
@@ -54,7 +55,7 @@ pub struct Attribute {
 pub struct PointCloud {
     points: Vec<Point3>,
     attributes: Vec<Attribute>,
-    tree: OnceLock<ImmutableKdTree<f64, 3>>,
+    tree: OnceLock<KdTree>,
 }
 
 impl Clone for PointCloud {

@@ -1,26 +1,18 @@
-//! Neighbour queries on a [`PointCloud`]: k-nearest and radius search over a
-//! KD-tree (kiddo 6 `ImmutableKdTree`), one query at a time or batched in
-//! parallel (rayon).
+//! Neighbour queries on a [`PointCloud`]: k-nearest and radius search over
+//! the library's one KD-tree ([`crate::spatial::KdTree`]), one query at a
+//! time or batched in parallel (rayon).
 //!
 //! Distances returned are Euclidean (not squared). Results are sorted by
 //! distance, nearest first; ties keep the tree's order.
 
 use std::num::NonZeroUsize;
 
-use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
 
 use super::PointCloud;
+use crate::spatial::KdTree;
+pub use crate::spatial::Neighbour;
 use crate::{Error, Point3, Result};
-
-/// One neighbour: its index in the cloud and its distance to the query.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Neighbour {
-    /// Index of the point in the cloud.
-    pub index: usize,
-    /// Euclidean distance to the query point.
-    pub distance: f64,
-}
 
 /// The k nearest neighbours of many points, stored flat: row `i` holds the
 /// neighbours of point (or query) `i`, nearest first.
@@ -56,14 +48,16 @@ impl Neighbourhoods {
     }
 }
 
-fn coords(p: &Point3) -> [f64; 3] {
-    [p.x, p.y, p.z]
-}
-
 impl PointCloud {
     /// The KD-tree over the points, built on first use (an error for an
     /// empty cloud or more than 2^32 points).
-    pub fn tree(&self) -> Result<&ImmutableKdTree<f64, 3>> {
+    ///
+    /// ```
+    /// use scanfit::{Point3, PointCloud};
+    /// let cloud = PointCloud::new(vec![Point3::origin(), Point3::new(1.0, 0.0, 0.0)]).unwrap();
+    /// assert_eq!(cloud.tree().unwrap().len(), 2);
+    /// ```
+    pub fn tree(&self) -> Result<&KdTree> {
         if self.points.is_empty() {
             return Err(Error::InvalidInput(
                 "the point cloud is empty; neighbour queries need at least one point".into(),
@@ -78,9 +72,7 @@ impl PointCloud {
         if let Some(t) = self.tree.get() {
             return Ok(t);
         }
-        let c: Vec<[f64; 3]> = self.points.iter().map(coords).collect();
-        let tree = ImmutableKdTree::new_from_slice(&c)
-            .map_err(|e| Error::InvalidInput(format!("could not index the points: {e:?}")))?;
+        let tree = KdTree::new(&self.points, "the cloud's points")?;
         Ok(self.tree.get_or_init(|| tree))
     }
 
@@ -98,19 +90,7 @@ impl PointCloud {
             check_query(q, &format!("query point {i}"))?;
         }
         let tree = self.tree()?;
-        Ok(queries
-            .par_iter()
-            .map(|q| {
-                let r = tree
-                    .query(&coords(q))
-                    .nearest_one::<SquaredEuclidean<f64>>()
-                    .execute();
-                Neighbour {
-                    index: r.item as usize,
-                    distance: r.distance.sqrt(),
-                }
-            })
-            .collect())
+        Ok(queries.par_iter().map(|q| tree.nearest(q)).collect())
     }
 
     /// The `k` nearest points to `query` (fewer if the cloud is smaller),
@@ -118,7 +98,7 @@ impl PointCloud {
     pub fn knn(&self, query: &Point3, k: usize) -> Result<Vec<Neighbour>> {
         let k = checked_k(k)?;
         check_query(query, "the query point")?;
-        Ok(knn_with(self.tree()?, self.points.len(), query, k))
+        Ok(self.tree()?.nearest_n(query, k))
     }
 
     /// All points within distance `radius` of `query` (inclusive), nearest first.
@@ -129,19 +109,7 @@ impl PointCloud {
             )));
         }
         check_query(query, "the query point")?;
-        let mut out: Vec<Neighbour> = self
-            .tree()?
-            .query(&coords(query))
-            .within::<SquaredEuclidean<f64>>(radius * radius)
-            .execute()
-            .into_iter()
-            .map(|r| Neighbour {
-                index: r.item as usize,
-                distance: r.distance.sqrt(),
-            })
-            .collect();
-        out.sort_by(|a, b| a.distance.total_cmp(&b.distance));
-        Ok(out)
+        Ok(self.tree()?.within(query, radius))
     }
 
     /// The `k` nearest points of each of `queries`, in parallel.
@@ -159,7 +127,7 @@ impl PointCloud {
             .zip(distances.par_chunks_mut(k))
             .zip(queries.par_iter())
             .for_each(|((idx, dist), q)| {
-                for (j, n) in knn_with(tree, k, q, kq).into_iter().enumerate().take(k) {
+                for (j, n) in tree.nearest_n(q, kq).into_iter().enumerate().take(k) {
                     idx[j] = n.index as u32;
                     dist[j] = n.distance;
                 }
@@ -262,26 +230,6 @@ fn check_query(query: &Point3, which: &str) -> Result<()> {
             query.x, query.y, query.z
         )))
     }
-}
-
-/// The `k` nearest of the `n` points in `tree` (k is capped at n: the tree
-/// reserves room for k results).
-fn knn_with(
-    tree: &ImmutableKdTree<f64, 3>,
-    n: usize,
-    query: &Point3,
-    k: NonZeroUsize,
-) -> Vec<Neighbour> {
-    let k = NonZeroUsize::new(k.get().min(n)).unwrap_or(NonZeroUsize::MIN);
-    tree.query(&coords(query))
-        .nearest_n::<SquaredEuclidean<f64>>(k)
-        .execute()
-        .into_iter()
-        .map(|r| Neighbour {
-            index: r.item as usize,
-            distance: r.distance.sqrt(),
-        })
-        .collect()
 }
 
 #[cfg(test)]

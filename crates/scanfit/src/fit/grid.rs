@@ -1,4 +1,4 @@
-//! Surfaces through or near data on a regular grid (*The NURBS Book* section
+//! Surfaces through or near data on a regular grid ([NURBS97] section
 //! 9.2.5, Algorithm A9.4, and the least-squares analogue of section 9.4.3):
 //! parameters by chord length along every grid line, averaged over the lines
 //! (eqs. 9.5 and 9.10-9.11); knots by averaging (interpolation) or eqs.

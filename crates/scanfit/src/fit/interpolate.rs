@@ -1,4 +1,4 @@
-//! Global curve interpolation (*The NURBS Book* section 9.2.1, A9.1), with end
+//! Global curve interpolation ([NURBS97] section 9.2.1, A9.1), with end
 //! derivatives (section 9.2.2) and closed (periodic) interpolation.
 
 use super::banded::BandMatrix;
@@ -13,7 +13,7 @@ use crate::{Error, Point3, Result, Vector3};
 pub struct InterpolationConfig {
     /// Degree (default 3).
     pub degree: usize,
-    /// Parameterization (default: the curve paper's new method, a = 0.8).
+    /// Parameterization (default: [CURVE12]'s new method, a = 0.8).
     pub method: Method,
     /// Prescribed first derivatives `C'(0)` and `C'(1)` (open curves only).
     pub end_derivatives: Option<(Vector3, Vector3)>,

@@ -1,4 +1,4 @@
-//! Least-squares curve approximation (*The NURBS Book* section 9.4.1, A9.6
+//! Least-squares curve approximation ([NURBS97] section 9.4.1, A9.6
 //! without weights in the constraints), with optional point weights and an
 //! optional smoothing term:
 //!
@@ -27,7 +27,7 @@ pub struct ApproximationConfig {
     pub degree: usize,
     /// Number of control points (distinct ones for a closed curve).
     pub ctrl_count: usize,
-    /// Parameterization (default: the curve paper's new method, a = 0.8).
+    /// Parameterization (default: [CURVE12]'s new method, a = 0.8).
     pub method: Method,
     /// Pin the curve's ends to the first and last points (default true; open only).
     pub fix_ends: bool,

@@ -1,5 +1,5 @@
 //! Least-squares B-spline surface fitting to scattered points with given
-//! parameters (*The NURBS Book* section 9.4.3 generalised to scattered data):
+//! parameters ([NURBS97] section 9.4.3 generalised to scattered data):
 //!
 //! ```text
 //! minimise  sum_k w_k |P_k - S(u_k, v_k)|^2
@@ -17,7 +17,6 @@
 use faer::linalg::solvers::Solve;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};
-use rayon::prelude::*;
 
 use super::gram;
 use crate::bspline::{BasisWorkspace, KnotVector, Surface};
@@ -326,6 +325,10 @@ fn validate(
     Ok(())
 }
 
+/// Points per chunk of the parallel assembly ([`crate::par::accumulate`]): a
+/// constant, so the summation order does not depend on the thread count.
+const ASSEMBLY_CHUNK: usize = 16_384;
+
 /// Normal equations in band-block layout, right-hand sides, and the diagonal
 /// data term per unknown (zero where no point influences a control point).
 fn assemble(
@@ -338,23 +341,22 @@ fn assemble(
 ) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     let n = l.nu * l.nv;
     let s = l.slots();
-    let threads = rayon::current_num_threads().max(1);
-    let chunk = points.len().div_ceil(threads).max(1024);
     let (p, q) = (l.p, l.q);
     let tu = ku.as_slice();
     let tv = kv.as_slice();
-    let identity = || (vec![0.0; n * s], vec![0.0; n * 3]);
-    let (acc, rhs) = points
-        .par_chunks(chunk)
-        .enumerate()
-        .map(|(c, pts)| {
-            let (mut acc, mut rhs) = identity();
+    // fixed chunks merged in order (crate::par): the sums, and so the
+    // surface, are bit-identical for every thread count
+    let (acc, rhs) = crate::par::accumulate(
+        points.len(),
+        ASSEMBLY_CHUNK,
+        || (vec![0.0; n * s], vec![0.0; n * 3]),
+        |(acc, rhs), range| {
             let mut wu = BasisWorkspace::new(p, 0);
             let mut wv = BasisWorkspace::new(q, 0);
             let mut b = vec![0.0; (p + 1) * (q + 1)];
             let mut rows = vec![0usize; (p + 1) * (q + 1)];
-            for (k, pt) in pts.iter().enumerate() {
-                let idx = c * chunk + k;
+            for idx in range {
+                let pt = &points[idx];
                 let [u, v] = uv[idx];
                 let w = weights.map_or(1.0, |w| w[idx]);
                 let (su, sv) = (ku.find_span(u), kv.find_span(v));
@@ -386,13 +388,12 @@ fn assemble(
                     }
                 }
             }
-            (acc, rhs)
-        })
-        .reduce(identity, |(mut a1, mut r1), (a2, r2)| {
+        },
+        |(a1, r1), (a2, r2)| {
             a1.iter_mut().zip(&a2).for_each(|(x, y)| *x += y);
             r1.iter_mut().zip(&r2).for_each(|(x, y)| *x += y);
-            (a1, r1)
-        });
+        },
+    );
     let centre = l.slot(p, q);
     let diag = (0..n).map(|r| acc[r * s + centre]).collect();
     (acc, rhs, diag)

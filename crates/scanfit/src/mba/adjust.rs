@@ -1,4 +1,4 @@
-//! The MBA paper's projection adjustment of control points (sections
+//! [MBA18]'s projection adjustment of control points (sections
 //! 2.2-2.4): grid points of the surface at the knot positions are projected
 //! onto the scattered data, and each control value moves by `alpha` times
 //! its grid point's signed distance to the projection.
@@ -8,7 +8,7 @@
 //!   coordinates `(i, j)`, `i = 0..m`, `j = 0..n`.
 //! * Projection (section 2.3): directed projection along z
 //!   ([`crate::project::project_directed_batch`], eqs. 5-12, with the weight
-//!   factor of eq. 13, 14, 15 or the turntable paper's eq. 19).
+//!   factor of eq. 13, 14, 15 or [TURN17]'s eq. 19).
 //! * Adjustment (section 2.4, eq. 16): `phi*_ij = phi_ij + alpha dd_ij` for
 //!   the control value over grid point `(i, j)` (lattice index `(i+1, j+1)`),
 //!   with `dd_ij = z(p^d_ij) - z(p_ij)`, the *signed* vertical distance, so
@@ -31,7 +31,7 @@ use super::{Frame, Mba, MbaConfig, MbaRun};
 /// Settings of the projection adjustment.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AdjustConfig {
-    /// Step factor (MBA paper: 1.49, chosen empirically there).
+    /// Step factor ([MBA18]: 1.49, chosen empirically there).
     pub alpha: f64,
     /// The directed projection of the grid points (weight factor, neighbourhood).
     pub projection: DirectedConfig,
@@ -86,7 +86,7 @@ pub fn knot_grid(frame: &Frame, lattice: &Lattice) -> Vec<Point3> {
     g
 }
 
-/// The MBA paper's eq. 17 for `lattice`: RMSE of the distances from its knot
+/// [MBA18]'s eq. 17 for `lattice`: RMSE of the distances from its knot
 /// grid points to their nearest data points.
 pub fn lattice_grid_rmse(cloud: &PointCloud, frame: &Frame, lattice: &Lattice) -> Result<f64> {
     rmse_to_cloud(cloud, &knot_grid(frame, lattice))
@@ -113,6 +113,85 @@ impl AdjustConfig {
     }
 }
 
+/// The signed vertical distances `dd_ij = z(p^d_ij) - z(p_ij)` ([MBA18]
+/// eq. 16) from the knot grid points of `lattice` ([`knot_grid`], row `i`
+/// of `m + 1`, column `j` of `n + 1`) to their directed projections onto
+/// `cloud` along z (section 2.3); 0 where a grid point finds no data.
+pub fn grid_offsets(
+    cloud: &PointCloud,
+    frame: &Frame,
+    lattice: &Lattice,
+    projection: &DirectedConfig,
+) -> Result<Vec<f64>> {
+    let grid = knot_grid(frame, lattice);
+    let up = vec![Vector3::z(); grid.len()];
+    let projected = project_directed_batch(cloud, &grid, &up, projection)?;
+    Ok(grid
+        .iter()
+        .zip(&projected)
+        .map(|(g, p)| {
+            if p.neighbours > 0 {
+                p.point.z - g.z
+            } else {
+                0.0
+            }
+        })
+        .collect())
+}
+
+/// `lattice` with the control value over each knot grid point moved by
+/// `alpha dd_ij` ([MBA18] eq. 16: `phi*_ij = phi_ij + alpha dd_ij`, lattice
+/// index `(i + 1, j + 1)`); `dd` as [`grid_offsets`] returns it.
+pub fn offset_lattice(lattice: &Lattice, dd: &[f64], alpha: f64) -> Result<Lattice> {
+    let n1 = lattice.n + 1;
+    if dd.len() != (lattice.m + 1) * n1 {
+        return Err(Error::InvalidInput(format!(
+            "{} grid offsets given for a lattice of {} x {} cells, which has {} knot grid points",
+            dd.len(),
+            lattice.m,
+            lattice.n,
+            (lattice.m + 1) * n1
+        )));
+    }
+    let mut out = lattice.clone();
+    for i in 0..=lattice.m {
+        for j in 0..=lattice.n {
+            out.phi[(i + 1) * (lattice.n + 3) + j + 1] += alpha * dd[i * n1 + j];
+        }
+    }
+    Ok(out)
+}
+
+/// [MBA18]'s adjustment step exactly as the paper states it (section 2.4):
+/// the grid offsets and `phi* = phi + alpha dd` once, with no check of the
+/// result (what [`adjust_lattice`] adds is the guard).
+///
+/// ```
+/// use scanfit::cloud::PointCloud;
+/// use scanfit::mba::adjust::{lattice_grid_rmse, paper_step, AdjustConfig};
+/// use scanfit::mba::{mba, MbaConfig};
+/// use scanfit::testdata::scattered;
+/// // a smooth height field, MBA to 2 levels, then one literal step
+/// let p = scattered(4000, 3, [0.0, 0.0, 10.0, 8.0], |x, y| (1.3 * x).sin() * (0.9 * y).cos());
+/// let cloud = PointCloud::new(p.clone()).unwrap();
+/// let r = mba(&p, &MbaConfig { max_levels: 2, ..Default::default() }).unwrap();
+/// let cfg = AdjustConfig::default();
+/// let stepped = paper_step(&cloud, &r.frame, &r.lattice, cfg.alpha, &cfg.projection).unwrap();
+/// let before = lattice_grid_rmse(&cloud, &r.frame, &r.lattice).unwrap();
+/// let after = lattice_grid_rmse(&cloud, &r.frame, &stepped).unwrap();
+/// assert!(after < before, "{before} -> {after}");
+/// ```
+pub fn paper_step(
+    cloud: &PointCloud,
+    frame: &Frame,
+    lattice: &Lattice,
+    alpha: f64,
+    projection: &DirectedConfig,
+) -> Result<Lattice> {
+    let dd = grid_offsets(cloud, frame, lattice, projection)?;
+    offset_lattice(lattice, &dd, alpha)
+}
+
 /// Adjusts `lattice` (in `frame`) towards `cloud` (sections 2.2-2.4, see
 /// the module documentation); returns the steps.
 pub fn adjust_lattice(
@@ -132,33 +211,14 @@ pub fn adjust_lattice(
     let mut steps = Vec::new();
     let mut rmse = lattice_grid_rmse(cloud, frame, lattice)?;
     for _ in 0..config.max_steps {
-        let grid = knot_grid(frame, lattice);
-        let up = vec![Vector3::z(); grid.len()];
-        let projected = project_directed_batch(cloud, &grid, &up, &config.projection)?;
-        // signed vertical distance from each grid point to its projection
-        let dd: Vec<f64> = grid
-            .iter()
-            .zip(&projected)
-            .map(|(g, p)| {
-                if p.neighbours > 0 {
-                    p.point.z - g.z
-                } else {
-                    0.0
-                }
-            })
-            .collect();
+        let dd = grid_offsets(cloud, frame, lattice, &config.projection)?;
         let mut alpha = config.alpha;
         let mut taken = None;
         for _ in 0..4 {
-            let mut candidate = lattice.clone();
-            let n1 = lattice.n + 1;
-            for i in 0..=lattice.m {
-                for j in 0..=lattice.n {
-                    candidate.phi[(i + 1) * (lattice.n + 3) + j + 1] += alpha * dd[i * n1 + j];
-                }
-            }
+            let candidate = offset_lattice(lattice, &dd, alpha)?;
             let after = lattice_grid_rmse(cloud, frame, &candidate)?;
             let max_change = alpha * dd.iter().fold(0.0f64, |a, d| a.max(d.abs()));
+            // the guard (a departure from [MBA18], see the module docs)
             let accepted = after <= rmse;
             steps.push(AdjustStep {
                 alpha,
@@ -207,7 +267,7 @@ pub struct AdjustedLevel {
 }
 
 /// The multilevel approximation with the projection adjustment at each
-/// level (the MBA paper's Fig. 3 loop).
+/// level ([MBA18]'s Fig. 3 loop).
 #[derive(Debug, Clone, PartialEq)]
 pub struct AdjustedMba {
     /// The approximation; its `lattice` is the adjusted one of the last level
@@ -219,7 +279,7 @@ pub struct AdjustedMba {
     pub steps: Vec<AdjustStep>,
 }
 
-/// MBA with the projection adjustment (MBA paper Fig. 3): at each level the
+/// MBA with the projection adjustment ([MBA18] Fig. 3): at each level the
 /// combined lattice is adjusted; if the eq. 17 RMSE is at most
 /// `config.tolerance` the loop stops, otherwise the next level fits the
 /// residuals of the adjusted surface on a refined lattice.
@@ -290,13 +350,8 @@ mod tests {
 
     /// A bumpy terrain-like height field on a jittered grid.
     fn terrain(n: usize) -> Vec<Point3> {
-        let mut s = 5u64;
-        let mut rnd = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::testdata::Lcg::new(5);
+        let mut rnd = || rng.next_f64();
         (0..n)
             .map(|_| {
                 let (x, y) = (rnd() * 10.0, rnd() * 8.0);
@@ -307,9 +362,12 @@ mod tests {
     }
 
     #[test]
-    fn adjustment_never_raises_the_rmse_and_moves_towards_the_data() {
+    fn the_paper_step_moves_towards_the_data_and_the_guard_keeps_it() {
+        // the paper-literal step (no guard) must itself lower eq. 17 on a
+        // smooth terrain: this is what the method claims, and it can fail
         let p = terrain(8000);
         let cloud = PointCloud::new(p.clone()).unwrap();
+        let cfg = AdjustConfig::default();
         for levels in [2, 3, 4] {
             let r = mba(
                 &p,
@@ -319,17 +377,63 @@ mod tests {
                 },
             )
             .unwrap();
+            let before = lattice_grid_rmse(&cloud, &r.frame, &r.lattice).unwrap();
+            let literal =
+                paper_step(&cloud, &r.frame, &r.lattice, cfg.alpha, &cfg.projection).unwrap();
+            let lit = lattice_grid_rmse(&cloud, &r.frame, &literal).unwrap();
+            assert!(lit < 0.95 * before, "{levels}: {before} -> {lit}");
+            // the guarded loop takes exactly that step first (bit for bit)
             let mut lattice = r.lattice.clone();
-            let before = lattice_grid_rmse(&cloud, &r.frame, &lattice).unwrap();
-            let steps =
-                adjust_lattice(&cloud, &r.frame, &mut lattice, &AdjustConfig::default()).unwrap();
-            let after = lattice_grid_rmse(&cloud, &r.frame, &lattice).unwrap();
-            assert!(after <= before, "{levels}: {before} -> {after}");
-            assert!(steps.iter().any(|s| s.accepted), "{levels}: {steps:?}");
-            assert!(after < before, "{levels}: {before} -> {after}");
-            for s in &steps {
-                assert!(s.rmse_after <= s.rmse_before);
-            }
+            let steps = adjust_lattice(&cloud, &r.frame, &mut lattice, &cfg).unwrap();
+            assert!(
+                steps[0].accepted && steps[0].alpha == cfg.alpha,
+                "{steps:?}"
+            );
+            assert_eq!(steps[0].rmse_after, lit);
+            let one = AdjustConfig {
+                max_steps: 1,
+                ..cfg
+            };
+            let mut first = r.lattice.clone();
+            adjust_lattice(&cloud, &r.frame, &mut first, &one).unwrap();
+            assert_eq!(first.phi, literal.phi);
+        }
+    }
+
+    #[test]
+    fn the_guard_rejects_a_step_that_raises_the_rmse() {
+        // alpha = 40 overshoots: the paper-literal step raises eq. 17, the
+        // guard halves alpha (40, 20, 10, 5) and, when every try is worse,
+        // leaves the lattice as it was
+        let p = terrain(4000);
+        let cloud = PointCloud::new(p.clone()).unwrap();
+        let r = mba(
+            &p,
+            &MbaConfig {
+                max_levels: 3,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let before = lattice_grid_rmse(&cloud, &r.frame, &r.lattice).unwrap();
+        let cfg = AdjustConfig {
+            alpha: 40.0,
+            ..Default::default()
+        };
+        let literal = paper_step(&cloud, &r.frame, &r.lattice, 40.0, &cfg.projection).unwrap();
+        let lit = lattice_grid_rmse(&cloud, &r.frame, &literal).unwrap();
+        assert!(lit > 2.0 * before, "{before} -> {lit}");
+        let mut lattice = r.lattice.clone();
+        let steps = adjust_lattice(&cloud, &r.frame, &mut lattice, &cfg).unwrap();
+        assert!(!steps[0].accepted && steps[0].alpha == 40.0, "{steps:?}");
+        let alphas: Vec<f64> = steps.iter().map(|s| s.alpha).collect();
+        assert_eq!(&alphas[..2], &[40.0, 20.0], "{steps:?}");
+        let after = lattice_grid_rmse(&cloud, &r.frame, &lattice).unwrap();
+        match steps.iter().position(|s| s.accepted) {
+            // a smaller alpha helped: the lattice is that step's
+            Some(k) => assert!(after < before && steps[k].alpha < 40.0, "{steps:?}"),
+            // nothing helped: untouched, bit for bit
+            None => assert_eq!(lattice.phi, r.lattice.phi),
         }
     }
 
@@ -403,9 +507,13 @@ mod tests {
         let last = r.levels.last().unwrap();
         assert!(last.adjusted_rmse <= 0.12, "{:?}", r.levels);
         assert!(r.levels.len() < 8);
-        for l in &r.levels {
-            assert!(l.adjusted_rmse <= l.mba_rmse, "{l:?}");
-        }
+        // the adjustment lowered eq. 17 by more than 1% at some level (the
+        // guard alone would allow no change at all)
+        assert!(
+            r.levels.iter().any(|l| l.adjusted_rmse < 0.99 * l.mba_rmse),
+            "{:?}",
+            r.levels
+        );
         let bad = AdjustConfig {
             alpha: -1.0,
             ..Default::default()

@@ -1,19 +1,17 @@
-//! The uniform cubic B-spline control lattice of the MBA papers and its
+//! The uniform cubic B-spline control lattice of [MBA18]s and its
 //! B-spline approximation (BA) of scattered values.
 //!
 //! A lattice of `(m + 3) x (n + 3)` values `phi` over the rectangle
-//! `[0, m] x [0, n]` of lattice coordinates defines (MBA paper eq. 1)
+//! `[0, m] x [0, n]` of lattice coordinates defines ([MBA18] eq. 1)
 //! `f(x, y) = sum_{k,l=0..3} B_k(s) B_l(t) phi_(i+k)(j+l)` with
 //! `i = floor(x) - 1`, `j = floor(y) - 1`, `s = x - floor(x)`,
 //! `t = y - floor(y)` and the uniform cubic B-spline basis `B_0..B_3`. The
 //! paper numbers the lattice from -1; here index `a = i + 1` runs from 0.
 
-use rayon::prelude::*;
-
 use crate::{Error, Result};
 
 /// The four uniform cubic B-spline basis functions at `s` in [0, 1]
-/// (Lee, Wolberg & Shin 1997, eq. 2).
+/// ([LWS97], eq. 2).
 #[inline]
 pub fn uniform_cubic_basis(s: f64) -> [f64; 4] {
     let t = 1.0 - s;
@@ -27,6 +25,10 @@ pub fn uniform_cubic_basis(s: f64) -> [f64; 4] {
     ]
 }
 
+/// Points per chunk of the parallel BA sums ([`crate::par::accumulate`]): a
+/// constant, so the summation order does not depend on the thread count.
+const BA_CHUNK: usize = 16_384;
+
 /// Most control values of one lattice (2^24: 128 MiB of f64, a 4096 x 4096
 /// net), so that a level count or base lattice from the command line cannot
 /// exhaust memory.
@@ -36,12 +38,12 @@ pub const MAX_LATTICE_VALUES: usize = 1 << 24;
 /// in its 4 x 4 neighbourhood.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum ControlFormula {
-    /// Lee, Wolberg & Shin (MBA paper eq. 4, turntable paper eq. 5): the
+    /// Lee, Wolberg & Shin ([MBA18] eq. 4, [TURN17] eq. 5): the
     /// mean of the candidates weighted by `w_c^2`, `w_c = B_k(s) B_l(t)`,
     /// which minimises the local error `sum_c (w_c phi - w_c phi_c)^2`.
     #[default]
     LeeWolbergShin,
-    /// Hjelle 2001 (turntable paper eq. 6): the mean weighted by `w_c`
+    /// Hjelle 2001 ([TURN17] eq. 6): the mean weighted by `w_c`
     /// itself, less dominated by the points nearest the control point and
     /// so less sensitive to outliers. The OCR text of eq. 6 prints the
     /// denominator squared, which would not reproduce a constant (all
@@ -126,7 +128,7 @@ impl Lattice {
     }
 
     /// The B-spline approximation (BA) of the values `z` at the lattice
-    /// coordinates `xy` (MBA paper eqs. 2-4, or Hjelle's eq. 6): every point
+    /// coordinates `xy` ([MBA18] eqs. 2-4, or Hjelle's eq. 6): every point
     /// proposes `phi_c = w_c z / sum_ab w_ab^2` (eq. 3) for each of its 16
     /// control values, and each control value is the weighted mean of its
     /// proposals; a control value no point reaches is 0.
@@ -140,19 +142,15 @@ impl Lattice {
         let mut lattice = Self::zeros(m, n)?;
         let len = lattice.phi.len();
         let st = lattice.stride();
-        // (numerator, denominator) per control value, summed in parallel
-        // one pair of accumulators per thread's share, not per rayon split
-        let share = xy
-            .len()
-            .div_ceil(rayon::current_num_threads().max(1))
-            .max(1024);
-        let (num, den) = xy
-            .par_iter()
-            .zip(z.par_iter())
-            .with_min_len(share)
-            .fold(
-                || (vec![0.0; len], vec![0.0; len]),
-                |(mut num, mut den), (p, &zc)| {
+        // (numerator, denominator) per control value, summed over fixed
+        // chunks merged in order (crate::par): bit-identical for every
+        // thread count
+        let (num, den) = crate::par::accumulate(
+            xy.len(),
+            BA_CHUNK,
+            || (vec![0.0; len], vec![0.0; len]),
+            |(num, den), range| {
+                for (p, &zc) in xy[range.clone()].iter().zip(&z[range]) {
                     let (i, s) = locate(p[0].clamp(0.0, m as f64), m);
                     let (j, t) = locate(p[1].clamp(0.0, n as f64), n);
                     let (bs, bt) = (uniform_cubic_basis(s), uniform_cubic_basis(t));
@@ -175,21 +173,17 @@ impl Lattice {
                             den[at] += weight;
                         }
                     }
-                    (num, den)
-                },
-            )
-            .reduce(
-                || (vec![0.0; len], vec![0.0; len]),
-                |(mut a, mut b), (c, d)| {
-                    for (x, y) in a.iter_mut().zip(&c) {
-                        *x += y;
-                    }
-                    for (x, y) in b.iter_mut().zip(&d) {
-                        *x += y;
-                    }
-                    (a, b)
-                },
-            );
+                }
+            },
+            |(a, b), (c, d)| {
+                for (x, y) in a.iter_mut().zip(&c) {
+                    *x += y;
+                }
+                for (x, y) in b.iter_mut().zip(&d) {
+                    *x += y;
+                }
+            },
+        );
         for ((p, nu), de) in lattice.phi.iter_mut().zip(&num).zip(&den) {
             *p = if *de > 0.0 { nu / de } else { 0.0 };
         }
@@ -197,7 +191,7 @@ impl Lattice {
     }
 
     /// The same function on the lattice with twice the cells in each
-    /// direction (Lee, Wolberg & Shin 1997, section 5: B-spline refinement by
+    /// direction ([LWS97], section 5: B-spline refinement by
     /// subdivision, `(1, 6, 1) / 8` at even and `(1, 1) / 2` at odd fine
     /// indices, applied along x and then along y). Exact: the refined lattice
     /// evaluates equal to this one at corresponding coordinates.

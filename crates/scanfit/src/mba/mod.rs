@@ -1,6 +1,6 @@
 //! Multilevel B-spline approximation (MBA) of scattered 2.5D data
-//! (Lee, Wolberg & Shin 1997, as summarised in the MBA paper section 2.1 and
-//! the turntable paper section 2.1), with the MBA paper's projection
+//! ([LWS97], as summarised in [MBA18] section 2.1 and
+//! [TURN17] section 2.1), with [MBA18]'s projection
 //! adjustment of control points (sections 2.2-2.4, [`adjust`]).
 //!
 //! The data `(x, y, z)` are mapped to the lattice rectangle: `x` from the
@@ -22,6 +22,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
+use crate::bspline::ops::greville;
 use crate::bspline::{KnotVector, Surface};
 use crate::metrics::ErrorStats;
 use crate::{validate_points, Error, Point3, Result};
@@ -337,40 +338,31 @@ fn uniform_knots(cells: usize) -> Result<KnotVector> {
 /// abscissae (which reproduce the linear maps exactly), z the control values.
 pub fn lattice_surface(frame: &Frame, lattice: &Lattice) -> Result<Surface> {
     let (m, n) = (lattice.m, lattice.n);
-    let greville = |a: usize, cells: usize| (a as f64 - 1.0) / cells as f64;
+    let (ku, kv) = (uniform_knots(m)?, uniform_knots(n)?);
+    // (a - 1) / cells on these knots, up to rounding
+    let (xi, eta) = (greville(&ku), greville(&kv));
     let mut ctrl = Vec::with_capacity(lattice.phi.len());
-    for a in 0..m + 3 {
-        for b in 0..n + 3 {
+    for (a, x) in xi.iter().enumerate() {
+        for (b, y) in eta.iter().enumerate() {
             ctrl.push(Point3::new(
-                frame.x0 + frame.width * greville(a, m),
-                frame.y0 + frame.height * greville(b, n),
+                frame.x0 + frame.width * x,
+                frame.y0 + frame.height * y,
                 frame.z0 + lattice.get(a, b),
             ));
         }
     }
-    Surface::new(uniform_knots(m)?, uniform_knots(n)?, ctrl)?.to_clamped()
+    Surface::new(ku, kv, ctrl)?.to_clamped()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn franke(x: f64, y: f64) -> f64 {
-        let (x9, y9) = (9.0 * x, 9.0 * y);
-        0.75 * (-((x9 - 2.0).powi(2) + (y9 - 2.0).powi(2)) / 4.0).exp()
-            + 0.75 * (-(x9 + 1.0).powi(2) / 49.0 - (y9 + 1.0) / 10.0).exp()
-            + 0.5 * (-((x9 - 7.0).powi(2) + (y9 - 3.0).powi(2)) / 4.0).exp()
-            - 0.2 * (-(x9 - 4.0).powi(2) - (y9 - 7.0).powi(2)).exp()
-    }
+    use crate::testdata::franke;
 
     fn random_points(n: usize, f: impl Fn(f64, f64) -> f64, offset: [f64; 2]) -> Vec<Point3> {
-        let mut s = 99u64;
-        let mut rnd = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::testdata::Lcg::new(99);
+        let mut rnd = || rng.next_f64();
         (0..n)
             .map(|_| {
                 let (x, y) = (rnd(), rnd());

@@ -1,7 +1,7 @@
 //! The exponential family of parameterizations (Lee 1989): uniform (a = 0),
 //! centripetal (a = 1/2), chord length (a = 1) and general exponential a.
 //!
-//! Curve paper, Table 1 and section 2.1: `u_0 = 0`, `u_n = 1`,
+//! [CURVE12] Table 1 and section 2.1: `u_0 = 0`, `u_n = 1`,
 //! `u_i = u_{i-1} + |P_i - P_{i-1}|^a / sum_j |P_j - P_{j-1}|^a`.
 //! Each parameter is the running sum divided by the total (not a sum of
 //! divided increments), and the last is set to exactly 1.

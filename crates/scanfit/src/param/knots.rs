@@ -1,4 +1,4 @@
-//! Knot placement for curve fitting (*The NURBS Book*, chapter 9).
+//! Knot placement for curve fitting ([NURBS97], chapter 9).
 
 use crate::bspline::KnotVector;
 use crate::{Error, Result};

@@ -1,5 +1,5 @@
-//! Curve parameterization: the seven methods of the curve paper
-//! (`curve-parameterization-methods.txt`, Haron et al. 2012) and knot placement.
+//! Curve parameterization: the seven methods of [CURVE12]
+//! ([CURVE12]) and knot placement.
 //!
 //! | method | file | parameters |
 //! |---|---|---|
@@ -24,7 +24,7 @@ use crate::bspline::KnotVector;
 use crate::{Error, Point3, Result};
 
 /// Default exponent of the exponential method and of the new method's first
-/// step (curve paper, section 3.2 step 1: "a = 0.8 ... based on experiment").
+/// step ([CURVE12], section 3.2 step 1: "a = 0.8 ... based on experiment").
 pub const DEFAULT_EXPONENT: f64 = 0.8;
 
 /// A curve parameterization method.

@@ -1,4 +1,4 @@
-//! The curve paper's new parameterization method (section 3.2, Algorithm 1,
+//! [CURVE12]'s new parameterization method (section 3.2, Algorithm 1,
 //! eqs. 3.2-3.4):
 //!
 //! 1. `u_i` from the exponential method with `a = 0.8`;

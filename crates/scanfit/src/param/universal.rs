@@ -1,4 +1,4 @@
-//! Universal parameterization (Lim 1999; curve paper Table 1 and Fig. 9(b)).
+//! Universal parameterization (Lim 1999; [CURVE12] Table 1 and Fig. 9(b)).
 //!
 //! The knot vector is uniform and clamped for `n + 1` control points, and each
 //! parameter `u_i` is where the basis function `N_{i,p}` attains its maximum.

@@ -33,7 +33,7 @@ impl Default for WeightComparison {
     fn default() -> Self {
         Self {
             rounds: 5,
-            weights: vec![WeightFactor::Moon, WeightFactor::Aza04, WeightFactor::As05],
+            weights: vec![WeightFactor::DistanceOffset, WeightFactor::PointDistance, WeightFactor::DampedDistanceOffset],
         }
     }
 }

@@ -1,5 +1,5 @@
-//! Directed projection of a point onto a point cloud (Azariadis 2004), as
-//! written in the MBA paper eqs. (5)-(15) and the turntable paper eqs.
+//! Directed projection of a point onto a point cloud ([Aza04]), as
+//! written in [MBA18] eqs. (5)-(15) and [TURN17] eqs.
 //! (7)-(16) and (19).
 //!
 //! A point `p` moves along a direction `n` to `p* = p + t n` (eq. 8), the
@@ -19,12 +19,12 @@
 //! Weight factors ([`WeightFactor`]), with `r_d = |p - p_d|` and
 //! `e_d = |(p_d - p) x n|` (distance of `p_d` from the projection line, `n` unit):
 //!
-//! | factor | formula | source |
+//! | factor (CLI name) | formula | source |
 //! |---|---|---|
-//! | `Aza04` | `1 / r^4` | Azariadis 2004; MBA eq. 13, turntable eq. 15 |
-//! | `As05` | `1 / (1 + r^2 e^2)` | Azariadis & Sapidis 2005; MBA eq. 14, turntable eq. 16 |
-//! | `Moon` | `1 / (r^4 e^2)` | turntable paper's modified factor, eq. 19 |
-//! | `Axis4` | `1 / e^4` | MBA paper eq. 15 (its citation of the modified factor, as printed) |
+//! | `PointDistance` (`aza04`) | `1 / r^4` | [Aza04]; [MBA18] eq. 13, [TURN17] eq. 15 |
+//! | `DampedDistanceOffset` (`as05`) | `1 / (1 + r^2 e^2)` | [AS05]; [MBA18] eq. 14, [TURN17] eq. 16 |
+//! | `DistanceOffset` (`moon`) | `1 / (r^4 e^2)` | [TURN17] eq. 19, the modified factor |
+//! | `LineOffset` (`axis4`) | `1 / e^4` | [MBA18] eq. 15 (its citation of the modified factor, as printed) |
 //!
 //! Guarded division: a cloud point with a zero denominator (on `p` itself,
 //! or on the projection line for the factors with `e`) has an infinite
@@ -41,36 +41,71 @@ use rayon::prelude::*;
 use crate::cloud::PointCloud;
 use crate::{Error, Point3, Result, Vector3};
 
-/// The weight factor `a_d` of eq. 5 (see the module table).
+/// The weight factor `a_d` of [MBA18] eq. 5 (see the module table), named by
+/// what it weights a cloud point `p_d` by: `r = |p - p_d|`, its distance to
+/// the moving point, and `e = |(p_d - p) x n|`, its offset from the
+/// projection line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum WeightFactor {
-    /// `1 / |p - p_d|^4` (Azariadis 2004).
-    Aza04,
-    /// `1 / (1 + |p - p_d|^2 |(p_d - p) x n|^2)` (Azariadis & Sapidis 2005).
-    As05,
-    /// `1 / (|p - p_d|^4 |(p_d - p) x n|^2)` (turntable paper eq. 19).
+    /// `1 / r^4`: the distance to the moving point ([Aza04]; [MBA18] eq. 13,
+    /// [TURN17] eq. 15). Command-line name `aza04`.
+    PointDistance,
+    /// `1 / (1 + r^2 e^2)`: distance and line offset, damped by the `1 +`
+    /// ([AS05]; [MBA18] eq. 14, [TURN17] eq. 16). Command-line name `as05`.
+    DampedDistanceOffset,
+    /// `1 / (r^4 e^2)`: distance and line offset ([TURN17] eq. 19, the
+    /// modified factor). Command-line name `moon`.
     #[default]
-    Moon,
-    /// `1 / |(p_d - p) x n|^4` (MBA paper eq. 15 as printed).
-    Axis4,
+    DistanceOffset,
+    /// `1 / e^4`: the line offset alone ([MBA18] eq. 15 as printed, its
+    /// citation of the modified factor). Command-line name `axis4`.
+    LineOffset,
+}
+
+#[allow(non_upper_case_globals)]
+impl WeightFactor {
+    /// Old name of [`WeightFactor::PointDistance`].
+    #[deprecated(note = "use WeightFactor::PointDistance")]
+    pub const Aza04: Self = Self::PointDistance;
+    /// Old name of [`WeightFactor::DampedDistanceOffset`].
+    #[deprecated(note = "use WeightFactor::DampedDistanceOffset")]
+    pub const As05: Self = Self::DampedDistanceOffset;
+    /// Old name of [`WeightFactor::DistanceOffset`].
+    #[deprecated(note = "use WeightFactor::DistanceOffset")]
+    pub const Moon: Self = Self::DistanceOffset;
+    /// Old name of [`WeightFactor::LineOffset`].
+    #[deprecated(note = "use WeightFactor::LineOffset")]
+    pub const Axis4: Self = Self::LineOffset;
 }
 
 impl WeightFactor {
-    /// Short name used on the command line (`aza04`, `as05`, `moon`, `axis4`).
+    /// Short name used on the command line (`aza04`, `as05`, `moon`, `axis4`:
+    /// the paper keys, unchanged by the renaming of the variants).
+    ///
+    /// ```
+    /// use scanfit::project::WeightFactor;
+    /// assert_eq!(WeightFactor::DistanceOffset.name(), "moon");
+    /// assert_eq!(WeightFactor::from_name("AZA04"), Some(WeightFactor::PointDistance));
+    /// ```
     pub fn name(self) -> &'static str {
         match self {
-            Self::Aza04 => "aza04",
-            Self::As05 => "as05",
-            Self::Moon => "moon",
-            Self::Axis4 => "axis4",
+            Self::PointDistance => "aza04",
+            Self::DampedDistanceOffset => "as05",
+            Self::DistanceOffset => "moon",
+            Self::LineOffset => "axis4",
         }
     }
 
     /// Parses a [`name`](Self::name).
     pub fn from_name(s: &str) -> Option<Self> {
-        [Self::Aza04, Self::As05, Self::Moon, Self::Axis4]
-            .into_iter()
-            .find(|w| w.name().eq_ignore_ascii_case(s))
+        [
+            Self::PointDistance,
+            Self::DampedDistanceOffset,
+            Self::DistanceOffset,
+            Self::LineOffset,
+        ]
+        .into_iter()
+        .find(|w| w.name().eq_ignore_ascii_case(s))
     }
 
     /// The denominator of the weight (`a_d = 1 / denominator`) from `r^2`
@@ -78,10 +113,10 @@ impl WeightFactor {
     /// others are homogeneous, so the caller may pass scaled distances.
     fn denominator(self, r2: f64, e2: f64) -> f64 {
         match self {
-            Self::Aza04 => r2 * r2,
-            Self::As05 => 1.0 + r2 * e2,
-            Self::Moon => r2 * r2 * e2,
-            Self::Axis4 => e2 * e2,
+            Self::PointDistance => r2 * r2,
+            Self::DampedDistanceOffset => 1.0 + r2 * e2,
+            Self::DistanceOffset => r2 * r2 * e2,
+            Self::LineOffset => e2 * e2,
         }
     }
 }
@@ -100,7 +135,7 @@ pub enum Neighbourhood {
 /// Settings of the directed projection.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DirectedConfig {
-    /// Weight factor (default the turntable paper's eq. 19).
+    /// Weight factor (default [TURN17]'s eq. 19).
     pub weight: WeightFactor,
     /// Which points enter the sums (default the 32 nearest).
     pub neighbourhood: Neighbourhood,
@@ -114,7 +149,7 @@ pub struct DirectedConfig {
 impl Default for DirectedConfig {
     fn default() -> Self {
         Self {
-            weight: WeightFactor::Moon,
+            weight: WeightFactor::DistanceOffset,
             neighbourhood: Neighbourhood::Nearest(32),
             tolerance: 1e-9,
             max_iterations: 50,
@@ -182,7 +217,7 @@ fn step(
     scale: f64,
 ) -> (f64, f64, usize) {
     // homogeneous factors work in units of the cloud's size (no overflow of r^8)
-    let unit = if weight == WeightFactor::As05 {
+    let unit = if weight == WeightFactor::DampedDistanceOffset {
         1.0
     } else {
         scale
@@ -374,13 +409,8 @@ mod tests {
     /// Samples of z = f(x, y) on a jittered grid over [-1, 1]^2.
     fn height_field(n: usize, f: impl Fn(f64, f64) -> f64) -> PointCloud {
         let mut p = Vec::new();
-        let mut s = 12345u64;
-        let mut rnd = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rng = crate::testdata::Lcg::new(12345);
+        let mut rnd = || rng.next_f64() - 0.5;
         let h = 2.0 / (n - 1) as f64;
         for i in 0..n {
             for j in 0..n {
@@ -400,10 +430,10 @@ mod tests {
             let r2 = (p - q).norm_squared();
             let e2 = (q - p).cross(n).norm_squared();
             let a = match w {
-                WeightFactor::Aza04 => 1.0 / (r2 * r2),
-                WeightFactor::As05 => 1.0 / (1.0 + r2 * e2),
-                WeightFactor::Moon => 1.0 / (r2 * r2 * e2),
-                WeightFactor::Axis4 => 1.0 / (e2 * e2),
+                WeightFactor::PointDistance => 1.0 / (r2 * r2),
+                WeightFactor::DampedDistanceOffset => 1.0 / (1.0 + r2 * e2),
+                WeightFactor::DistanceOffset => 1.0 / (r2 * r2 * e2),
+                WeightFactor::LineOffset => 1.0 / (e2 * e2),
             };
             c0 += a;
             c1 += a * q.x;
@@ -420,10 +450,10 @@ mod tests {
         let p = Point3::new(0.123, -0.321, 0.9);
         let n = Vector3::new(0.1, 0.05, -1.0).normalize();
         for w in [
-            WeightFactor::Aza04,
-            WeightFactor::As05,
-            WeightFactor::Moon,
-            WeightFactor::Axis4,
+            WeightFactor::PointDistance,
+            WeightFactor::DampedDistanceOffset,
+            WeightFactor::DistanceOffset,
+            WeightFactor::LineOffset,
         ] {
             let cfg = DirectedConfig {
                 weight: w,
@@ -442,7 +472,11 @@ mod tests {
     fn projection_lands_on_the_sampled_surface() {
         let f = |x: f64, y: f64| 0.5 * (2.0 * x).sin() * y + 0.2;
         let cloud = height_field(60, f);
-        for w in [WeightFactor::Aza04, WeightFactor::Moon, WeightFactor::Axis4] {
+        for w in [
+            WeightFactor::PointDistance,
+            WeightFactor::DistanceOffset,
+            WeightFactor::LineOffset,
+        ] {
             let cfg = DirectedConfig {
                 weight: w,
                 ..Default::default()
@@ -474,7 +508,11 @@ mod tests {
         let f = |x: f64, y: f64| 0.4 * x * x + 0.3 * y;
         let cloud = height_field(40, f);
         let mut worst: f64 = 0.0;
-        for w in [WeightFactor::Aza04, WeightFactor::Moon, WeightFactor::Axis4] {
+        for w in [
+            WeightFactor::PointDistance,
+            WeightFactor::DistanceOffset,
+            WeightFactor::LineOffset,
+        ] {
             for &(x, y) in &[(0.0, 0.0), (0.33, -0.6), (-0.7, 0.45), (0.9, 0.9)] {
                 let p = Point3::new(x, y, 1.5);
                 let n = Vector3::new(0.0, 0.0, -1.0);
@@ -505,7 +543,7 @@ mod tests {
         ])
         .unwrap();
         // the line x = y = 0 passes exactly through point 0: infinite weight for Moon/Axis4
-        for w in [WeightFactor::Moon, WeightFactor::Axis4] {
+        for w in [WeightFactor::DistanceOffset, WeightFactor::LineOffset] {
             let cfg = DirectedConfig {
                 weight: w,
                 neighbourhood: Neighbourhood::All,

@@ -1,5 +1,5 @@
-//! The Coons paper's parameterization by nearest grid vertex and iteration
-//! (`coons-base-surface-parameterization.txt`, section IV, eqs. 17-22):
+//! [COONS19]'s parameterization by nearest grid vertex and iteration
+//! ([COONS19] section IV, eqs. 17-22):
 //!
 //! 1. the surface is sampled on a grid of step `h` (default 0.001) in both
 //!    parameters and each point takes the parameters of its nearest vertex
@@ -17,11 +17,11 @@
 //! This method is offered for comparison with Newton point inversion
 //! ([`super::SurfaceInverter`]), which is exact to rounding.
 
-use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
 
 use super::Inversion;
-use crate::bspline::Surface;
+use crate::spatial::KdTree;
+use crate::surface::ParametricSurface;
 use crate::{Error, Point3, Result};
 
 /// Settings of [`grid_iteration`] (the paper's defaults).
@@ -45,9 +45,23 @@ impl Default for GridIterationConfig {
     }
 }
 
-/// Parameterizes `points` on `surface` by the grid scheme.
-pub fn grid_iteration(
-    surface: &Surface,
+/// Parameterizes `points` on `surface` (any [`ParametricSurface`]: a
+/// B-spline, or the Coons patch itself) by the grid scheme.
+///
+/// ```
+/// use scanfit::bspline::{KnotVector, Surface};
+/// use scanfit::project::{grid_iteration, GridIterationConfig};
+/// use scanfit::Point3;
+/// let k = KnotVector::uniform_clamped(1, 2).unwrap();
+/// let ctrl = vec![Point3::new(0., 0., 0.), Point3::new(0., 1., 0.), Point3::new(1., 0., 0.), Point3::new(1., 1., 0.)];
+/// let s = Surface::new(k.clone(), k, ctrl).unwrap();
+/// let cfg = GridIterationConfig { h: 0.01, ..Default::default() };
+/// let r = grid_iteration(&s, &[Point3::new(0.333, 0.5, 0.1)], &cfg).unwrap();
+/// // within the grid step of the foot point (0.333, 0.5)
+/// assert!((r[0].uv[0] - 0.333).abs() <= 0.01 && (r[0].uv[1] - 0.5).abs() <= 0.01);
+/// ```
+pub fn grid_iteration<S: ParametricSurface + ?Sized>(
+    surface: &S,
     points: &[Point3],
     cfg: &GridIterationConfig,
 ) -> Result<Vec<Inversion>> {
@@ -82,24 +96,13 @@ pub fn grid_iteration(
             })
         })
         .collect();
-    let verts: Vec<[f64; 3]> = uv
-        .par_iter()
-        .map(|t| {
-            let p = surface.point(t[0], t[1]);
-            [p.x, p.y, p.z]
-        })
-        .collect();
-    let tree: ImmutableKdTree<f64, 3> = ImmutableKdTree::new_from_slice(&verts)
-        .map_err(|e| Error::InvalidInput(format!("could not index the grid: {e:?}")))?;
+    let verts: Vec<Point3> = uv.par_iter().map(|t| surface.point(t[0], t[1])).collect();
+    let tree = KdTree::new(&verts, "the grid vertices")?;
     let (hu, hv) = ((u1 - u0) / nu as f64, (v1 - v0) / nv as f64);
     Ok(points
         .par_iter()
         .map(|p| {
-            let near = tree
-                .query(&[p.x, p.y, p.z])
-                .nearest_one::<SquaredEuclidean<f64>>()
-                .execute();
-            let [mut u, mut w] = uv[near.item as usize];
+            let [mut u, mut w] = uv[tree.nearest(p).index];
             let mut converged = false;
             let mut it = 0;
             while it < cfg.max_iterations {

@@ -1,8 +1,11 @@
-//! Point inversion: the orthogonal projection of points onto a B-spline surface
-//! (*The NURBS Book* section 6.1, eqs. 6.5-6.8).
+//! Point inversion: the orthogonal projection of points onto a parametric
+//! surface ([NURBS97] section 6.1, eqs. 6.5-6.8): any
+//! [`ParametricSurface`] (a B-spline, a Coons patch, a PDE surface), with no
+//! conversion; the code is generic, so the B-spline path is compiled for the
+//! B-spline and runs as fast as before.
 //!
 //! Start: the nearest vertex of a parameter grid sampled on the surface, found
-//! with a KD-tree (kiddo), moved by one Gauss-Newton step on the tangent plane
+//! with the library's KD-tree ([`crate::spatial::KdTree`]), moved by one Gauss-Newton step on the tangent plane
 //! stored with the vertex (no surface evaluation; the start error drops from
 //! O(h) to O(h^2)). Iteration: Newton on `f = r.S_u = 0`, `g = r.S_v = 0`
 //! (`r = S - P`) with the full Jacobian; when it is not positive definite (far
@@ -14,11 +17,12 @@
 //! both tangents, or the parameter step is negligible (also at the boundary,
 //! where the constrained minimum is not orthogonal).
 
-use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
 
-use crate::bspline::{BasisWorkspace, Surface};
-use crate::{Error, Point3, Result, Vector3};
+use crate::bspline::Surface;
+use crate::spatial::KdTree;
+use crate::surface::ParametricSurface;
+use crate::{Point3, Result, Vector3};
 
 /// Settings of [`SurfaceInverter`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -60,28 +64,41 @@ pub struct Inversion {
     pub converged: bool,
 }
 
-/// Reusable evaluation memory for one thread.
+/// Reusable evaluation memory for one thread (the surface's derivative
+/// workspace, up to second order).
 #[derive(Debug, Clone)]
-pub struct InversionWorkspace {
-    wu: BasisWorkspace,
-    wv: BasisWorkspace,
+pub struct InversionWorkspace<W = crate::surface::SurfaceWorkspace> {
+    ws: W,
 }
 
-impl InversionWorkspace {
+impl<W> InversionWorkspace<W> {
     /// Workspace for `surface`.
-    pub fn new(surface: &Surface) -> Self {
-        let (p, q) = surface.degrees();
+    ///
+    /// ```
+    /// use scanfit::bspline::{KnotVector, Surface};
+    /// use scanfit::project::{InversionConfig, InversionWorkspace, SurfaceInverter};
+    /// use scanfit::Point3;
+    /// let k = KnotVector::uniform_clamped(1, 2).unwrap();
+    /// let ctrl = vec![Point3::new(0., 0., 0.), Point3::new(0., 1., 0.), Point3::new(1., 0., 0.), Point3::new(1., 1., 0.)];
+    /// let s = Surface::new(k.clone(), k, ctrl).unwrap();
+    /// let inv = SurfaceInverter::new(&s, InversionConfig::default()).unwrap();
+    /// let mut ws = InversionWorkspace::new(&s);
+    /// let r = inv.invert(&Point3::new(0.25, 0.75, 2.0), &mut ws);
+    /// assert!((r.uv[0] - 0.25).abs() < 1e-12 && (r.uv[1] - 0.75).abs() < 1e-12);
+    /// assert!((r.distance - 2.0).abs() < 1e-12);
+    /// ```
+    pub fn new<S: ParametricSurface<Workspace = W> + ?Sized>(surface: &S) -> Self {
         Self {
-            wu: BasisWorkspace::new(p, 2),
-            wv: BasisWorkspace::new(q, 2),
+            ws: surface.workspace(2),
         }
     }
 }
 
-/// Projects points onto one surface; build once, query many times.
-pub struct SurfaceInverter<'s> {
-    surface: &'s Surface,
-    tree: ImmutableKdTree<f64, 3>,
+/// Projects points onto one surface; build once, query many times. Generic
+/// over the surface ([`ParametricSurface`]); the default is the B-spline.
+pub struct SurfaceInverter<'s, S: ParametricSurface + ?Sized = Surface> {
+    surface: &'s S,
+    tree: KdTree,
     grid: Vec<[f64; 2]>,
     /// Point and tangents `S, S_u, S_v` at each grid vertex.
     frames: Vec<[Vector3; 3]>,
@@ -89,14 +106,37 @@ pub struct SurfaceInverter<'s> {
     scale: f64,
 }
 
-impl<'s> SurfaceInverter<'s> {
-    /// Samples `surface` on a parameter grid and builds the KD-tree.
-    pub fn new(surface: &'s Surface, cfg: InversionConfig) -> Result<Self> {
+impl<'s, S: ParametricSurface + ?Sized> SurfaceInverter<'s, S> {
+    /// Samples `surface` on a parameter grid and builds the KD-tree: per
+    /// direction `samples_per_span` x the knot spans of a B-spline (the
+    /// surface's [`ParametricSurface::spans`]), clamped to 16..=1024.
+    ///
+    /// ```
+    /// use scanfit::base::CoonsPatch;
+    /// use scanfit::bspline::{Curve, KnotVector};
+    /// use scanfit::project::{InversionConfig, SurfaceInverter};
+    /// use scanfit::Point3;
+    /// let line = |a: [f64; 3], b: [f64; 3]| {
+    ///     let k = KnotVector::uniform_clamped(1, 2).unwrap();
+    ///     Curve::new(k, vec![Point3::from(a), Point3::from(b)]).unwrap()
+    /// };
+    /// // a Coons patch inverts directly, without its B-spline form
+    /// let c = CoonsPatch::new(
+    ///     &line([0., 0., 0.], [2., 0., 0.]),
+    ///     &line([0., 1., 0.], [2., 1., 0.]),
+    ///     &line([0., 0., 0.], [0., 1., 0.]),
+    ///     &line([2., 0., 0.], [2., 1., 0.]),
+    /// )
+    /// .unwrap();
+    /// let inv = SurfaceInverter::new(&c, InversionConfig::default()).unwrap();
+    /// let r = inv.invert_all(&[Point3::new(0.5, 0.25, -1.0)]);
+    /// assert!((r[0].uv[0] - 0.25).abs() < 1e-12 && (r[0].uv[1] - 0.25).abs() < 1e-12);
+    /// ```
+    pub fn new(surface: &'s S, cfg: InversionConfig) -> Result<Self> {
         let ((u0, u1), (v0, v1)) = surface.domain();
-        let count = |kv: &crate::bspline::KnotVector| {
-            ((kv.breakpoints().len() - 1) * cfg.samples_per_span.max(1)).clamp(16, 1024)
-        };
-        let (nu, nv) = (count(surface.knots_u()), count(surface.knots_v()));
+        let (su, sv) = surface.spans();
+        let count = |spans: usize| (spans * cfg.samples_per_span.max(1)).clamp(16, 1024);
+        let (nu, nv) = (count(su), count(sv));
         let mut grid = Vec::with_capacity((nu + 1) * (nv + 1));
         for i in 0..=nu {
             for j in 0..=nv {
@@ -112,16 +152,14 @@ impl<'s> SurfaceInverter<'s> {
                 || InversionWorkspace::new(surface),
                 |ws, t| {
                     let mut d = [Vector3::zeros(); 4];
-                    surface.derivatives_into(t[0], t[1], &mut ws.wu, &mut ws.wv, 1, &mut d);
+                    surface.derivatives(t[0], t[1], 1, &mut ws.ws, &mut d);
                     [d[0], d[2], d[1]]
                 },
             )
             .collect();
-        let pts: Vec<[f64; 3]> = frames.iter().map(|f| [f[0].x, f[0].y, f[0].z]).collect();
-        let scale = crate::geom::bbox_diagonal(surface.control_points()).max(f64::MIN_POSITIVE);
-        let tree = ImmutableKdTree::new_from_slice(&pts).map_err(|e| {
-            Error::InvalidInput(format!("could not index the surface samples: {e:?}"))
-        })?;
+        let pts: Vec<Point3> = frames.iter().map(|f| Point3::from(f[0])).collect();
+        let scale = surface.extent().max(f64::MIN_POSITIVE);
+        let tree = KdTree::new(&pts, "the surface samples")?;
         Ok(Self {
             surface,
             tree,
@@ -133,32 +171,23 @@ impl<'s> SurfaceInverter<'s> {
     }
 
     /// The surface.
-    pub fn surface(&self) -> &Surface {
+    pub fn surface(&self) -> &S {
         self.surface
     }
 
     /// Projects `p` (KD-tree start, restarts if needed).
-    pub fn invert(&self, p: &Point3, ws: &mut InversionWorkspace) -> Inversion {
-        let q = [p.x, p.y, p.z];
-        let first = self
-            .tree
-            .query(&q)
-            .nearest_one::<SquaredEuclidean<f64>>()
-            .execute();
-        let mut best = self.invert_from(p, self.refined_start(p, first.item as usize), ws);
+    pub fn invert(&self, p: &Point3, ws: &mut InversionWorkspace<S::Workspace>) -> Inversion {
+        let first = self.tree.nearest(p);
+        let mut best = self.invert_from(p, self.refined_start(p, first.index), ws);
         if best.converged || self.cfg.starts <= 1 {
             return best;
         }
         let n = std::num::NonZeroUsize::new(self.cfg.starts.max(2))
             .unwrap_or(std::num::NonZeroUsize::MIN);
-        let more = self
-            .tree
-            .query(&q)
-            .nearest_n::<SquaredEuclidean<f64>>(n)
-            .execute();
+        let more = self.tree.nearest_n(p, n);
         let mut iterations = best.iterations;
         for item in more.iter().skip(1) {
-            let r = self.invert_from(p, self.refined_start(p, item.item as usize), ws);
+            let r = self.invert_from(p, self.refined_start(p, item.index), ws);
             iterations += r.iterations;
             if (r.converged && !best.converged) || r.distance < best.distance {
                 best = r;
@@ -229,7 +258,12 @@ impl<'s> SurfaceInverter<'s> {
     }
 
     /// Newton iteration from `uv0`.
-    pub fn invert_from(&self, p: &Point3, uv0: [f64; 2], ws: &mut InversionWorkspace) -> Inversion {
+    pub fn invert_from(
+        &self,
+        p: &Point3,
+        uv0: [f64; 2],
+        ws: &mut InversionWorkspace<S::Workspace>,
+    ) -> Inversion {
         let s = self.surface;
         let ((u0, u1), (v0, v1)) = s.domain();
         let (pu, pv) = s.periodic();
@@ -244,7 +278,7 @@ impl<'s> SurfaceInverter<'s> {
         let eps2 = self.cfg.tolerance; // zero-cosine tolerance (eq. 6.8)
         let mut d = [Vector3::zeros(); 9];
         let (mut u, mut v) = (uv0[0], uv0[1]);
-        s.derivatives_into(u, v, &mut ws.wu, &mut ws.wv, 2, &mut d);
+        s.derivatives(u, v, 2, &mut ws.ws, &mut d);
         let mut r = d[0] - p.coords;
         let mut dist = r.norm();
         let mut converged = false;
@@ -342,7 +376,7 @@ impl<'s> SurfaceInverter<'s> {
                 converged = true;
                 break;
             }
-            s.derivatives_into(u, v, &mut ws.wu, &mut ws.wv, 2, &mut d);
+            s.derivatives(u, v, 2, &mut ws.ws, &mut d);
         }
         Inversion {
             uv: [u, v],

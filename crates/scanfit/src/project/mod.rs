@@ -1,6 +1,6 @@
 //! Projection of points onto surfaces: orthogonal projection (point inversion)
-//! and the Coons paper's grid iteration; and of points onto point clouds:
-//! directed projection (Azariadis 2004).
+//! and [COONS19]'s grid iteration; and of points onto point clouds:
+//! directed projection ([Aza04]).
 
 mod directed;
 mod grid_iteration;

@@ -1,4 +1,4 @@
-//! The turntable's axis and centre (turntable paper section 3.2).
+//! The turntable's axis and centre ([TURN17] section 3.2).
 //!
 //! The paper assumes the turntable axis is `y` and works in a frame where the
 //! views look from `+z`. [`CylinderFrame`] is that frame for any axis: local

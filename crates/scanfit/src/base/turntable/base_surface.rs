@@ -1,9 +1,9 @@
-//! The base surface (turntable paper sections 3.6-3.7).
+//! The base surface ([TURN17] sections 3.6-3.7).
 //!
 //! Initial base surface (3.6): every final layer curve is sampled with the
 //! same count, the largest layer's; a grid of `M` samples around by `L`
 //! layers is interpolated by a bicubic surface closed (periodic) in `u`
-//! around the axis and clamped along it (*The NURBS Book* A9.4 with a
+//! around the axis and clamped along it ([NURBS97] A9.4 with a
 //! periodic `u` direction, [`crate::fit::grid::fit_grid`]). The paper
 //! samples and parameterizes uniformly; the samples here are uniform in each
 //! curve's chord-length parameter and the grid fit averages chord lengths
@@ -16,7 +16,7 @@
 //! parameters) is projected onto the cloud along the surface normal by
 //! directed projection, then relaxed and re-interpolated. The paper says
 //! only that the relaxation "is the method used in the DBS approach"
-//! (Azariadis 2004) and prints no formula; we relax as a tangential
+//! ([Aza04]) and prints no formula; we relax as a tangential
 //! umbrella (Laplacian) step: each grid point moves by `lambda` times the
 //! part of `(mean of its grid neighbours) - point` in the tangent plane of
 //! the base surface, neighbours around the axis and, inside, along it. The

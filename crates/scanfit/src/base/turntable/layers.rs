@@ -1,9 +1,9 @@
-//! Layer curves (turntable paper sections 3.4-3.5).
+//! Layer curves ([TURN17] sections 3.4-3.5).
 //!
 //! On every layer (constant height along the axis) the polygon left by the
 //! intersection pairs ([`super::views::layer_polygon`]), without its
 //! outliers, is interpolated by a closed cubic B-spline (global
-//! interpolation, *The NURBS Book* section 9.2.1, closed form) with chord
+//! interpolation, [NURBS97] section 9.2.1, closed form) with chord
 //! length parameters.
 //!
 //! Two departures from section 3.4, stated: (1) the paper interpolates an
@@ -18,7 +18,7 @@
 //!
 //! The curve is then sampled uniformly in its parameter with as many samples
 //! as the layer kept points, and every sample is moved by directed
-//! projection (Azariadis 2004, eqs. 7-14) along the curve normal inside the
+//! projection ([Aza04], eqs. 7-14) along the curve normal inside the
 //! layer plane, `n = C'(u) x a`, with the weight factor of eq. 19 by default
 //! (eqs. 15 and 16 selectable). One round is one projection step per sample
 //! (the paper's Tables 1-2 count these), followed by re-interpolation and

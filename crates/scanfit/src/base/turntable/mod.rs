@@ -1,5 +1,5 @@
 //! The virtual turntable parameterization of cylindrical point clouds
-//! (Kim et al., `cylindrical-turntable-parameterization.txt`), end to end:
+//! ([TURN17]), end to end:
 //!
 //! 1. the axis ([`axis`]): given, or the cloud's principal axis; the centre
 //!    `c0` from Ritter's farthest pair across the axis (section 3.2);

@@ -1,6 +1,6 @@
-//! The virtual turntable (turntable paper sections 3.2-3.3): the cloud turned
+//! The virtual turntable ([TURN17] sections 3.2-3.3): the cloud turned
 //! by `2 pi k / V` about the axis (eq. 17), hidden point removal from `+z`
-//! (Katz, Tal & Basri 2007) for each turn, a multilevel B-spline surface
+//! ([Katz07]) for each turn, a multilevel B-spline surface
 //! `z' = f_k(x', y')` on each visible set, grid points on layers of constant
 //! height, intersection pairs between neighbouring views and the grid points
 //! beyond them discarded.
@@ -40,7 +40,7 @@ pub struct ViewConfig {
     /// Hidden point removal (default `gamma = 2`, see [`HprConfig`]).
     pub hpr: HprConfig,
     /// Multilevel B-splines on each view (default: 6 levels from the
-    /// aspect-ratio base lattice, eq. 4 of Lee, Wolberg & Shin 1997).
+    /// aspect-ratio base lattice, eq. 4 of [LWS97]).
     pub mba: MbaConfig,
     /// Grid points per layer and view (`u` count; default 32). The base
     /// surface gets about `0.7 V` times as many samples around the axis;
