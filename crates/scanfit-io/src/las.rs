@@ -278,6 +278,7 @@ pub(crate) fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<
         },
         file_index: None,
         dropped_non_finite: 0,
+        warnings: Vec::new(),
     }
     .finish(options.non_finite)
 }

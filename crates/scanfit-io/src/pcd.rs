@@ -541,6 +541,7 @@ fn read_binary(path: &Path, bytes: &[u8], h: &Header, plan: Plan) -> Result<Poin
         origin,
         file_index: None,
         dropped_non_finite: 0,
+        warnings: Vec::new(),
     })
 }
 
@@ -674,6 +675,7 @@ fn read_ascii(path: &Path, bytes: &[u8], h: &Header, plan: Plan) -> Result<Point
         origin: Origin::Lines(lines),
         file_index: None,
         dropped_non_finite: 0,
+        warnings: Vec::new(),
     })
 }
 

@@ -473,6 +473,7 @@ fn read_binary(
         },
         file_index: None,
         dropped_non_finite: 0,
+        warnings: Vec::new(),
     })
 }
 
@@ -539,6 +540,7 @@ fn read_binary_lists(
         origin: Origin::Offsets(offsets),
         file_index: None,
         dropped_non_finite: 0,
+        warnings: Vec::new(),
     })
 }
 
@@ -673,6 +675,7 @@ fn read_ascii(
         origin: Origin::Lines(line_numbers),
         file_index: None,
         dropped_non_finite: 0,
+        warnings: Vec::new(),
     })
 }
 
