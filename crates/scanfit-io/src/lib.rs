@@ -11,6 +11,7 @@ mod atomic;
 mod binary;
 pub mod cloud;
 mod error;
+pub mod fuzz;
 pub mod gltf;
 pub mod iges;
 pub mod json;
