@@ -132,7 +132,10 @@ pub fn write_all_atomic<P: AsRef<Path>, B: AsRef<[u8]>>(files: &[(P, B)]) -> Res
     );
     let mut txn = Transaction {
         entries: Vec::new(),
-        journals: dirs.iter().map(|d| d.join(format!("{JOURNAL}{run}"))).collect(),
+        journals: dirs
+            .iter()
+            .map(|d| d.join(format!("{JOURNAL}{run}")))
+            .collect(),
         pause: pause(),
     };
     // stage
@@ -165,7 +168,9 @@ pub fn write_all_atomic<P: AsRef<Path>, B: AsRef<[u8]>>(files: &[(P, B)]) -> Res
     for k in 0..txn.entries.len() {
         if let Err(error) = txn.commit(k) {
             txn.abort(k + 1);
-            let path = regular.get(k).map_or_else(PathBuf::new, |r| r.0.to_path_buf());
+            let path = regular
+                .get(k)
+                .map_or_else(PathBuf::new, |r| r.0.to_path_buf());
             return Err(Error::Io { path, error });
         }
     }
@@ -461,7 +466,10 @@ impl Transaction {
 /// `SCANFIT_ATOMIC_PAUSE_MS`: milliseconds to sleep after each step of a
 /// run (tests only: it widens every phase so a kill can land in it).
 fn pause() -> Option<std::time::Duration> {
-    let ms: u64 = std::env::var("SCANFIT_ATOMIC_PAUSE_MS").ok()?.parse().ok()?;
+    let ms: u64 = std::env::var("SCANFIT_ATOMIC_PAUSE_MS")
+        .ok()?
+        .parse()
+        .ok()?;
     Some(std::time::Duration::from_millis(ms))
 }
 
@@ -562,7 +570,8 @@ mod tests {
     use super::*;
 
     fn tmpdir(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("scanfit-atomic-{name}-{}", std::process::id()));
+        let dir =
+            std::env::temp_dir().join(format!("scanfit-atomic-{name}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         dir
@@ -649,7 +658,10 @@ mod tests {
         txn.commit(0).unwrap();
         txn.commit(1).unwrap();
         assert_eq!(std::fs::read(&a).unwrap(), b"new a");
-        assert!(txn.commit(2).is_err(), "renaming a file over a non-empty directory");
+        assert!(
+            txn.commit(2).is_err(),
+            "renaming a file over a non-empty directory"
+        );
         txn.abort(3);
         assert_eq!(std::fs::read(&a).unwrap(), b"old a");
         assert!(!d.exists());
@@ -664,16 +676,24 @@ mod tests {
         std::fs::write(&input, b"1 2 3\n").unwrap();
         let link = dir.join("link.xyz");
         std::os::unix::fs::symlink(&input, &link).unwrap();
-        let e = check_paths(&[&input], &[dir.join("o.json"), dir.join(".").join("o.json")])
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("o.json: this output is given twice (also as"), "{e}");
+        let e = check_paths(
+            &[&input],
+            &[dir.join("o.json"), dir.join(".").join("o.json")],
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("o.json: this output is given twice (also as"),
+            "{e}"
+        );
         let e = check_paths(&[&input], &[&link]).unwrap_err().to_string();
         assert!(e.contains("link.xyz: this output is the input file"), "{e}");
         assert!(check_paths(&[&input], &[dir.join("o.json")]).is_ok());
         // write_all_atomic refuses duplicates before writing anything
         let o = dir.join("o.json");
-        let e = write_all_atomic(&[(&o, b"1"), (&o, b"2")]).unwrap_err().to_string();
+        let e = write_all_atomic(&[(&o, b"1"), (&o, b"2")])
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("given twice"), "{e}");
         assert!(!o.exists());
         std::fs::remove_dir_all(&dir).unwrap();
@@ -687,17 +707,26 @@ mod tests {
         let link = dir.join("link.txt");
         std::os::unix::fs::symlink("real.txt", &link).unwrap();
         write_atomic(&link, b"new").unwrap();
-        assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+        assert!(std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink());
         assert_eq!(std::fs::read(&real).unwrap(), b"new");
         // a dangling link: its target is created
         let dangling = dir.join("dangling.txt");
         std::os::unix::fs::symlink("made.txt", &dangling).unwrap();
         write_atomic(&dangling, b"made").unwrap();
         assert_eq!(std::fs::read(dir.join("made.txt")).unwrap(), b"made");
-        assert!(std::fs::symlink_metadata(&dangling).unwrap().file_type().is_symlink());
+        assert!(std::fs::symlink_metadata(&dangling)
+            .unwrap()
+            .file_type()
+            .is_symlink());
         // a FIFO is written to, not replaced
         let fifo = dir.join("pipe");
-        let st = std::process::Command::new("mkfifo").arg(&fifo).status().unwrap();
+        let st = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap();
         assert!(st.success());
         let reader = {
             let fifo = fifo.clone();
@@ -740,14 +769,20 @@ mod tests {
             pause: None,
         };
         // killed after the first rename: rolled back
-        txn.entries.iter().zip([&b"new a"[..], b"new b"]).for_each(|(e, c)| stage(e, c).unwrap());
+        txn.entries
+            .iter()
+            .zip([&b"new a"[..], b"new b"])
+            .for_each(|(e, c)| stage(e, c).unwrap());
         txn.journal(State::Renaming).unwrap();
         txn.commit(0).unwrap();
         assert_eq!(recover(&dir).unwrap(), 1, "one journal");
         assert_eq!(std::fs::read(&a).unwrap(), b"old a");
         assert_eq!(listing(&dir), ["a.txt"]);
         // killed after every rename, before the clean-up: rolled forward
-        txn.entries.iter().zip([&b"new a"[..], b"new b"]).for_each(|(e, c)| stage(e, c).unwrap());
+        txn.entries
+            .iter()
+            .zip([&b"new a"[..], b"new b"])
+            .for_each(|(e, c)| stage(e, c).unwrap());
         txn.journal(State::Renaming).unwrap();
         txn.commit(0).unwrap();
         txn.commit(1).unwrap();

@@ -412,7 +412,12 @@ pub const MAX_DEGREE: usize = 64;
 /// A document's degree checked before any knot vector is built from it:
 /// at least 1, at most [`MAX_DEGREE`], and below the number of knots (a
 /// degree-p B-spline needs at least 2(p + 1) knots).
-fn check_degree(degree: usize, knots: usize, name: &str, knots_name: &str) -> std::result::Result<(), String> {
+fn check_degree(
+    degree: usize,
+    knots: usize,
+    name: &str,
+    knots_name: &str,
+) -> std::result::Result<(), String> {
     if degree == 0 || degree > MAX_DEGREE {
         return Err(format!(
             "{name} is {degree}; give a degree from 1 to {MAX_DEGREE}"

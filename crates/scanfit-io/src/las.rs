@@ -270,18 +270,28 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<()> {
     let start = raw.offset_to_points;
     // the chunk table: its offset is the first 8 bytes of the point data
     // (or, when that is not past them, the last 8 bytes of the file)
-    let table = usize::try_from(start).ok().and_then(|s| u64_at(bytes, s)).and_then(|o| {
-        if (o as i64) > start as i64 {
-            Some(o)
-        } else {
-            bytes.len().checked_sub(8).and_then(|k| u64_at(bytes, k)).filter(|&o| (o as i64) > start as i64)
-        }
-    });
+    let table = usize::try_from(start)
+        .ok()
+        .and_then(|s| u64_at(bytes, s))
+        .and_then(|o| {
+            if (o as i64) > start as i64 {
+                Some(o)
+            } else {
+                bytes
+                    .len()
+                    .checked_sub(8)
+                    .and_then(|k| u64_at(bytes, k))
+                    .filter(|&o| (o as i64) > start as i64)
+            }
+        });
     let data_end = match table {
         Some(t) if t < len => {
             // every chunk starts with one raw point: a table with more
             // entries than the data between could hold is a damaged file
-            let chunks = usize::try_from(t).ok().and_then(|t| u32_at(bytes, t + 4)).unwrap_or(0);
+            let chunks = usize::try_from(t)
+                .ok()
+                .and_then(|t| u32_at(bytes, t + 4))
+                .unwrap_or(0);
             let room = t.saturating_sub(start + 8) / items_size.max(1);
             if u64::from(chunks) > room {
                 return Err(binary(t, format!(
@@ -301,7 +311,8 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<()> {
     }
     // the point counts of variable-size chunks come from the chunk table
     let table_counts: Option<Vec<u64>> = if chunk_size == u32::MAX {
-        let lazvlr = laz::LazVlr::from_buffer(vlr).map_err(|e| binary(vlr_at, format!("the LASzip VLR is damaged: {e}")))?;
+        let lazvlr = laz::LazVlr::from_buffer(vlr)
+            .map_err(|e| binary(vlr_at, format!("the LASzip VLR is damaged: {e}")))?;
         let mut cursor = Cursor::new(bytes);
         cursor.set_position(start);
         laz::laszip::ChunkTable::read_from(&mut cursor, &lazvlr)
@@ -317,7 +328,10 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<()> {
     let mut chunk = 0usize;
     while left > 0 {
         let head = first_point + 4 + 4 * layers;
-        let Some(p) = usize::try_from(pos).ok().filter(|_| pos.saturating_add(head) <= data_end) else {
+        let Some(p) = usize::try_from(pos)
+            .ok()
+            .filter(|_| pos.saturating_add(head) <= data_end)
+        else {
             return Err(binary(pos, format!(
                 "the header declares {count} points, but the compressed data ends after {} of them (chunk {chunk}); the file is truncated",
                 count - left

@@ -104,7 +104,10 @@ fn a_few_kilobyte_laz_cannot_ask_for_gigabytes() {
     let mut bomb = good.clone();
     put_u32(&mut bomb, table + 4, u32::MAX);
     let e = read("s.laz", &bomb).unwrap_err();
-    assert!(e.contains("the LAZ chunk table declares 4294967295 chunks"), "{e}");
+    assert!(
+        e.contains("the LAZ chunk table declares 4294967295 chunks"),
+        "{e}"
+    );
     // a point count of 4 billion in a 428-byte file
     let mut bomb = good.clone();
     put_u32(&mut bomb, 107, u32::MAX);
@@ -114,7 +117,10 @@ fn a_few_kilobyte_laz_cannot_ask_for_gigabytes() {
     let mut bomb = good.clone();
     bomb[105..107].copy_from_slice(&60_000u16.to_le_bytes());
     let e = read("s.laz", &bomb).unwrap_err();
-    assert!(e.contains("the LASzip items describe 34-byte points"), "{e}");
+    assert!(
+        e.contains("the LASzip items describe 34-byte points"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -173,7 +179,10 @@ fn las_counts_that_disagree_with_the_data() {
     let mut more = good.clone();
     put_u32(&mut more, 107, n + 1);
     let e = read("s.las", &more).unwrap_err();
-    assert!(e.contains(&format!("declares {} point records", n + 1)), "{e}");
+    assert!(
+        e.contains(&format!("declares {} point records", n + 1)),
+        "{e}"
+    );
     // the intact file: no warning
     assert!(read("s.las", &good).unwrap().warnings.is_empty());
 }
@@ -196,7 +205,10 @@ fn json_documents_with_huge_degrees_are_errors() {
     let e = parse_curve(Path::new("c.json"), &curve.replace("DEG", "2"))
         .unwrap_err()
         .to_string();
-    assert!(e.contains("degree 2 needs at least 6 knots, but knots has 4"), "{e}");
+    assert!(
+        e.contains("degree 2 needs at least 6 knots, but knots has 4"),
+        "{e}"
+    );
     let surface = r#"{"schema":"scanfit/1","type":"bspline_surface","degree_u":DU,"degree_v":DV,
       "periodic_u":false,"periodic_v":false,"knots_u":[0,0,1,1],"knots_v":[0,0,1,1],
       "count_u":CU,"count_v":CV,"control_points":[[0,0,0],[0,1,0],[1,0,0],[1,1,1]],"weights":null}"#;
@@ -208,13 +220,19 @@ fn json_documents_with_huge_degrees_are_errors() {
             .replace("CV", cv)
     };
     assert!(parse_surface(Path::new("s.json"), &doc("1", "1", "2", "2")).is_ok());
-    let e = parse_surface(Path::new("s.json"), &doc("18446744073709551615", "1", "2", "2"))
-        .unwrap_err()
-        .to_string();
+    let e = parse_surface(
+        Path::new("s.json"),
+        &doc("18446744073709551615", "1", "2", "2"),
+    )
+    .unwrap_err()
+    .to_string();
     assert!(e.contains("degree_u is 18446744073709551615"), "{e}");
-    let e = parse_surface(Path::new("s.json"), &doc("1", "18446744073709551615", "2", "2"))
-        .unwrap_err()
-        .to_string();
+    let e = parse_surface(
+        Path::new("s.json"),
+        &doc("1", "18446744073709551615", "2", "2"),
+    )
+    .unwrap_err()
+    .to_string();
     assert!(e.contains("degree_v is 18446744073709551615"), "{e}");
     // a net whose size overflows
     let e = parse_surface(
@@ -223,5 +241,10 @@ fn json_documents_with_huge_degrees_are_errors() {
     )
     .unwrap_err()
     .to_string();
-    assert!(e.contains("count_u x count_v = 4294967296 x 4294967296 does not match the 4 control points"), "{e}");
+    assert!(
+        e.contains(
+            "count_u x count_v = 4294967296 x 4294967296 does not match the 4 control points"
+        ),
+        "{e}"
+    );
 }
