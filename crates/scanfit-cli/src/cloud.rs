@@ -252,6 +252,7 @@ impl InputArgs {
             },
         };
         let table = read_cloud(&self.input, &options)?;
+        crate::print_warnings(&table.warnings);
         let dropped = table.dropped_non_finite;
         Ok((table.into_cloud()?, dropped))
     }

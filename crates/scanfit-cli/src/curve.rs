@@ -141,7 +141,9 @@ pub fn run(cmd: CurveCommand) -> Result<()> {
 
 /// Reads the input, with a file-level error message.
 fn load(path: &Path) -> Result<PointTable> {
-    Ok(read_points(path)?)
+    let table = read_points(path)?;
+    crate::print_warnings(&table.warnings);
+    Ok(table)
 }
 
 /// Adds `file:line` to library errors that name point indices.

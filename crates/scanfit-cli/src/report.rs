@@ -76,6 +76,7 @@ pub fn run(a: ReportArgs) -> Result<()> {
     progress.stage("reading");
     let (doc, surface) = read_surface(&a.surface)?;
     let table = read_points(&a.input)?;
+    crate::print_warnings(&table.warnings);
     let pts = &table.points;
     progress.stage(format!("projecting {} points", pts.len()));
     let inverter = SurfaceInverter::new(&surface, InversionConfig::default())?;

@@ -91,6 +91,7 @@ pub fn run(a: FitArgs) -> Result<()> {
     let progress = Progress::spinner(a.quiet);
     progress.stage(format!("reading {}", a.input.display()));
     let table = read_points(&a.input)?;
+    crate::print_warnings(&table.warnings);
     let pts = &table.points;
     progress.stage("parameterizing");
     let mut uv: Vec<[f64; 2]> = match a.params.as_str() {
