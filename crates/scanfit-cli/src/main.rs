@@ -114,7 +114,12 @@ fn exit_quietly_on_broken_pipe() {
         // the failed print left nothing behind: a one-byte probe fails with
         // EPIPE on a closed pipe (and then writes nothing)
         if payload.starts_with("failed printing to stdout")
-            && broken(std::io::stdout().lock().write_all(b"\n").and_then(|()| std::io::stdout().flush()))
+            && broken(
+                std::io::stdout()
+                    .lock()
+                    .write_all(b"\n")
+                    .and_then(|()| std::io::stdout().flush()),
+            )
         {
             std::process::exit(EXIT_BROKEN_PIPE);
         }

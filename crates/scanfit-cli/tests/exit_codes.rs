@@ -16,7 +16,10 @@ fn bin() -> Command {
 
 fn no_panic(stderr: &[u8]) {
     let s = String::from_utf8_lossy(stderr);
-    assert!(!s.contains("panicked") && !s.contains("RUST_BACKTRACE"), "{s}");
+    assert!(
+        !s.contains("panicked") && !s.contains("RUST_BACKTRACE"),
+        "{s}"
+    );
 }
 
 #[test]
@@ -49,10 +52,16 @@ fn warnings_of_the_readers_are_printed() {
     let pts = dir.join("scan.pts");
     std::fs::write(&pts, "5\n0 0 0\n1 0 0\n0 1 0\n1 1 1\n").unwrap();
     let o = run(&["cloud", "info", pts.to_str().unwrap()]);
-    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(
-        err.contains("warning: ") && err.contains("scan.pts:1: the count line declares 5 points, but the file holds 4"),
+        err.contains("warning: ")
+            && err.contains("scan.pts:1: the count line declares 5 points, but the file holds 4"),
         "{err}"
     );
     std::fs::remove_dir_all(&dir).unwrap();
@@ -77,8 +86,17 @@ fn closed_stdout_is_141_without_a_panic() {
         let mut err = Vec::new();
         child.stderr.take().unwrap().read_to_end(&mut err).unwrap();
         let status = child.wait().unwrap();
-        assert_eq!(status.code(), Some(141), "{args:?}: {}", String::from_utf8_lossy(&err));
-        assert!(err.is_empty(), "{args:?}: {}", String::from_utf8_lossy(&err));
+        assert_eq!(
+            status.code(),
+            Some(141),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&err)
+        );
+        assert!(
+            err.is_empty(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&err)
+        );
     }
 }
 
@@ -112,7 +130,12 @@ fn closed_stderr_never_panics() {
         .unwrap();
     drop(child.stderr.take());
     let mut out = String::new();
-    child.stdout.take().unwrap().read_to_string(&mut out).unwrap();
+    child
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_string(&mut out)
+        .unwrap();
     assert_eq!(child.wait().unwrap().code(), Some(0));
     assert!(out.contains("points"), "{out}");
     // stderr closed outright (not a pipe): the same

@@ -601,8 +601,17 @@ fn read_binary_lists(
 /// An ascii file with more records than its header declares: the
 /// non-empty lines after the vertices and the elements that follow them are
 /// reported as a warning (they are not read).
-fn ascii_trailing(path: &Path, bytes: &[u8], header: &Header, table: &mut PointTable, after: &[Element]) {
-    let Some(text) = bytes.get(header.body..).and_then(|b| std::str::from_utf8(b).ok()) else {
+fn ascii_trailing(
+    path: &Path,
+    bytes: &[u8],
+    header: &Header,
+    table: &mut PointTable,
+    after: &[Element],
+) {
+    let Some(text) = bytes
+        .get(header.body..)
+        .and_then(|b| std::str::from_utf8(b).ok())
+    else {
         return;
     };
     let last_vertex = match &table.origin {
@@ -993,5 +1002,98 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("t.ply:15"), "{e}");
+    }
+
+    #[test]
+    fn every_line_ending_in_ascii_files() {
+        for eol in ["\n", "\r\n", "\r"] {
+            let text = [
+                "ply",
+                "format ascii 1.0",
+                "element vertex 2",
+                "property float x",
+                "property float y",
+                "property float z",
+                "end_header",
+                "1 2 3",
+                "4 5 6",
+            ]
+            .join(eol)
+                + eol;
+            let t = read(text.as_bytes()).unwrap();
+            assert_eq!(
+                t.points,
+                vec![Point3::new(1., 2., 3.), Point3::new(4., 5., 6.)],
+                "{eol:?}"
+            );
+            assert_eq!(t.locate(1), "t.ply:9", "{eol:?}");
+            assert!(t.warnings.is_empty(), "{eol:?}: {:?}", t.warnings);
+        }
+    }
+
+    #[test]
+    fn counts_smaller_than_the_data_are_warnings() {
+        let head = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n";
+        // ascii: a third vertex line the header does not declare
+        let t = read(format!("{head}end_header\n1 2 3\n4 5 6\n7 8 9\n").as_bytes()).unwrap();
+        assert_eq!(t.points.len(), 2);
+        assert_eq!(
+            t.warnings,
+            ["t.ply: 1 more non-empty lines follow the records the header declares; they were not read (is the vertex count 2 too small?)"]
+        );
+        // with a face element after the vertices, its lines are expected
+        let faces = format!(
+            "{head}element face 1\nproperty list uchar int vertex_indices\nend_header\n1 2 3\n4 5 6\n3 0 1 0\n"
+        );
+        assert!(read(faces.as_bytes()).unwrap().warnings.is_empty());
+        // binary: a third record after the declared two
+        let mut b = "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
+            .as_bytes()
+            .to_vec();
+        for v in 0..9 {
+            b.extend((v as f32).to_le_bytes());
+        }
+        let t = read(&b).unwrap();
+        assert_eq!(t.points.len(), 2);
+        assert_eq!(
+            t.warnings,
+            ["t.ply: 12 bytes follow the last element the header declares; they were not read (is the vertex count 2 too small?)"]
+        );
+        // a declared face element that the file does not hold: a warning
+        let mut f = "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nelement face 5\nproperty list uchar int vertex_indices\nend_header\n"
+            .as_bytes()
+            .to_vec();
+        for v in 0..6 {
+            f.extend((v as f32).to_le_bytes());
+        }
+        let t = read(&f).unwrap();
+        assert_eq!(t.points.len(), 2);
+        assert!(
+            t.warnings.len() == 1
+                && t.warnings[0].contains("the file ends inside list 'vertex_indices' of face 0"),
+            "{:?}",
+            t.warnings
+        );
+        // more declared than present stays an error
+        let e = read(format!("{head}end_header\n1 2 3\n").as_bytes())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("the file ends after 1 of the 2 vertices"), "{e}");
+    }
+
+    #[test]
+    fn too_many_properties_are_refused() {
+        let mut h = String::from("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n");
+        for k in 0..MAX_COLUMNS {
+            h.push_str(&format!("property uchar p{k}\n"));
+        }
+        h.push_str("end_header\n");
+        let e = read(h.as_bytes()).unwrap_err().to_string();
+        assert!(
+            e.contains(
+                "the vertex element declares 1027 properties; a point file may have at most 1024"
+            ),
+            "{e}"
+        );
     }
 }

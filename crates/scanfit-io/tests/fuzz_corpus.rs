@@ -66,13 +66,24 @@ fn seed_corpora_replay_and_the_intact_seeds_are_accepted() {
     let names: Vec<&str> = r.iter().map(|(t, _, _)| t.as_str()).collect();
     assert_eq!(
         names,
-        ["curve_json", "las", "laz", "pcd", "ply", "surface_json", "text"]
+        [
+            "curve_json",
+            "las",
+            "laz",
+            "pcd",
+            "ply",
+            "surface_json",
+            "text"
+        ]
     );
     for (target, files, accepted) in &r {
         assert!(*files > 0, "{target}: no seeds");
         // the seeds are valid files, except the text seed with an empty
         // field, accepted only under the drop policy (point_file tries both)
-        assert_eq!(accepted, files, "{target}: {accepted} of {files} seeds accepted");
+        assert_eq!(
+            accepted, files,
+            "{target}: {accepted} of {files} seeds accepted"
+        );
     }
 }
 
