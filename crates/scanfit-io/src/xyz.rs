@@ -81,17 +81,14 @@ fn split_fields<'a>(line: &'a str, out: &mut Vec<&'a str>) {
                 }
                 rest = tail;
                 // `1,,3` or `1, ;3`: a delimiter right after a delimiter
-                while delimited {
-                    match rest.strip_prefix(is_delim) {
-                        Some(t) => {
+                if delimited {
+                    while let Some(t) = rest.strip_prefix(is_delim) {
+                        out.push("");
+                        rest = t.trim_start_matches(is_blank);
+                        if rest.is_empty() {
                             out.push("");
-                            rest = t.trim_start_matches(is_blank);
-                            if rest.is_empty() {
-                                out.push("");
-                                return;
-                            }
+                            return;
                         }
-                        None => break,
                     }
                 }
             }

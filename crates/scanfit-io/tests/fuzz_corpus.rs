@@ -44,7 +44,7 @@ fn replay(kind: &str) -> Vec<(String, usize, usize)> {
         let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
             .unwrap()
             .map(|e| e.unwrap().path())
-            .filter(|p| p.is_file() && !p.file_name().is_some_and(|n| n == ".gitkeep"))
+            .filter(|p| p.is_file() && p.file_name().is_none_or(|n| n != ".gitkeep"))
             .collect();
         files.sort();
         let mut accepted = 0;
