@@ -248,3 +248,23 @@ fn json_documents_with_huge_degrees_are_errors() {
         "{e}"
     );
 }
+
+/// Writes the layered LAZ seeds of the fuzz corpus (`fuzz/corpus/laz`) when
+/// `SCANFIT_WRITE_SEEDS` is set; otherwise checks that they still read.
+#[test]
+fn layered_laz_seeds() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/corpus");
+    let seeds = [
+        ("laz/layered6.laz", layered(40, true)),
+        ("las/las14_format6.las", layered(20, false)),
+    ];
+    for (name, bytes) in seeds {
+        let path = dir.join(name);
+        if std::env::var_os("SCANFIT_WRITE_SEEDS").is_some() {
+            std::fs::write(&path, &bytes).unwrap();
+        }
+        let on_disk = std::fs::read(&path).unwrap();
+        let n = if name.ends_with(".laz") { 40 } else { 20 };
+        assert_eq!(read(name, &on_disk).unwrap().points.len(), n);
+    }
+}
