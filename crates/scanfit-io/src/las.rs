@@ -575,3 +575,29 @@ pub(crate) fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<
     }
     .finish(options.non_finite)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    static SEEN: AtomicUsize = AtomicUsize::new(0);
+
+    #[test]
+    fn decoder_panics_are_caught_silently_and_the_hook_restored() {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(|info| {
+            if info.payload().downcast_ref::<&str>() == Some(&"quietly-test") {
+                SEEN.fetch_add(1, Ordering::SeqCst);
+            }
+        }));
+        // inside: caught, and the hook (which would count it) not called
+        assert_eq!(quietly(|| -> u32 { panic!("quietly-test") }), None);
+        assert_eq!(quietly(|| 7), Some(7));
+        assert_eq!(SEEN.load(Ordering::SeqCst), 0);
+        // outside: the hook is back
+        let _ = std::panic::catch_unwind(|| panic!("quietly-test"));
+        assert_eq!(SEEN.load(Ordering::SeqCst), 1);
+        std::panic::set_hook(previous);
+    }
+}
