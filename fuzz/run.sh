@@ -33,8 +33,10 @@ for t in "${targets[@]}"; do
   cargo +nightly fuzz run -s none -a "$t" "work/$t" "corpus/$t" "regressions/$t" -- \
     -max_total_time="$secs" -rss_limit_mb=2048 -timeout=10 -max_len=65536 \
     -print_final_stats=1 >"$log" 2>&1 || status=$?
-  execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)
-  cov=$(grep -oE '(#[0-9]+).*cov: [0-9]+ ft: [0-9]+' "$log" | tail -1 | grep -oE 'cov: [0-9]+ ft: [0-9]+')
+  # (a crashed run has no final stats: take the last status line)
+  execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1 || true)
+  [ -n "$execs" ] || execs=$(grep -oE '^#[0-9]+' "$log" | tail -1 | tr -d '#' || true)
+  cov=$(grep -oE 'cov: [0-9]+ ft: [0-9]+' "$log" | tail -1 || true)
   line="$t: ${secs}s, ${execs:-?} executions, ${cov:-cov ?}, exit $status"
   echo "$line" | tee -a work/summary.txt
   if [ "$status" -ne 0 ]; then

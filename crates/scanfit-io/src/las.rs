@@ -264,9 +264,8 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<()> {
             raw.record_len
         )));
     }
-    if count == 0 {
-        return Ok(());
-    }
+    // (even with no points: the decoder reads the chunk table when it is
+    // built)
     let start = raw.offset_to_points;
     // the chunk table: its offset is the first 8 bytes of the point data
     // (or, when that is not past them, the last 8 bytes of the file)

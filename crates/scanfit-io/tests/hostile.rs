@@ -268,3 +268,14 @@ fn layered_laz_seeds() {
         assert_eq!(read(name, &on_disk).unwrap().points.len(), n);
     }
 }
+
+/// Fuzz finding (laz target): a LAZ file declaring no points still has its
+/// chunk table read by the decoder, which reserved 31 GB for it.
+#[test]
+fn a_chunk_table_is_checked_even_without_points() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fuzz/regressions/laz/chunk-table-with-zero-points.laz");
+    let bytes = std::fs::read(path).unwrap();
+    let e = read("f.laz", &bytes).unwrap_err();
+    assert!(e.contains("the LAZ chunk table declares"), "{e}");
+}
