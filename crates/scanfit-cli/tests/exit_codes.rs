@@ -146,3 +146,55 @@ fn closed_stderr_never_panics() {
         .unwrap();
     assert_eq!(o.status.code(), Some(1));
 }
+
+#[test]
+fn an_output_given_twice_or_equal_to_the_input_is_refused_before_work() {
+    let dir = tmpdir("exit", "paths");
+    let doc = dir.join("c.json");
+    std::fs::copy(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../fuzz/corpus/curve_json/cubic.json"),
+        &doc,
+    )
+    .unwrap();
+    let out = dir.join("out.stp");
+    let o = run(&[
+        "export",
+        doc.to_str().unwrap(),
+        "--step",
+        out.to_str().unwrap(),
+        "--iges",
+        dir.join("./out.stp").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("this output is given twice"), "{err}");
+    assert!(!out.exists());
+    let o = run(&[
+        "export",
+        doc.to_str().unwrap(),
+        "--step",
+        doc.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("this output is the input file"), "{err}");
+    assert!(std::fs::read_to_string(&doc)
+        .unwrap()
+        .contains("bspline_curve"));
+    // the same command with distinct outputs works
+    let o = run(&[
+        "export",
+        doc.to_str().unwrap(),
+        "--step",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(out.exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
