@@ -250,12 +250,6 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
     let values = fields
         .iter()
         .try_fold(0usize, |acc, f| acc.checked_add(f.count));
-    if let Some(v) = values.filter(|&v| v > MAX_COLUMNS) {
-        return Err(perr(
-            line_no,
-            format!("the fields declare {v} values per point; a point file may have at most {MAX_COLUMNS}"),
-        ));
-    }
     match (record, values) {
         (Some(r), Some(v)) if r <= bytes.len() && v <= bytes.len() => {}
         _ => {
@@ -267,6 +261,12 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
                 ),
             ))
         }
+    }
+    if let Some(v) = values.filter(|&v| v > MAX_COLUMNS) {
+        return Err(perr(
+            line_no,
+            format!("the fields declare {v} values per point; a point file may have at most {MAX_COLUMNS}"),
+        ));
     }
     let mut warnings = Vec::new();
     if let (Some(p), Some(w)) = (points, width) {
