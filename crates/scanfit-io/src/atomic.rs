@@ -207,7 +207,7 @@ pub fn write_all_atomic<P: AsRef<Path>, B: AsRef<[u8]>>(files: &[(P, B)]) -> Res
 /// assert!(ok.is_ok());
 /// let twice = scanfit_io::check_paths(&[&input], &[dir.join("a.json"), dir.join("./a.json")]);
 /// assert!(twice.unwrap_err().to_string().contains("given twice"));
-/// let onto_input = scanfit_io::check_paths(&[&input], &[dir.join("x/../scan.ply")]);
+/// let onto_input = scanfit_io::check_paths(&[&input], &[dir.join(".").join("scan.ply")]);
 /// assert!(onto_input.unwrap_err().to_string().contains("is the input"));
 /// ```
 pub fn check_paths<I: AsRef<Path>, O: AsRef<Path>>(inputs: &[I], outputs: &[O]) -> Result<()> {
