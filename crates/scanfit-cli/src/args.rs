@@ -306,6 +306,14 @@ impl InputArgs {
     /// in the file, for messages); tells about dropped points as
     /// [`InputArgs::load`] does.
     pub fn table(&self, quiet: bool) -> Result<PointTable> {
+        let table = self.read()?;
+        note_dropped(table.dropped_non_finite, quiet);
+        Ok(table)
+    }
+
+    /// Reads the file with this group's options; the reader's warnings (a
+    /// header count that disagrees with the data, ...) go to stderr.
+    fn read(&self) -> Result<PointTable> {
         let options = ReadOptions {
             format: self.format.map(Format::from),
             non_finite: if self.drop_non_finite {
@@ -315,9 +323,17 @@ impl InputArgs {
             },
         };
         let table = read_cloud(&self.input, &options)?;
-        note_dropped(table.dropped_non_finite, quiet);
+        crate::print_warnings(&table.warnings);
         Ok(table)
     }
+}
+
+/// Reads a point file with the default options (format by extension,
+/// non-finite coordinates refused); the reader's warnings go to stderr.
+pub fn read_points_warned(path: &std::path::Path) -> Result<PointTable> {
+    let table = scanfit_io::read_points(path)?;
+    crate::print_warnings(&table.warnings);
+    Ok(table)
 }
 
 /// The one place that tells how many non-finite points were dropped.
@@ -355,15 +371,7 @@ impl InputArgs {
     /// the number of non-finite points dropped, telling nothing (for reports
     /// that show the count themselves).
     pub fn load_counted(&self) -> Result<(PointCloud, usize)> {
-        let options = ReadOptions {
-            format: self.format.map(Format::from),
-            non_finite: if self.drop_non_finite {
-                NonFinite::Drop
-            } else {
-                NonFinite::Reject
-            },
-        };
-        let table = read_cloud(&self.input, &options)?;
+        let table = self.read()?;
         let dropped = table.dropped_non_finite;
         Ok((table.into_cloud()?, dropped))
     }

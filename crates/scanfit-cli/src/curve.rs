@@ -13,7 +13,7 @@ use scanfit::quality::CurveQuality;
 use scanfit_io::json::{CurveDoc, QualityDoc};
 use scanfit_io::step::CadItem;
 use scanfit_io::svg::{curve_panels, curve_panels_png, Panel, PanelSize};
-use scanfit_io::{read_points, write_all_atomic, PointTable};
+use scanfit_io::{write_all_atomic, PointTable};
 use serde::Serialize;
 
 use crate::args::{option_note, Parsed, Vectors, VECTORS};
@@ -237,7 +237,7 @@ fn fit_cmd(a: FitArgs) -> Result<()> {
     let config = a.config()?;
     let progress = Progress::spinner(a.quiet);
     progress.stage(format!("reading {}", a.input.display()));
-    let table = read_points(&a.input)?;
+    let table = crate::args::read_points_warned(&a.input)?;
     let pts = &table.points;
     let r = fit_curve(pts, &config, &progress).map_err(|e| locate(&e, &table))?;
     progress.finish();
@@ -373,7 +373,7 @@ struct CompareRow {
 }
 
 fn compare_cmd(a: CompareArgs) -> Result<()> {
-    let table = read_points(&a.input)?;
+    let table = crate::args::read_points_warned(&a.input)?;
     let pts = &table.points;
     let progress = Progress::bar(a.quiet, Method::ALL.len() as u64);
     let mut config = CompareConfig::default();

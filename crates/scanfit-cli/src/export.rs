@@ -63,6 +63,10 @@ fn read_item(path: &Path) -> Result<Item> {
 
 /// Runs `scanfit export`.
 pub fn run(a: ExportArgs) -> Result<()> {
+    scanfit_io::check_paths(
+        &a.inputs,
+        &[&a.step, &a.iges].into_iter().flatten().collect::<Vec<_>>(),
+    )?;
     check_extensions(&[
         (&a.step, "--step", &["stp", "step"][..]),
         (&a.iges, "--iges", &["igs", "iges"][..]),

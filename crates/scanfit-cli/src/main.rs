@@ -57,39 +57,127 @@ enum Command {
     Turntable(turntable::TurntableArgs),
 }
 
-fn main() {
-    // `scanfit ... | head`: a closed stdout ends the program quietly, as for
-    // any Unix tool, instead of a panic message from println!
+/// Exit status: the command ran and succeeded.
+const EXIT_OK: i32 = 0;
+/// Exit status: the command failed (bad input, a fit that cannot be done,
+/// an output that cannot be written); the message says why.
+const EXIT_ERROR: i32 = 1;
+/// Exit status: the command line is wrong (unknown option, missing or
+/// malformed value); clap's message says what to change.
+const EXIT_USAGE: i32 = 2;
+/// Exit status: stdout or stderr was closed by its reader (`scanfit ... |
+/// head`): 128 + SIGPIPE, as a shell reports a Unix tool killed by SIGPIPE.
+const EXIT_BROKEN_PIPE: i32 = 141;
+
+/// Whether `e` is, or is caused by, a write to a closed pipe.
+fn is_broken_pipe(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| {
+        c.downcast_ref::<std::io::Error>()
+            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+            || c.downcast_ref::<scanfit_io::Error>().is_some_and(|s| {
+                matches!(s, scanfit_io::Error::Io { error, .. } if error.kind() == std::io::ErrorKind::BrokenPipe)
+            })
+    })
+}
+
+/// Prints a line on stderr; a closed stderr is not an error of the command
+/// (nothing can be reported on it), so the failure is ignored.
+fn print_stderr(line: std::fmt::Arguments<'_>) {
+    use std::io::Write;
+    let mut err = std::io::stderr().lock();
+    let _ = err.write_fmt(line).and_then(|()| err.write_all(b"\n"));
+}
+
+/// Prints the warnings of a reader (`PointTable::warnings`: a header count
+/// that disagrees with the data, ...) on stderr.
+pub(crate) fn print_warnings(warnings: &[String]) {
+    for w in warnings {
+        print_stderr(format_args!("warning: {w}"));
+    }
+}
+
+/// The commands print with `println!`, which panics when stdout is a closed
+/// pipe. This hook turns exactly that panic into a quiet exit 141: it acts
+/// only on the panic of the standard library's print functions, and only
+/// after a write to stdout (resp. stderr) fails with
+/// `io::ErrorKind::BrokenPipe`; every other panic goes to the default hook
+/// (exit 101, an internal error).
+fn exit_quietly_on_broken_pipe() {
     let default_hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
-        let msg = info
+        use std::io::Write;
+        let payload = info
             .payload()
             .downcast_ref::<String>()
             .map(String::as_str)
             .or_else(|| info.payload().downcast_ref::<&str>().copied())
             .unwrap_or("");
-        if msg.contains("failed printing to stdout") && msg.contains("Broken pipe") {
-            std::process::exit(141);
+        let broken = |probe: std::io::Result<()>| {
+            probe.is_err_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
+        };
+        // the failed print left nothing behind: a one-byte probe fails with
+        // EPIPE on a closed pipe (and then writes nothing)
+        if payload.starts_with("failed printing to stdout")
+            && broken(
+                std::io::stdout()
+                    .lock()
+                    .write_all(b"\n")
+                    .and_then(|()| std::io::stdout().flush()),
+            )
+        {
+            std::process::exit(EXIT_BROKEN_PIPE);
+        }
+        if payload.starts_with("failed printing to stderr")
+            && broken(std::io::stderr().lock().write_all(b"\n"))
+        {
+            std::process::exit(EXIT_BROKEN_PIPE);
         }
         default_hook(info);
     }));
-    // a value refused by a typed option parser is bad input (status 1, like
-    // any other); a malformed command line is a usage error (clap's status 2)
+}
+
+fn main() {
+    exit_quietly_on_broken_pipe();
     let cli = match Cli::try_parse() {
-        Ok(c) => c,
-        Err(e) if e.kind() == clap::error::ErrorKind::ValueValidation => {
-            let _ = e.print();
-            std::process::exit(1);
+        Ok(cli) => cli,
+        Err(e) => {
+            // --help and --version print on stdout and succeed; a value
+            // refused by a typed option parser is bad input (status 1, like
+            // any other refused value); every other parse error is a usage
+            // error on stderr (status 2)
+            let code = if !e.use_stderr() {
+                EXIT_OK
+            } else if e.kind() == clap::error::ErrorKind::ValueValidation {
+                EXIT_ERROR
+            } else {
+                EXIT_USAGE
+            };
+            match e.print() {
+                Err(io) if io.kind() == std::io::ErrorKind::BrokenPipe && !e.use_stderr() => {
+                    std::process::exit(EXIT_BROKEN_PIPE)
+                }
+                _ => std::process::exit(code),
+            }
         }
-        Err(e) => e.exit(),
     };
     let threads = scanfit::par::Threads::from_count(cli.threads);
     let result = scanfit::par::with_threads(threads, || dispatch(cli.command))
         .map_err(anyhow::Error::from)
         .and_then(|r| r);
     if let Err(e) = result {
-        eprintln!("error: {e:#}");
-        std::process::exit(1);
+        if is_broken_pipe(&e) {
+            std::process::exit(EXIT_BROKEN_PIPE);
+        }
+        print_stderr(format_args!("error: {e:#}"));
+        std::process::exit(EXIT_ERROR);
+    }
+    // a closed stdout that nothing wrote to after it closed: flush what is
+    // buffered and report a broken pipe the same way
+    use std::io::Write;
+    if let Err(e) = std::io::stdout().flush() {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(EXIT_BROKEN_PIPE);
+        }
     }
 }
 

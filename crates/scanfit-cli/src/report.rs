@@ -12,7 +12,6 @@ use scanfit::metrics::nearest_points;
 use scanfit::pipeline::measure::{run as measure, MeasureConfig, MeasureReport};
 use scanfit::Point3;
 use scanfit_io::json::{read_surface, SurfaceDoc};
-use scanfit_io::read_points;
 use scanfit_io::render::{render_png, render_points_png, Colouring, RenderOptions};
 use scanfit_io::write_atomic;
 
@@ -221,7 +220,7 @@ pub fn run(a: ReportArgs) -> Result<()> {
     let progress = Progress::spinner(a.quiet);
     progress.stage("reading");
     let (doc, surface) = read_surface(&a.surface)?;
-    let table = read_points(&a.input)?;
+    let table = crate::args::read_points_warned(&a.input)?;
     let pts = &table.points;
     let r = measure(&surface, pts, &MeasureConfig::default(), &progress)?;
     progress.stage("rendering");

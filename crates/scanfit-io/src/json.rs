@@ -202,6 +202,12 @@ pub fn parse_curve(path: &Path, text: &str) -> Result<(CurveDoc, Curve)> {
             message: format!("type is '{}', expected 'bspline_curve'", doc.kind),
         });
     }
+    check_degree(doc.degree, doc.knots.len(), "degree", "knots").map_err(|message| {
+        Error::Invalid {
+            path: path.to_path_buf(),
+            message,
+        }
+    })?;
     let curve = doc.curve().map_err(|error| Error::Geometry {
         path: path.to_path_buf(),
         error,
@@ -347,7 +353,24 @@ pub fn read_surface(path: &Path) -> Result<(SurfaceDoc, Surface)> {
         path: path.to_path_buf(),
         error,
     })?;
-    let doc: SurfaceDoc = serde_json::from_str(&text).map_err(|e| Error::Parse {
+    parse_surface(path, &text)
+}
+
+/// Parses a surface document (`path` for messages only).
+///
+/// ```
+/// use std::path::Path;
+/// let text = r#"{"schema":"scanfit/1","type":"bspline_surface","degree_u":1,"degree_v":1,
+///   "periodic_u":false,"periodic_v":false,"knots_u":[0,0,1,1],"knots_v":[0,0,1,1],
+///   "count_u":2,"count_v":2,"control_points":[[0,0,0],[0,1,0],[1,0,0],[1,1,1]],"weights":null}"#;
+/// let (doc, surface) = scanfit_io::json::parse_surface(Path::new("s.json"), text).unwrap();
+/// assert_eq!(doc.count_u * doc.count_v, surface.control_points().len());
+/// // a degree no knot vector can carry is an error, not an overflow
+/// let bad = text.replace(r#""degree_u":1"#, r#""degree_u":18446744073709551615"#);
+/// assert!(scanfit_io::json::parse_surface(Path::new("s.json"), &bad).is_err());
+/// ```
+pub fn parse_surface(path: &Path, text: &str) -> Result<(SurfaceDoc, Surface)> {
+    let doc: SurfaceDoc = serde_json::from_str(text).map_err(|e| Error::Parse {
         path: path.to_path_buf(),
         line: e.line(),
         message: format!("not a scanfit surface document: {e}"),
@@ -358,11 +381,55 @@ pub fn read_surface(path: &Path) -> Result<(SurfaceDoc, Surface)> {
             message: format!("type is '{}', expected 'bspline_surface'", doc.kind),
         });
     }
+    let invalid = |message: String| Error::Invalid {
+        path: path.to_path_buf(),
+        message,
+    };
+    check_degree(doc.degree_u, doc.knots_u.len(), "degree_u", "knots_u").map_err(invalid)?;
+    check_degree(doc.degree_v, doc.knots_v.len(), "degree_v", "knots_v").map_err(invalid)?;
+    let net = doc.count_u.checked_mul(doc.count_v);
+    if net != Some(doc.control_points.len()) {
+        return Err(invalid(format!(
+            "count_u x count_v = {} x {} does not match the {} control points; give count_u * count_v points, row-major with u slow",
+            doc.count_u,
+            doc.count_v,
+            doc.control_points.len()
+        )));
+    }
     let surface = doc.surface().map_err(|error| Error::Geometry {
         path: path.to_path_buf(),
         error,
     })?;
     Ok((doc, surface))
+}
+
+/// Most degree a document may declare: far beyond any CAD use (CAD
+/// systems stop at 25 or so), small enough that no computation on the
+/// degree (knot counts, basis tables of `(p + 1)^2` entries) can overflow
+/// or allocate without bound.
+pub const MAX_DEGREE: usize = 64;
+
+/// A document's degree checked before any knot vector is built from it:
+/// at least 1, at most [`MAX_DEGREE`], and below the number of knots (a
+/// degree-p B-spline needs at least 2(p + 1) knots).
+fn check_degree(
+    degree: usize,
+    knots: usize,
+    name: &str,
+    knots_name: &str,
+) -> std::result::Result<(), String> {
+    if degree == 0 || degree > MAX_DEGREE {
+        return Err(format!(
+            "{name} is {degree}; give a degree from 1 to {MAX_DEGREE}"
+        ));
+    }
+    let need = 2 * (degree + 1);
+    if knots < need {
+        return Err(format!(
+            "{name} {degree} needs at least {need} knots, but {knots_name} has {knots}; the document is damaged"
+        ));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -14,14 +14,19 @@
 use std::io::Cursor;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
+use std::sync::Mutex;
 
 use scanfit::Point3;
 
 use crate::table::{capacity, Format, Origin, PointTable, ReadOptions};
 use crate::{Error, Result};
 
-/// Points decoded per call into the crate.
+/// Points decoded per call into the crate (fewer for long records: see
+/// [`BATCH_BYTES`]).
 const BATCH: u64 = 1 << 18;
+
+/// Most bytes of decoded records per call into the crate.
+const BATCH_BYTES: u64 = 16 << 20;
 
 fn u16_at(b: &[u8], at: usize) -> Option<u16> {
     b.get(at..at + 2)?.try_into().ok().map(u16::from_le_bytes)
@@ -41,9 +46,30 @@ struct Raw {
     offset_to_points: u64,
     compressed: bool,
     record_len: u64,
+    /// where the point records end: the first EVLR, else the file's end
+    data_end: u64,
+    /// the 1.4 header's 64-bit count, when it and the legacy count disagree
+    count_mismatch: Option<(u64, u64)>,
 }
 
-/// Checks the raw header's sizes against the file before the crate reads it.
+/// LAZ item types of the layered (point formats 6-10) compressor with the
+/// size of their raw first point and their number of layers; `None` for a
+/// type the layered compressor does not use.
+fn layered_item(item_type: u16, size: u16) -> Option<(u64, u64)> {
+    match item_type {
+        10 => Some((30, 9)),
+        11 => Some((6, 1)),
+        12 => Some((8, 2)),
+        13 => Some((29, 1)),
+        14 => Some((u64::from(size), u64::from(size))),
+        _ => None,
+    }
+}
+
+/// Checks the raw header's sizes against the file before the crate reads
+/// it, mirroring what the crate reads: the EVLR fields whenever the version
+/// is 1.4 (whatever the header size says), the first EVLR's 64-bit length,
+/// the point count against the bytes, and the scale factors.
 fn precheck(path: &Path, bytes: &[u8]) -> Result<Raw> {
     let invalid = |message: String| Error::Invalid {
         path: path.to_path_buf(),
@@ -60,13 +86,24 @@ fn precheck(path: &Path, bytes: &[u8]) -> Result<Raw> {
         ));
     }
     let len = bytes.len() as u64;
-    let (Some(minor), Some(header_size), Some(offset), Some(format), Some(record_len)) = (
+    let (
+        Some(major),
+        Some(minor),
+        Some(header_size),
+        Some(offset),
+        Some(format),
+        Some(record_len),
+        Some(legacy_count),
+    ) = (
+        bytes.get(24).copied(),
         bytes.get(25).copied(),
         u16_at(bytes, 94),
         u32_at(bytes, 96),
         bytes.get(104).copied(),
         u16_at(bytes, 105),
-    ) else {
+        u32_at(bytes, 107),
+    )
+    else {
         return Err(invalid(format!(
             "the file ends inside the LAS header ({len} bytes); it is truncated"
         )));
@@ -76,9 +113,29 @@ fn precheck(path: &Path, bytes: &[u8]) -> Result<Raw> {
             "the header declares {header_size} header bytes and point data at byte {offset}, but the file has {len} bytes; it is truncated"
         )));
     }
-    if minor >= 4 && header_size >= 247 {
-        if let (Some(start), Some(count)) = (u64_at(bytes, 235), u32_at(bytes, 243)) {
-            if start > 0 && count > 0 {
+    // the scale factors multiply every integer coordinate: 0 collapses the
+    // cloud onto the offset, a negative one mirrors it, NaN poisons it
+    for (k, axis) in ["x", "y", "z"].into_iter().enumerate() {
+        if let Some(scale) = u64_at(bytes, 131 + 8 * k).map(f64::from_bits) {
+            if !(scale.is_finite() && scale > 0.0) {
+                return Err(binary(
+                    131 + 8 * k as u64,
+                    format!(
+                        "the {axis} scale factor is {scale}; a LAS scale factor must be a positive finite number (typically 0.01 or 0.001); the header is damaged"
+                    ),
+                ));
+            }
+        }
+    }
+    let v14 = major == 1 && minor == 4;
+    let mut data_end = len;
+    let mut count = u64::from(legacy_count);
+    let mut count_mismatch = None;
+    if v14 {
+        // the crate reads these fields for every 1.4 file, whatever
+        // header_size says: check them the same way
+        if let (Some(start), Some(evlrs)) = (u64_at(bytes, 235), u32_at(bytes, 243)) {
+            if start > 0 && evlrs > 0 {
                 let length = start
                     .checked_add(20)
                     .and_then(|at| usize::try_from(at).ok())
@@ -91,36 +148,250 @@ fn precheck(path: &Path, bytes: &[u8]) -> Result<Raw> {
                 });
                 if !fits {
                     return Err(binary(start, format!(
-                        "the extended VLR declared here does not fit in the file's {len} bytes; the file is truncated or its header is damaged"
+                        "the extended VLR declared here{} does not fit in the file's {len} bytes; the file is truncated or its header is damaged",
+                        length.map_or(String::new(), |l| format!(" ({l} bytes)"))
                     )));
                 }
+                data_end = data_end.min(start);
+            }
+        }
+        if let Some(large) = u64_at(bytes, 247) {
+            if legacy_count == 0 {
+                count = large;
+            } else if large != u64::from(legacy_count) {
+                count_mismatch = Some((u64::from(legacy_count), large));
             }
         }
     }
     let compressed = format & 0xc0 != 0;
-    if compressed {
-        // the chunk table: its entry count sizes an allocation in the crate
-        let at = u64_at(bytes, offset as usize).map(|v| v as i64);
-        let table = match at {
-            Some(-1) => bytes.len().checked_sub(8).and_then(|k| u64_at(bytes, k)),
-            Some(v) if v > 0 => Some(v as u64),
-            _ => None,
-        };
-        if let Some(t) = table.and_then(|t| usize::try_from(t).ok()) {
-            if let Some(chunks) = t.checked_add(4).and_then(|k| u32_at(bytes, k)) {
-                if u64::from(chunks) > len {
-                    return Err(binary(t as u64, format!(
-                        "the LAZ chunk table declares {chunks} chunks, more than the file's {len} bytes could hold; the file is damaged"
-                    )));
-                }
-            }
-        }
+    let end_of_points = u64::from(record_len)
+        .checked_mul(count)
+        .and_then(|b| b.checked_add(u64::from(offset)));
+    if end_of_points.is_none() {
+        return Err(invalid(format!(
+            "the header declares {count} point records of {record_len} bytes, more than any file can hold; the header is damaged"
+        )));
     }
     Ok(Raw {
         offset_to_points: u64::from(offset),
         compressed,
         record_len: u64::from(record_len),
+        data_end,
+        count_mismatch,
     })
+}
+
+/// The LAZ checks the decoder does not make: the LASzip VLR's items
+/// against the point record, the chunk table's size against the file, and
+/// (layered compressor, point formats 6-10) every chunk's layer sizes
+/// against the bytes left, walking the chunks the way the decoder will.
+/// Without them a few-kilobyte file can make the decoder allocate
+/// gigabytes (it sizes buffers from these fields before reading).
+fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<()> {
+    let binary = |offset: u64, message: String| Error::Binary {
+        path: path.to_path_buf(),
+        offset,
+        message,
+    };
+    let len = bytes.len() as u64;
+    let header_size = u64::from(u16_at(bytes, 94).unwrap_or(0));
+    let vlrs = u32_at(bytes, 100).unwrap_or(0);
+    let count = {
+        let legacy = u64::from(u32_at(bytes, 107).unwrap_or(0));
+        match (bytes.get(24..26), u64_at(bytes, 247)) {
+            (Some([1, 4]), Some(large)) if legacy == 0 => large,
+            _ => legacy,
+        }
+    };
+    // find the LASzip VLR (user id "laszip encoded", record 22204)
+    let mut at = header_size;
+    let mut laz = None;
+    for _ in 0..vlrs {
+        let Some(start) = usize::try_from(at).ok() else {
+            break;
+        };
+        let (Some(user), Some(record), Some(length)) = (
+            bytes.get(start + 2..start + 18),
+            u16_at(bytes, start + 18),
+            u16_at(bytes, start + 20),
+        ) else {
+            break;
+        };
+        let data = at + 54;
+        if user.starts_with(b"laszip encoded") && record == 22204 {
+            laz = Some((data, u64::from(length)));
+            break;
+        }
+        at = data + u64::from(length);
+    }
+    let Some((vlr_at, vlr_len)) = laz else {
+        // the crate reports a missing LASzip VLR itself
+        return Ok(());
+    };
+    let Some(vlr) = usize::try_from(vlr_at)
+        .ok()
+        .and_then(|v| bytes.get(v..v.checked_add(vlr_len as usize)?))
+    else {
+        return Err(binary(vlr_at, format!(
+            "the LASzip VLR declares {vlr_len} bytes, but the file ends before them; it is truncated"
+        )));
+    };
+    let compressor = u16_at(vlr, 0).unwrap_or(0);
+    let chunk_size = u32_at(vlr, 12).unwrap_or(0);
+    let items = u16_at(vlr, 32).unwrap_or(0);
+    let mut items_size = 0u64;
+    let mut first_point = 0u64;
+    let mut layers = 0u64;
+    let mut layered_ok = true;
+    for k in 0..usize::from(items) {
+        let (Some(ty), Some(size)) = (u16_at(vlr, 34 + 6 * k), u16_at(vlr, 36 + 6 * k)) else {
+            return Err(binary(vlr_at, format!(
+                "the LASzip VLR declares {items} items, but its {vlr_len} bytes hold fewer; the file is damaged"
+            )));
+        };
+        items_size += u64::from(size);
+        match layered_item(ty, size) {
+            Some((raw_size, n)) => {
+                first_point += raw_size;
+                layers += n;
+            }
+            None => layered_ok = false,
+        }
+    }
+    if items_size != raw.record_len {
+        return Err(binary(vlr_at, format!(
+            "the LASzip items describe {items_size}-byte points, but the header's point records have {} bytes; the file is damaged",
+            raw.record_len
+        )));
+    }
+    // (even with no points: the decoder reads the chunk table when it is
+    // built)
+    let start = raw.offset_to_points;
+    // the chunk table: its offset is the first 8 bytes of the point data
+    // (or, when that is not past them, the last 8 bytes of the file)
+    let table = usize::try_from(start)
+        .ok()
+        .and_then(|s| u64_at(bytes, s))
+        .and_then(|o| {
+            if (o as i64) > start as i64 {
+                Some(o)
+            } else {
+                bytes
+                    .len()
+                    .checked_sub(8)
+                    .and_then(|k| u64_at(bytes, k))
+                    .filter(|&o| (o as i64) > start as i64)
+            }
+        });
+    let data_end = match table {
+        Some(t) if t < len => {
+            // every chunk starts with one raw point: a table with more
+            // entries than the data between could hold is a damaged file
+            let chunks = usize::try_from(t)
+                .ok()
+                .and_then(|t| u32_at(bytes, t + 4))
+                .unwrap_or(0);
+            let room = t.saturating_sub(start + 8) / items_size.max(1);
+            if u64::from(chunks) > room {
+                return Err(binary(t, format!(
+                    "the LAZ chunk table declares {chunks} chunks, but the {} bytes of point data hold at most {room}; the file is damaged",
+                    t.saturating_sub(start + 8)
+                )));
+            }
+            t
+        }
+        _ => raw.data_end,
+    };
+    if compressor != 3 {
+        return Ok(());
+    }
+    if !layered_ok {
+        return Err(binary(vlr_at, "the LASzip VLR uses the layered compressor with an item type it does not allow; the file is damaged".into()));
+    }
+    // the point counts of variable-size chunks come from the chunk table
+    let table_counts: Option<Vec<u64>> = if chunk_size == u32::MAX {
+        let lazvlr = laz::LazVlr::from_buffer(vlr)
+            .map_err(|e| binary(vlr_at, format!("the LASzip VLR is damaged: {e}")))?;
+        let mut cursor = Cursor::new(bytes);
+        cursor.set_position(start);
+        laz::laszip::ChunkTable::read_from(&mut cursor, &lazvlr)
+            .ok()
+            .map(|t| (0..t.len()).map(|k| t[k].point_count).collect())
+    } else {
+        None
+    };
+    // walk the chunks as the decoder reads them: a raw first point, the
+    // point count, one 32-bit size per layer, then the layers
+    let mut pos = start + 8;
+    let mut left = count;
+    let mut chunk = 0usize;
+    while left > 0 {
+        let head = first_point + 4 + 4 * layers;
+        let Some(p) = usize::try_from(pos)
+            .ok()
+            .filter(|_| pos.saturating_add(head) <= data_end)
+        else {
+            return Err(binary(pos, format!(
+                "the header declares {count} points, but the compressed data ends after {} of them (chunk {chunk}); the file is truncated",
+                count - left
+            )));
+        };
+        let in_chunk = u64::from(u32_at(bytes, p + first_point as usize).unwrap_or(0));
+        let mut sizes = 0u64;
+        for l in 0..layers as usize {
+            sizes += u64::from(u32_at(bytes, p + (first_point + 4) as usize + 4 * l).unwrap_or(0));
+        }
+        let room = data_end - pos - head;
+        if sizes > room {
+            return Err(binary(pos, format!(
+                "LAZ chunk {chunk} declares {sizes} bytes of layers, but only {room} bytes of point data follow; the file is damaged"
+            )));
+        }
+        let points = match &table_counts {
+            Some(t) => match t.get(chunk) {
+                Some(&c) => c,
+                None => {
+                    return Err(binary(pos, format!(
+                        "the LAZ chunk table lists {} chunks, but the header's {count} points need more; the file is damaged",
+                        t.len()
+                    )))
+                }
+            },
+            None if chunk_size == u32::MAX => in_chunk,
+            None => u64::from(chunk_size),
+        };
+        left = left.saturating_sub(points);
+        pos += head + sizes;
+        chunk += 1;
+    }
+    Ok(())
+}
+
+/// Runs `f`, turning a panic into `None` without the panic message on
+/// stderr: the panic hook is swapped for a silent one around the call (a
+/// counter under a lock keeps concurrent callers from losing the hook) and
+/// restored afterwards.
+fn quietly<T>(f: impl FnOnce() -> T) -> Option<T> {
+    type Hook = Box<dyn Fn(&std::panic::PanicHookInfo<'_>) + Sync + Send + 'static>;
+    static SAVED: Mutex<(usize, Option<Hook>)> = Mutex::new((0, None));
+    let lock = || SAVED.lock().unwrap_or_else(|e| e.into_inner());
+    {
+        let mut saved = lock();
+        if saved.0 == 0 {
+            saved.1 = Some(std::panic::take_hook());
+            std::panic::set_hook(Box::new(|_| {}));
+        }
+        saved.0 += 1;
+    }
+    let result = catch_unwind(AssertUnwindSafe(f)).ok();
+    let mut saved = lock();
+    saved.0 -= 1;
+    if saved.0 == 0 {
+        if let Some(hook) = saved.1.take() {
+            std::panic::set_hook(hook);
+        }
+    }
+    result
 }
 
 /// Columns read from the crate.
@@ -186,10 +457,11 @@ fn read_with_crate(path: &Path, bytes: Vec<u8>, raw: &Raw) -> Result<Decoded> {
     let cap = capacity(n, (avail / record) as usize).min(1 << 24);
     let mut points = Vec::with_capacity(cap);
     let mut columns = vec![Vec::with_capacity(cap); names.len()];
+    let batch = (BATCH_BYTES / record).clamp(1, BATCH);
     let mut pd = las::PointDataBuilder::new().for_header(&header).build();
     let mut read = 0u64;
     while read < n {
-        let got = reader.fill_points(BATCH, &mut pd).map_err(lerr)?;
+        let got = reader.fill_points(batch, &mut pd).map_err(lerr)?;
         if got == 0 {
             break;
         }
@@ -235,14 +507,15 @@ fn read_with_crate(path: &Path, bytes: Vec<u8>, raw: &Raw) -> Result<Decoded> {
 /// Reads a LAS or LAZ file's bytes (`path` is for messages).
 pub(crate) fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<PointTable> {
     let raw = precheck(path, bytes)?;
-    // catch_unwind is used here and only here, around the third-party `las`
-    // crate: our own readers return errors and never panic on file content.
-    let decoded = catch_unwind(AssertUnwindSafe(|| {
-        read_with_crate(path, bytes.to_vec(), &raw)
-    }))
-    .map_err(|_| Error::Invalid {
+    if raw.compressed {
+        laz_check(path, bytes, &raw)?;
+    }
+    // the crate is third-party code: a panic on a damaged file becomes one
+    // error, without its message on stderr. Our own readers return errors
+    // and never panic on file content.
+    let decoded = quietly(|| read_with_crate(path, bytes.to_vec(), &raw)).ok_or_else(|| Error::Invalid {
         path: path.to_path_buf(),
-        message: "the LAS/LAZ reader failed on this file (it is damaged or uses a variant the las crate does not handle)".into(),
+        message: "the LAS/LAZ decoder failed on this file (it is damaged, or uses a variant the las crate does not handle)".into(),
     })??;
     let n = decoded.points.len();
     if (n as u64) < decoded.declared {
@@ -262,6 +535,25 @@ pub(crate) fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<
     }
     let mut columns: Vec<String> = ["x", "y", "z"].iter().map(|s| s.to_string()).collect();
     columns.extend(decoded.names.iter().map(|s| s.to_string()));
+    let mut warnings = Vec::new();
+    if let Some((legacy, large)) = raw.count_mismatch {
+        warnings.push(format!(
+            "{}: the LAS 1.4 header's point count is {large}, but its legacy count is {legacy}; the {legacy} points of the legacy count were read, as the LAS 1.4 specification asks (repair the header)",
+            path.display()
+        ));
+    }
+    if !raw.compressed {
+        let used = raw.offset_to_points + raw.record_len * n as u64;
+        let spare = raw.data_end.saturating_sub(used);
+        if raw.record_len > 0 && spare >= raw.record_len {
+            warnings.push(format!(
+                "{}: the header declares {n} point records, but {spare} more bytes ({} records of {} bytes) follow them; they were not read (the header's point count may be wrong)",
+                path.display(),
+                spare / raw.record_len,
+                raw.record_len
+            ));
+        }
+    }
     PointTable {
         path: path.to_path_buf(),
         format: Format::Las,
@@ -278,6 +570,33 @@ pub(crate) fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<
         },
         file_index: None,
         dropped_non_finite: 0,
+        warnings,
     }
     .finish(options.non_finite)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    static SEEN: AtomicUsize = AtomicUsize::new(0);
+
+    #[test]
+    fn decoder_panics_are_caught_silently_and_the_hook_restored() {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(|info| {
+            if info.payload().downcast_ref::<&str>() == Some(&"quietly-test") {
+                SEEN.fetch_add(1, Ordering::SeqCst);
+            }
+        }));
+        // inside: caught, and the hook (which would count it) not called
+        assert_eq!(quietly(|| -> u32 { panic!("quietly-test") }), None);
+        assert_eq!(quietly(|| 7), Some(7));
+        assert_eq!(SEEN.load(Ordering::SeqCst), 0);
+        // outside: the hook is back
+        let _ = std::panic::catch_unwind(|| panic!("quietly-test"));
+        assert_eq!(SEEN.load(Ordering::SeqCst), 1);
+        std::panic::set_hook(previous);
+    }
 }

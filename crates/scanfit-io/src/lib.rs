@@ -11,6 +11,7 @@ mod atomic;
 mod binary;
 pub mod cloud;
 mod error;
+pub mod fuzz;
 pub mod gltf;
 pub mod iges;
 pub mod json;
@@ -26,7 +27,7 @@ pub mod svg;
 pub mod table;
 pub mod xyz;
 
-pub use atomic::{write_all_atomic, write_atomic};
+pub use atomic::{check_paths, recover, write_all_atomic, write_atomic};
 pub use cloud::{cloud_bytes, parse_cloud, read_cloud, write_cloud, WriteFormat};
 pub use error::{Error, Result};
 pub use table::{Format, NonFinite, Origin, PointTable, ReadOptions};

@@ -15,7 +15,7 @@ use std::path::Path;
 use scanfit::Point3;
 
 use crate::binary::{decode_column, decode_points, Column, Scalar};
-use crate::table::{capacity, Format, Origin, PointTable, ReadOptions};
+use crate::table::{capacity, split_lines, Format, Origin, PointTable, ReadOptions, MAX_COLUMNS};
 use crate::{Error, Result};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -48,6 +48,8 @@ struct Header {
     data: Data,
     body: usize,
     lines: usize,
+    /// header fields that disagree with each other
+    warnings: Vec<String>,
 }
 
 fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
@@ -70,6 +72,13 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
     let (mut width, mut height, mut points) = (None::<u64>, None::<u64>, None::<u64>);
     let mut pos = 0usize;
     let mut line_no = 0usize;
+    // header lines end with LF (or CRLF); a header whose first line ends
+    // with a lone CR (classic Mac) uses CR throughout
+    let first = bytes.iter().position(|&b| b == b'\n' || b == b'\r');
+    let eol = match first {
+        Some(k) if bytes.get(k) == Some(&b'\r') && bytes.get(k + 1) != Some(&b'\n') => b'\r',
+        _ => b'\n',
+    };
     let data = loop {
         let Some(rest) = bytes.get(pos..).filter(|r| !r.is_empty()) else {
             return Err(perr(
@@ -77,7 +86,7 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
                 "the header has no DATA line: the file is truncated or not a PCD file".into(),
             ));
         };
-        let (raw, next) = match rest.iter().position(|&b| b == b'\n') {
+        let (raw, next) = match rest.iter().position(|&b| b == eol) {
             Some(k) => (rest.get(..k).unwrap_or_default(), pos + k + 1),
             None => (rest, bytes.len()),
         };
@@ -253,6 +262,22 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
             ))
         }
     }
+    if let Some(v) = values.filter(|&v| v > MAX_COLUMNS) {
+        return Err(perr(
+            line_no,
+            format!("the fields declare {v} values per point; a point file may have at most {MAX_COLUMNS}"),
+        ));
+    }
+    let mut warnings = Vec::new();
+    if let (Some(p), Some(w)) = (points, width) {
+        let wh = w.saturating_mul(height.unwrap_or(1));
+        if p != wh {
+            warnings.push(format!(
+                "{}: the header declares POINTS {p} but WIDTH x HEIGHT = {wh}; the {p} points of POINTS were read (fix the header)",
+                path.display()
+            ));
+        }
+    }
     let points = match (points, width, height) {
         (Some(p), _, _) => p,
         (None, Some(w), Some(h)) => w.saturating_mul(h),
@@ -270,6 +295,7 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
         data,
         body: pos,
         lines: line_no,
+        warnings,
     })
 }
 
@@ -410,10 +436,11 @@ pub(crate) fn lzf_decompress(input: &[u8], out_len: usize) -> std::result::Resul
 pub(crate) fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<PointTable> {
     let header = parse_header(path, bytes)?;
     let plan = plan(path, &header.fields)?;
-    let table = match header.data {
+    let mut table = match header.data {
         Data::Ascii => read_ascii(path, bytes, &header, plan)?,
         Data::Binary | Data::Compressed => read_binary(path, bytes, &header, plan)?,
     };
+    table.warnings.splice(0..0, header.warnings);
     table.finish(options.non_finite)
 }
 
@@ -431,6 +458,7 @@ fn read_binary(path: &Path, bytes: &[u8], h: &Header, plan: Plan) -> Result<Poin
     // where each field's values are: row-major records, or (compressed) one
     // block per field
     let storage: Vec<u8>;
+    let mut warnings = Vec::new();
     let mut columns_at: Vec<(&[u8], usize, usize)> = Vec::with_capacity(h.fields.len());
     let origin;
     if h.data == Data::Binary {
@@ -441,6 +469,15 @@ fn read_binary(path: &Path, bytes: &[u8], h: &Header, plan: Plan) -> Result<Poin
                 body.len(),
                 body.len() / record.max(1)
             )));
+        }
+        let spare = body.len() as u128 - need;
+        if record > 0 && spare >= record as u128 {
+            warnings.push(format!(
+                "{}: {spare} bytes ({} points of {record} bytes) follow the {} points the header declares; they were not read (is POINTS too small?)",
+                path.display(),
+                spare / record as u128,
+                h.points
+            ));
         }
         let mut off = 0;
         for f in &h.fields {
@@ -541,6 +578,7 @@ fn read_binary(path: &Path, bytes: &[u8], h: &Header, plan: Plan) -> Result<Poin
         origin,
         file_index: None,
         dropped_non_finite: 0,
+        warnings,
     })
 }
 
@@ -608,14 +646,12 @@ fn read_ascii(path: &Path, bytes: &[u8], h: &Header, plan: Plan) -> Result<Point
         }
     }
     let mut values = vec![0.0; width];
-    let mut rows = text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (h.lines + 1 + i, l))
+    let mut rows = split_lines(text)
+        .map(|(i, l)| (h.lines + i, l))
         .filter(|(_, l)| !l.trim().is_empty());
     for r in 0..h.points {
         let Some((line_no, line)) = rows.next() else {
-            return Err(perr(h.lines + text.lines().count(), format!(
+            return Err(perr(h.lines + split_lines(text).count(), format!(
                 "the file ends after {r} of the {} points the header declares; it is truncated or POINTS is wrong",
                 h.points
             )));
@@ -660,6 +696,15 @@ fn read_ascii(path: &Path, bytes: &[u8], h: &Header, plan: Plan) -> Result<Point
         }
         lines.push(line_no);
     }
+    let more = rows.count();
+    let mut warnings = Vec::new();
+    if more > 0 {
+        warnings.push(format!(
+            "{}: {more} more non-empty lines follow the {} points the header declares; they were not read (is POINTS too small?)",
+            path.display(),
+            h.points
+        ));
+    }
     let unpacked: Vec<Vec<f64>> = colours
         .iter()
         .flat_map(|&(alpha, c)| unpack(extra.get(c).map_or(&[][..], |v| v.as_slice()), alpha))
@@ -674,6 +719,7 @@ fn read_ascii(path: &Path, bytes: &[u8], h: &Header, plan: Plan) -> Result<Point
         origin: Origin::Lines(lines),
         file_index: None,
         dropped_non_finite: 0,
+        warnings,
     })
 }
 

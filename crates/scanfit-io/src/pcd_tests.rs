@@ -154,3 +154,74 @@ fn ascii_with_nan_points() {
     let e = read(b"ply\n").unwrap_err().to_string();
     assert!(e.contains("bad magic"), "{e}");
 }
+
+#[test]
+fn every_line_ending_in_ascii_files() {
+    for eol in ["\n", "\r\n", "\r"] {
+        let text = [
+            "# .PCD v0.7",
+            "VERSION 0.7",
+            "FIELDS x y z",
+            "SIZE 4 4 4",
+            "TYPE F F F",
+            "WIDTH 2",
+            "HEIGHT 1",
+            "POINTS 2",
+            "DATA ascii",
+            "1 2 3",
+            "4 5 6",
+        ]
+        .join(eol)
+            + eol;
+        let t = read(text.as_bytes()).unwrap();
+        assert_eq!(
+            t.points,
+            vec![Point3::new(1., 2., 3.), Point3::new(4., 5., 6.)],
+            "{eol:?}"
+        );
+        assert_eq!(t.locate(1), "t.pcd:11", "{eol:?}");
+        assert!(t.warnings.is_empty(), "{eol:?}: {:?}", t.warnings);
+    }
+}
+
+#[test]
+fn counts_that_disagree_with_the_data() {
+    let head = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 3\nHEIGHT 1\nPOINTS 2\n";
+    // POINTS against WIDTH x HEIGHT, and a line more than POINTS: warnings
+    let t = read(format!("{head}DATA ascii\n1 2 3\n4 5 6\n7 8 9\n").as_bytes()).unwrap();
+    assert_eq!(t.points.len(), 2);
+    assert_eq!(
+        t.warnings,
+        [
+            "t.pcd: the header declares POINTS 2 but WIDTH x HEIGHT = 3; the 2 points of POINTS were read (fix the header)",
+            "t.pcd: 1 more non-empty lines follow the 2 points the header declares; they were not read (is POINTS too small?)"
+        ]
+    );
+    // binary: a record after the declared ones
+    let mut b = format!("{head}DATA binary\n").into_bytes();
+    for v in 0..9 {
+        b.extend((v as f32).to_le_bytes());
+    }
+    let t = read(&b).unwrap();
+    assert_eq!(t.points[1], Point3::new(3., 4., 5.));
+    assert!(
+        t.warnings[1].contains("12 bytes (1 points of 12 bytes) follow the 2 points"),
+        "{:?}",
+        t.warnings
+    );
+    // fewer than POINTS: an error
+    let e = read(format!("{head}DATA ascii\n1 2 3\n").as_bytes())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("the file ends after 1 of the 2 points"), "{e}");
+    // too many values per point
+    let wide = format!(
+        "VERSION 0.7\nFIELDS x y z w\nSIZE 4 4 4 1\nTYPE F F F U\nCOUNT 1 1 1 2000\nPOINTS 1\nDATA ascii\n{}\n",
+        "0 ".repeat(2003)
+    );
+    let e = read(wide.as_bytes()).unwrap_err().to_string();
+    assert!(
+        e.contains("the fields declare 2003 values per point; a point file may have at most 1024"),
+        "{e}"
+    );
+}

@@ -16,7 +16,7 @@ use std::path::Path;
 use scanfit::Point3;
 
 use crate::binary::{decode_column, decode_points, Column, Scalar};
-use crate::table::{capacity, Format, Origin, PointTable, ReadOptions};
+use crate::table::{capacity, split_lines, Format, Origin, PointTable, ReadOptions, MAX_COLUMNS};
 use crate::{Error, Result};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -91,6 +91,13 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
     let mut line_no = 0usize;
     let mut encoding = None;
     let mut elements: Vec<Element> = Vec::new();
+    // header lines end with LF (or CRLF); a header whose first line ends
+    // with a lone CR (classic Mac) uses CR throughout
+    let eol = if bytes.starts_with(b"ply\r") && bytes.get(4) != Some(&b'\n') {
+        b'\r'
+    } else {
+        b'\n'
+    };
     loop {
         let Some(rest) = bytes.get(pos..).filter(|r| !r.is_empty()) else {
             return Err(perr(
@@ -99,7 +106,7 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
                     .into(),
             ));
         };
-        let (raw, next) = match rest.iter().position(|&b| b == b'\n') {
+        let (raw, next) = match rest.iter().position(|&b| b == eol) {
             Some(k) => (rest.get(..k).unwrap_or_default(), pos + k + 1),
             None => (rest, bytes.len()),
         };
@@ -244,6 +251,16 @@ struct Plan {
 }
 
 fn plan(path: &Path, v: &Element) -> Result<Plan> {
+    if v.props.len() > MAX_COLUMNS {
+        return Err(Error::Parse {
+            path: path.to_path_buf(),
+            line: v.line,
+            message: format!(
+                "the vertex element declares {} properties; a point file may have at most {MAX_COLUMNS}",
+                v.props.len()
+            ),
+        });
+    }
     let find = |axis: &str| {
         v.props.iter().position(|p| p.name == axis).or_else(|| {
             v.props
@@ -311,7 +328,8 @@ pub(crate) fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<
         })?;
     let plan = plan(path, &vertex)?;
     let before = header.elements.get(..vi).unwrap_or_default();
-    let table = match header.encoding {
+    let after = header.elements.get(vi + 1..).unwrap_or_default();
+    let mut table = match header.encoding {
         Encoding::Ascii => read_ascii(path, bytes, &header, before, &vertex, plan)?,
         Encoding::Little | Encoding::Big => {
             let big = header.encoding == Encoding::Big;
@@ -319,9 +337,45 @@ pub(crate) fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<
             for e in before {
                 pos = skip_binary(path, bytes, pos, e, big)?;
             }
-            read_binary(path, bytes, pos, &vertex, plan, big)?
+            let mut table = read_binary(path, bytes, pos, &vertex, plan, big)?;
+            // the elements after the vertices (faces, ...) are not read, but
+            // a header whose counts disagree with the data is reported
+            let mut end = pos.saturating_add(
+                vertex
+                    .fixed_stride()
+                    .map_or(0, |s| s.saturating_mul(table.points.len())),
+            );
+            if let Origin::Offsets(_) = table.origin {
+                end = skip_binary(path, bytes, pos, &vertex, big).unwrap_or(end);
+            }
+            for e in after {
+                match skip_binary(path, bytes, end, e, big) {
+                    Ok(next) => end = next,
+                    Err(err) => {
+                        table.warnings.push(format!(
+                            "{err} (the '{}' element is not needed for the points, which were read)",
+                            e.name
+                        ));
+                        end = bytes.len();
+                        break;
+                    }
+                }
+            }
+            let spare = bytes.len().saturating_sub(end);
+            let stride = vertex.fixed_stride().unwrap_or(1).max(1);
+            if spare >= stride {
+                table.warnings.push(format!(
+                    "{}: {spare} bytes follow the last element the header declares; they were not read (is the vertex count {} too small?)",
+                    path.display(),
+                    vertex.count
+                ));
+            }
+            table
         }
     };
+    if header.encoding == Encoding::Ascii {
+        ascii_trailing(path, bytes, &header, &mut table, after);
+    }
     table.finish(options.non_finite)
 }
 
@@ -473,6 +527,7 @@ fn read_binary(
         },
         file_index: None,
         dropped_non_finite: 0,
+        warnings: Vec::new(),
     })
 }
 
@@ -539,7 +594,46 @@ fn read_binary_lists(
         origin: Origin::Offsets(offsets),
         file_index: None,
         dropped_non_finite: 0,
+        warnings: Vec::new(),
     })
+}
+
+/// An ascii file with more records than its header declares: the
+/// non-empty lines after the vertices and the elements that follow them are
+/// reported as a warning (they are not read).
+fn ascii_trailing(
+    path: &Path,
+    bytes: &[u8],
+    header: &Header,
+    table: &mut PointTable,
+    after: &[Element],
+) {
+    let Some(text) = bytes
+        .get(header.body..)
+        .and_then(|b| std::str::from_utf8(b).ok())
+    else {
+        return;
+    };
+    let last_vertex = match &table.origin {
+        Origin::Lines(l) => l.last().copied().unwrap_or(header.lines),
+        _ => return,
+    };
+    let expected: u64 = after
+        .iter()
+        .filter(|e| !e.props.is_empty())
+        .map(|e| e.count)
+        .fold(0u64, u64::saturating_add);
+    let later = split_lines(text)
+        .filter(|(i, l)| header.lines + i > last_vertex && !l.trim().is_empty())
+        .count() as u64;
+    if later > expected {
+        table.warnings.push(format!(
+            "{}: {} more non-empty lines follow the records the header declares; they were not read (is the vertex count {} too small?)",
+            path.display(),
+            later - expected,
+            table.points.len()
+        ));
+    }
 }
 
 fn read_ascii(
@@ -572,12 +666,10 @@ fn read_ascii(
         message,
     };
     // non-empty lines with their 1-based numbers
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (header.lines + 1 + i, l))
+    let mut lines = split_lines(text)
+        .map(|(i, l)| (header.lines + i, l))
         .filter(|(_, l)| !l.trim().is_empty());
-    let last_line = header.lines + text.lines().count();
+    let last_line = header.lines + split_lines(text).count();
     for e in before {
         if e.props.is_empty() {
             continue;
@@ -673,6 +765,7 @@ fn read_ascii(
         origin: Origin::Lines(line_numbers),
         file_index: None,
         dropped_non_finite: 0,
+        warnings: Vec::new(),
     })
 }
 
@@ -909,5 +1002,98 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("t.ply:15"), "{e}");
+    }
+
+    #[test]
+    fn every_line_ending_in_ascii_files() {
+        for eol in ["\n", "\r\n", "\r"] {
+            let text = [
+                "ply",
+                "format ascii 1.0",
+                "element vertex 2",
+                "property float x",
+                "property float y",
+                "property float z",
+                "end_header",
+                "1 2 3",
+                "4 5 6",
+            ]
+            .join(eol)
+                + eol;
+            let t = read(text.as_bytes()).unwrap();
+            assert_eq!(
+                t.points,
+                vec![Point3::new(1., 2., 3.), Point3::new(4., 5., 6.)],
+                "{eol:?}"
+            );
+            assert_eq!(t.locate(1), "t.ply:9", "{eol:?}");
+            assert!(t.warnings.is_empty(), "{eol:?}: {:?}", t.warnings);
+        }
+    }
+
+    #[test]
+    fn counts_smaller_than_the_data_are_warnings() {
+        let head = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n";
+        // ascii: a third vertex line the header does not declare
+        let t = read(format!("{head}end_header\n1 2 3\n4 5 6\n7 8 9\n").as_bytes()).unwrap();
+        assert_eq!(t.points.len(), 2);
+        assert_eq!(
+            t.warnings,
+            ["t.ply: 1 more non-empty lines follow the records the header declares; they were not read (is the vertex count 2 too small?)"]
+        );
+        // with a face element after the vertices, its lines are expected
+        let faces = format!(
+            "{head}element face 1\nproperty list uchar int vertex_indices\nend_header\n1 2 3\n4 5 6\n3 0 1 0\n"
+        );
+        assert!(read(faces.as_bytes()).unwrap().warnings.is_empty());
+        // binary: a third record after the declared two
+        let mut b = "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
+            .as_bytes()
+            .to_vec();
+        for v in 0..9 {
+            b.extend((v as f32).to_le_bytes());
+        }
+        let t = read(&b).unwrap();
+        assert_eq!(t.points.len(), 2);
+        assert_eq!(
+            t.warnings,
+            ["t.ply: 12 bytes follow the last element the header declares; they were not read (is the vertex count 2 too small?)"]
+        );
+        // a declared face element that the file does not hold: a warning
+        let mut f = "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nelement face 5\nproperty list uchar int vertex_indices\nend_header\n"
+            .as_bytes()
+            .to_vec();
+        for v in 0..6 {
+            f.extend((v as f32).to_le_bytes());
+        }
+        let t = read(&f).unwrap();
+        assert_eq!(t.points.len(), 2);
+        assert!(
+            t.warnings.len() == 1
+                && t.warnings[0].contains("the file ends inside list 'vertex_indices' of face 0"),
+            "{:?}",
+            t.warnings
+        );
+        // more declared than present stays an error
+        let e = read(format!("{head}end_header\n1 2 3\n").as_bytes())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("the file ends after 1 of the 2 vertices"), "{e}");
+    }
+
+    #[test]
+    fn too_many_properties_are_refused() {
+        let mut h = String::from("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n");
+        for k in 0..MAX_COLUMNS {
+            h.push_str(&format!("property uchar p{k}\n"));
+        }
+        h.push_str("end_header\n");
+        let e = read(h.as_bytes()).unwrap_err().to_string();
+        assert!(
+            e.contains(
+                "the vertex element declares 1027 properties; a point file may have at most 1024"
+            ),
+            "{e}"
+        );
     }
 }

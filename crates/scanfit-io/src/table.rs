@@ -144,6 +144,10 @@ pub struct PointTable {
     /// How many points were left out for a non-finite coordinate
     /// ([`NonFinite::Drop`]).
     pub dropped_non_finite: usize,
+    /// What the reader accepted but the caller should hear about, one
+    /// sentence each, naming the file: a header count that disagrees with
+    /// the data, bytes after the last record, ... (the CLI prints them).
+    pub warnings: Vec<String>,
 }
 
 impl PointTable {
@@ -334,6 +338,39 @@ impl PointTable {
     }
 }
 
+/// Most columns (x, y, z and the extra ones) a point file may have. Point
+/// files carry tens of columns; a header or line declaring more is refused
+/// before anything is allocated from it, which also keeps the work per
+/// column (naming, attribute lookup) bounded.
+pub const MAX_COLUMNS: usize = 1024;
+
+/// The lines of `text`, split at LF, CRLF or a lone CR (classic Mac), with
+/// their 1-based numbers; the terminators are not part of the lines. A
+/// final terminator does not start an empty last line.
+pub(crate) fn split_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    let mut rest = text;
+    let mut number = 0usize;
+    std::iter::from_fn(move || {
+        if rest.is_empty() {
+            return None;
+        }
+        number += 1;
+        let (line, next) = match rest.find(['\n', '\r']) {
+            Some(k) => {
+                let after = if rest[k..].starts_with("\r\n") {
+                    k + 2
+                } else {
+                    k + 1
+                };
+                (&rest[..k], &rest[after..])
+            }
+            None => (rest, ""),
+        };
+        rest = next;
+        Some((number, line))
+    })
+}
+
 /// Capacity to reserve for `claimed` records when at most `available` can
 /// exist (each record needs at least one byte or line): a header that claims
 /// 10^12 points never allocates more than the file could hold.
@@ -358,6 +395,7 @@ mod tests {
             origin,
             file_index: None,
             dropped_non_finite: 0,
+            warnings: Vec::new(),
         }
     }
 

@@ -11,7 +11,7 @@ use std::path::Path;
 
 use scanfit::Point3;
 
-use crate::table::{Format, NonFinite, Origin, PointTable, ReadOptions};
+use crate::table::{split_lines, Format, NonFinite, Origin, PointTable, ReadOptions, MAX_COLUMNS};
 use crate::{Error, Result};
 
 /// Reads a point file of any supported format with the default options:
@@ -45,9 +45,68 @@ pub fn parse_points(path: &Path, text: &str) -> Result<PointTable> {
     parse_points_with(path, text, NonFinite::Reject)
 }
 
+/// Splits a data line into its fields. Spaces and tabs separate fields
+/// (a run of them counts once); a comma or semicolon is a delimiter, so two
+/// of them with only blanks between (`1,,3`), or one at the start or end of
+/// the line, enclose an empty field, returned as `""`. Linear in the line.
+fn split_fields<'a>(line: &'a str, out: &mut Vec<&'a str>) {
+    out.clear();
+    let is_blank = |c: char| c == ' ' || c == '\t' || c.is_whitespace();
+    let is_delim = |c: char| c == ',' || c == ';';
+    let mut rest = line.trim_matches(is_blank);
+    if rest.is_empty() {
+        return;
+    }
+    loop {
+        match rest.find(|c: char| is_blank(c) || is_delim(c)) {
+            None => {
+                out.push(rest);
+                return;
+            }
+            Some(k) => {
+                out.push(&rest[..k]);
+                // the separator: blanks, at most one delimiter, blanks
+                let mut tail = rest[k..].trim_start_matches(is_blank);
+                let mut delimited = false;
+                if let Some(t) = tail.strip_prefix(is_delim) {
+                    delimited = true;
+                    tail = t.trim_start_matches(is_blank);
+                }
+                if tail.is_empty() {
+                    if delimited {
+                        // `1,2,3,`: a delimiter ends the line
+                        out.push("");
+                    }
+                    return;
+                }
+                rest = tail;
+                // `1,,3` or `1, ;3`: a delimiter right after a delimiter
+                if delimited {
+                    while let Some(t) = rest.strip_prefix(is_delim) {
+                        out.push("");
+                        rest = t.trim_start_matches(is_blank);
+                        if rest.is_empty() {
+                            out.push("");
+                            return;
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// Parses the text of a point file with a policy for non-finite coordinates
 /// (`path` is used for messages only). Non-finite values in extra columns
 /// are kept: they are data (a missing normal, an undefined curvature).
+///
+/// Lines end with LF, CRLF or a lone CR. An empty field (`1,,3`, a
+/// delimiter at the start or end of a line) is an error naming the line
+/// and the value, or a NaN under [`NonFinite::Drop`] (a point whose x, y or
+/// z is empty is then dropped); it never shifts the columns. A Leica PTS
+/// count line that disagrees with the number of points read is a warning
+/// in [`PointTable::warnings`]. More than [`crate::table::MAX_COLUMNS`]
+/// columns is an error. Time is linear in the size of the text.
 pub fn parse_points_with(path: &Path, text: &str, policy: NonFinite) -> Result<PointTable> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let perr = |line: usize, message: String| Error::Parse {
@@ -59,24 +118,47 @@ pub fn parse_points_with(path: &Path, text: &str, policy: NonFinite) -> Result<P
     let mut width = 0usize;
     let mut points = Vec::new();
     let mut extra: Vec<Vec<f64>> = Vec::new();
+    let mut extra_index: Vec<usize> = Vec::new();
     let mut lines = Vec::new();
+    let mut fields: Vec<&str> = Vec::new();
     let mut values: Vec<f64> = Vec::new();
     let mut dropped = 0usize;
     let mut order = [0usize, 1, 2];
-    let mut pts_count_seen = false;
-    for (i, raw) in text.lines().enumerate() {
-        let line_no = i + 1;
+    let mut pts_count: Option<(usize, u64)> = None;
+    let too_wide = |line_no: usize, n: usize| {
+        perr(
+            line_no,
+            format!(
+                "{n} columns; a point file may have at most {} (is this a point file with one point per line?)",
+                MAX_COLUMNS
+            ),
+        )
+    };
+    for (line_no, raw) in split_lines(text) {
         let line = raw.trim();
         if line.is_empty() || line.starts_with('#') || line.starts_with("//") {
             continue;
         }
-        let fields: Vec<&str> = line
-            .split(|c: char| c == ',' || c == ';' || c.is_whitespace())
-            .filter(|f| !f.is_empty())
-            .collect();
+        split_fields(line, &mut fields);
+        if fields.len() > MAX_COLUMNS {
+            return Err(too_wide(line_no, fields.len()));
+        }
         values.clear();
         let mut bad: Option<(usize, &str)> = None;
         for (k, f) in fields.iter().enumerate() {
+            if f.is_empty() {
+                if policy == NonFinite::Drop {
+                    values.push(f64::NAN);
+                    continue;
+                }
+                return Err(perr(
+                    line_no,
+                    format!(
+                        "value {} is empty (two delimiters in a row, or one at the start or end of the line); write a number there (or 'nan', and read with ReadOptions {{ non_finite: NonFinite::Drop, .. }} to leave such points out)",
+                        k + 1
+                    ),
+                ));
+            }
             match f.parse::<f64>() {
                 Ok(v) => values.push(v),
                 Err(_) => {
@@ -89,11 +171,20 @@ pub fn parse_points_with(path: &Path, text: &str, policy: NonFinite) -> Result<P
             // the header: before any data, and no field a number (a data line
             // with a typo such as `0,O,0` is an error, not a header)
             if points.is_empty()
+                && width == 0
                 && columns.is_none()
                 && values.is_empty()
                 && fields.iter().all(|f| f.parse::<f64>().is_err())
             {
-                // the first non-numeric line before any data is the header
+                if let Some(e) = fields.iter().position(|f| f.is_empty()) {
+                    return Err(perr(
+                        line_no,
+                        format!(
+                            "column {} of the header line has no name; name every column",
+                            e + 1
+                        ),
+                    ));
+                }
                 columns = Some(
                     fields
                         .iter()
@@ -109,12 +200,12 @@ pub fn parse_points_with(path: &Path, text: &str, policy: NonFinite) -> Result<P
         }
         // Leica PTS: the first data line holds only the point count
         if width == 0
-            && !pts_count_seen
+            && pts_count.is_none()
             && values.len() == 1
             && values[0] >= 0.0
             && values[0].fract() == 0.0
         {
-            pts_count_seen = true;
+            pts_count = Some((line_no, values[0] as u64));
             continue;
         }
         if width == 0 {
@@ -132,7 +223,8 @@ pub fn parse_points_with(path: &Path, text: &str, policy: NonFinite) -> Result<P
                     format!("{width} columns found; a point needs at least x, y, z"),
                 ));
             }
-            extra = vec![Vec::new(); width - 3];
+            extra_index = (0..width).filter(|k| !order.contains(k)).collect();
+            extra = vec![Vec::new(); extra_index.len()];
         }
         if values.len() != width {
             return Err(perr(
@@ -163,10 +255,7 @@ pub fn parse_points_with(path: &Path, text: &str, policy: NonFinite) -> Result<P
             value(order[1]),
             value(order[2]),
         ));
-        for (col, k) in extra
-            .iter_mut()
-            .zip((0..width).filter(|k| !order.contains(k)))
-        {
+        for (col, &k) in extra.iter_mut().zip(&extra_index) {
             col.push(value(k));
         }
         lines.push(line_no);
@@ -181,15 +270,20 @@ pub fn parse_points_with(path: &Path, text: &str, policy: NonFinite) -> Result<P
             },
         });
     }
+    let mut warnings = Vec::new();
+    if let Some((line, declared)) = pts_count {
+        let found = (points.len() + dropped) as u64;
+        if declared != found {
+            warnings.push(format!(
+                "{}:{line}: the count line declares {declared} points, but the file holds {found}; all {found} were read (fix the count, or check whether the file is truncated)",
+                path.display()
+            ));
+        }
+    }
     // the table's columns are x, y, z first, then the others in file order
     let columns = columns.map(|c| {
         let mut out: Vec<String> = order.iter().map(|&k| c[k].clone()).collect();
-        out.extend(
-            c.iter()
-                .enumerate()
-                .filter(|(k, _)| !order.contains(k))
-                .map(|(_, n)| n.clone()),
-        );
+        out.extend(extra_index.iter().map(|&k| c[k].clone()));
         out
     });
     let columns = columns.unwrap_or_else(|| {
@@ -206,6 +300,7 @@ pub fn parse_points_with(path: &Path, text: &str, policy: NonFinite) -> Result<P
         origin: Origin::Lines(lines),
         file_index: None,
         dropped_non_finite: dropped,
+        warnings,
     })
 }
 
@@ -315,5 +410,102 @@ mod tests {
         assert!(e.starts_with("/nonexistent/p.xyz:"), "{e}");
         let e = read_points(Path::new("scan.e57")).unwrap_err().to_string();
         assert!(e.contains("not supported"), "{e}");
+    }
+
+    #[test]
+    fn every_line_ending_gives_the_same_points() {
+        let want = vec![
+            Point3::new(1., 2., 3.),
+            Point3::new(4., 5., 6.),
+            Point3::new(7., 8., 9.),
+        ];
+        for eol in ["\n", "\r\n", "\r"] {
+            let text = ["x y z", "1 2 3", "4 5 6", "7 8 9"].join(eol) + eol;
+            let t = parse(&text).unwrap();
+            assert_eq!(t.points, want, "{eol:?}");
+            assert_eq!(t.columns, ["x", "y", "z"], "{eol:?}");
+            assert_eq!(t.locate(2), "t.csv:4", "{eol:?}");
+        }
+        // mixed endings in one file, and a CR-only file without a final one
+        let t = parse("1 2 3\r4 5 6\n7 8 9\r\n").unwrap();
+        assert_eq!(t.points, want);
+        let t = parse("1 2 3\r4 5 6\r7 8 9").unwrap();
+        assert_eq!(t.points, want);
+        assert_eq!(t.origin, Origin::Lines(vec![1, 2, 3]));
+    }
+
+    #[test]
+    fn an_empty_field_is_an_error_or_nan_never_a_shift() {
+        for (text, line, value) in [
+            ("1,2,3,4\n5,,7,8\n", 2, 2),
+            ("1,2,3,4\n,6,7,8\n", 2, 1),
+            ("1,2,3,4\n5,6,7,\n", 2, 4),
+            ("1;2;3;4\n5; ;7;8\n", 2, 2),
+            ("x,y,z,w\n1, ,3,4\n", 2, 2),
+        ] {
+            let e = parse(text).unwrap_err().to_string();
+            assert!(
+                e.starts_with(&format!("t.csv:{line}: value {value} is empty")),
+                "{text:?}: {e}"
+            );
+        }
+        // a space after a comma is one separator, not an empty field
+        let t = parse("1, 2, 3, 4\n5 ,6 , 7,8\n").unwrap();
+        assert_eq!(t.points[1], Point3::new(5., 6., 7.));
+        assert_eq!(t.extra, vec![vec![4.0, 8.0]]);
+        // under the drop policy: NaN; a point with an empty coordinate is dropped,
+        // an empty extra value stays NaN in its own column
+        let t = parse_points_with(
+            Path::new("t.csv"),
+            "x,y,z,w\n1,2,3,\n4,,6,7\n8,9,10,11\n",
+            NonFinite::Drop,
+        )
+        .unwrap();
+        assert_eq!(
+            t.points,
+            vec![Point3::new(1., 2., 3.), Point3::new(8., 9., 10.)]
+        );
+        assert_eq!(t.dropped_non_finite, 1);
+        let w = t.column("w").unwrap();
+        assert!(w[0].is_nan() && w[1] == 11.0, "{w:?}");
+        let e = parse("x,,z\n1,2,3\n").unwrap_err().to_string();
+        assert!(
+            e.starts_with("t.csv:1: column 2 of the header line has no name"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_pts_count_that_disagrees_is_a_warning() {
+        let t = parse("2\n1 2 3\n4 5 6\n").unwrap();
+        assert!(t.warnings.is_empty(), "{:?}", t.warnings);
+        let t = parse("5\n1 2 3\n4 5 6\n").unwrap();
+        assert_eq!(t.points.len(), 2);
+        assert_eq!(
+            t.warnings,
+            ["t.csv:1: the count line declares 5 points, but the file holds 2; all 2 were read (fix the count, or check whether the file is truncated)"]
+        );
+        let t = parse("1\n1 2 3\n4 5 6\n7 8 9\n").unwrap();
+        assert_eq!(t.points.len(), 3);
+        assert!(t.warnings[0].contains("declares 1 points, but the file holds 3"));
+    }
+
+    #[test]
+    fn wide_lines_are_linear_and_bounded() {
+        // at the limit: read, each column kept
+        let n = crate::table::MAX_COLUMNS;
+        let row = |v: usize| vec![v.to_string(); n].join(" ");
+        let t = parse(&format!("{}\n{}\n", row(1), row(2))).unwrap();
+        assert_eq!(t.extra.len(), n - 3);
+        assert_eq!(t.columns[n - 1], format!("col{n}"));
+        // beyond it: an error on the first line, before any column is built
+        let wide = "1 ".repeat(500_000);
+        let start = std::time::Instant::now();
+        let e = parse(&format!("{wide}\n{wide}\n")).unwrap_err().to_string();
+        assert!(
+            e.starts_with("t.csv:1: 500000 columns; a point file may have at most 1024"),
+            "{e}"
+        );
+        assert!(start.elapsed().as_secs_f64() < 2.0, "{:?}", start.elapsed());
     }
 }

@@ -1,0 +1,6 @@
+//! Fuzz target: the ply reader (`scanfit_io::fuzz_point_file` with a `.ply` name).
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    scanfit_io::fuzz::point_file("f.ply", data);
+});
