@@ -24,6 +24,10 @@
 //! * [`metrics`]: surface error measures and parameterization quality.
 //! * [`project`]: point inversion (orthogonal projection onto surfaces).
 //! * [`quality`]: per-curve quality report (deviation, curvature, loops, length).
+//! * [`network`]: the patch network of a segmented cloud (labels, shared
+//!   corners and edges, edge curves, per-patch surfaces with exact boundaries).
+//! * [`pipeline`]: whole pipelines, e.g. [`pipeline::reconstruct`] (a
+//!   segmented cloud to patches that share their edge curves).
 
 pub mod base;
 pub mod bspline;
@@ -33,8 +37,11 @@ pub mod fit;
 mod geom;
 pub mod mba;
 pub mod metrics;
+pub mod network;
 pub mod param;
 pub mod pde;
+/// Pipelines: config + `run(&cloud, &config, progress)` -> report.
+pub mod pipeline;
 pub mod progress;
 pub mod project;
 pub mod quality;
