@@ -28,6 +28,8 @@
 //!   corners and edges, edge curves, per-patch surfaces with exact boundaries).
 //! * [`pipeline`]: whole pipelines, e.g. [`pipeline::reconstruct`] (a
 //!   segmented cloud to patches that share their edge curves).
+//! * [`topology`]: multi-patch models: vertices, shared edge curves, faces
+//!   and their checks (gaps along edges, enclosed volume).
 
 pub mod base;
 pub mod bspline;
@@ -45,6 +47,7 @@ pub mod pipeline;
 pub mod progress;
 pub mod project;
 pub mod quality;
+pub mod topology;
 
 pub use cloud::PointCloud;
 pub use error::{Error, Result};
