@@ -35,6 +35,10 @@ fn labelled(pts: Vec<Point3>, labels: Vec<f64>) -> PointCloud {
 /// A closed cylinder (radius 1, height 2): 4 side sectors (labels 0-3) and
 /// two caps (10 bottom, 11 top), normal noise `sigma` along the normal.
 fn can(sigma: f64, seed: u64) -> PointCloud {
+    can_sectors(sigma, seed, 4)
+}
+
+fn can_sectors(sigma: f64, seed: u64, sectors: usize) -> PointCloud {
     let mut rng = Rng(seed);
     let h = 0.035;
     let (mut pts, mut lab) = (Vec::new(), Vec::new());
@@ -46,7 +50,11 @@ fn can(sigma: f64, seed: u64) -> PointCloud {
             let z = (j as f64 + 0.5) / nz as f64 * 2.0;
             let r = 1.0 + sigma * rng.normal();
             pts.push(Point3::new(r * t.cos(), r * t.sin(), z));
-            lab.push((t / (PI / 2.0)).floor().min(3.0));
+            lab.push(
+                (t / (TAU / sectors as f64))
+                    .floor()
+                    .min(sectors as f64 - 1.0),
+            );
         }
     }
     let n = (2.0 / h).round() as i64;
@@ -128,6 +136,13 @@ fn closed_can_six_faces_no_gaps() {
         );
         assert!(e.patches[1].is_some());
     }
+    // the shared model: valid to 1e-9 of its size, closed, outward normals,
+    // the volume of the can (pi r^2 h) within 1%
+    let model = r.complex.as_ref().unwrap();
+    model.validate_with(1e-9).unwrap();
+    assert!(model.is_closed());
+    let v = model.signed_volume();
+    assert!((v / (2.0 * PI) - 1.0).abs() < 0.01, "volume {v}");
     // the fit follows the noise: orthogonal RMSE within 3 sigma
     for p in &r.patches {
         assert!(
@@ -163,6 +178,37 @@ fn closed_can_six_faces_no_gaps() {
             );
         }
     }
+}
+
+#[test]
+fn caps_with_six_corners_merge_into_four_sides() {
+    let sigma = 0.002;
+    let r = run(
+        &can_sectors(sigma, 9, 6),
+        &ReconstructConfig::default(),
+        &NoProgress,
+    )
+    .unwrap();
+    assert_eq!(r.network.vertices.len(), 12);
+    assert_eq!(r.network.edges.len(), 18);
+    for p in &r.patches {
+        assert_eq!(p.sides, 4);
+        assert_eq!(p.edges, if p.id >= 10 { 6 } else { 4 }, "patch {}", p.id);
+        assert!(
+            p.orthogonal.rmse < 3.0 * sigma,
+            "patch {}: {:?}",
+            p.id,
+            p.orthogonal
+        );
+    }
+    // the caps' sides hold two edges each: still no gap along any edge
+    assert!(
+        r.totals.max_gap <= 1e-9 * r.totals.diagonal,
+        "{:e}",
+        r.totals.max_gap
+    );
+    let e = r.complex.unwrap_err();
+    assert!(e.contains("3 or 4 corners"), "{e}");
 }
 
 #[test]
@@ -227,6 +273,9 @@ fn umbrella_of_three_sided_panels() {
     assert_eq!(r.network.vertices.len(), 9);
     assert_eq!(r.network.edges.len(), 16);
     assert!(r.patches.iter().all(|p| p.sides == 3));
+    let model = r.complex.as_ref().unwrap();
+    model.validate_with(1e-9).unwrap();
+    assert_eq!(model.border_edges().len(), 8);
     assert!(
         r.totals.max_gap <= 1e-9 * r.totals.diagonal,
         "{:e}",

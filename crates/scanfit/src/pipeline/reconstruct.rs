@@ -21,6 +21,7 @@ use crate::network::{
 };
 use crate::progress::Progress;
 use crate::project::InversionConfig;
+use crate::topology::{self, PatchComplex};
 use crate::{Error, Point3, PointCloud, Result, Vector3};
 
 /// Settings of [`run`].
@@ -124,6 +125,11 @@ pub struct ReconstructReport {
     pub edges: Vec<EdgeReport>,
     /// Totals.
     pub totals: Totals,
+    /// The model as a [`PatchComplex`] (faces sharing edges), for the CAD
+    /// writers; `Err` says why it cannot be formed: a patch with a side made
+    /// of several edges (more than 4 corners), which the complex's one edge
+    /// per side cannot hold.
+    pub complex: std::result::Result<PatchComplex, String>,
 }
 
 /// The `(u, v)` of side `s` at side parameter `t` (counter-clockwise: side
@@ -269,6 +275,7 @@ pub fn run(
         diagonal,
         closed: network.is_closed(),
     };
+    let complex = complex(&network, &sides, &faces);
     Ok(ReconstructReport {
         network,
         sides,
@@ -276,6 +283,60 @@ pub fn run(
         patches,
         edges,
         totals,
+        complex,
+    })
+}
+
+/// The network and the faces as a [`PatchComplex`] (see
+/// [`ReconstructReport::complex`]).
+fn complex(
+    net: &Network,
+    sides: &[Vec<Vec<NetUse>>],
+    faces: &[FaceSurface],
+) -> std::result::Result<PatchComplex, String> {
+    let mut out = Vec::with_capacity(faces.len());
+    for ((p, s), f) in net.patches.iter().zip(sides).zip(faces) {
+        let mut uses: [Option<topology::EdgeUse>; 4] = [None; 4];
+        for (k, side) in s.iter().enumerate() {
+            match side[..] {
+                [u] => {
+                    uses[k] = Some(topology::EdgeUse {
+                        edge: u.edge,
+                        reversed: u.reversed,
+                    })
+                }
+                _ => {
+                    return Err(format!(
+                        "patch {} has {} corners, so its side {k} is made of {} edges; the model (one edge per side) cannot hold it: relabel so that every patch has 3 or 4 corners",
+                        p.id,
+                        p.cycle.len(),
+                        side.len()
+                    ))
+                }
+            }
+        }
+        out.push(topology::Face {
+            id: p.id,
+            surface: f.surface.clone(),
+            sides: uses,
+        });
+    }
+    Ok(PatchComplex {
+        vertices: net
+            .vertices
+            .iter()
+            .map(|&point| topology::Vertex { point })
+            .collect(),
+        edges: net
+            .edges
+            .iter()
+            .map(|e| topology::Edge {
+                start: e.start,
+                end: e.end,
+                curve: e.curve.clone(),
+            })
+            .collect(),
+        faces: out,
     })
 }
 
