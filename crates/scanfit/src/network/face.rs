@@ -241,6 +241,8 @@ pub struct FaceSurface {
     pub errors: ErrorStats,
     /// Orthogonal distances of the points to the exported surface.
     pub orthogonal: ErrorStats,
+    /// The orthogonal distance of each point (in the order given).
+    pub distances: Vec<f64>,
     /// Largest distance between the PDE surface and its B-spline form (0 for
     /// the B-spline fit).
     pub conversion_deviation: f64,
@@ -571,6 +573,7 @@ pub fn fit_face(
         coons_errors,
         errors,
         orthogonal: ErrorStats::of(&orth),
+        distances: orth,
         conversion_deviation: deviation,
     })
 }
