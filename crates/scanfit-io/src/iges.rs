@@ -4,9 +4,12 @@
 //!
 //! Entity 128 lists weights and control points with the `u` index varying
 //! fastest (`W(0,0), W(1,0), ..., W(K1,0), W(0,1), ...`), the transpose of
-//! scanfit's row-major net. Units are declared as millimetres.
+//! scanfit's row-major net. Units are declared as millimetres. A multi-patch
+//! model ([`iges_model_file`]) is written as its patches and its shared edge
+//! curves.
 
 use scanfit::bspline::{Curve, Surface};
+use scanfit::topology::PatchComplex;
 
 use crate::step::CadItem;
 use crate::{Error, Result};
@@ -206,6 +209,38 @@ pub fn iges_file(items: &[CadItem], name: &str) -> Result<String> {
     );
     out.push_str(&record(&term, 'T', 1));
     Ok(out)
+}
+
+/// An IGES file for a multi-patch model: every patch surface as entity 128
+/// (in face order) followed by every shared edge curve as entity 126 (in edge
+/// order), each written once. IGES 5.3 has no shell topology short of the
+/// B-rep entities 186/514 (which few readers accept), so the faces are not
+/// sewn here; use [`crate::step_shell`] for a sewn shell.
+///
+/// ```
+/// use scanfit::bspline::{KnotVector, Surface};
+/// use scanfit::topology::{FaceCorners, PatchComplex};
+/// use scanfit::Point3;
+/// use scanfit_io::iges::iges_model_file;
+/// let k = KnotVector::uniform_clamped(1, 2).unwrap();
+/// let c = [Point3::new(0.0, 0.0, 0.0), Point3::new(1.0, 0.0, 0.0),
+///          Point3::new(1.0, 1.0, 0.0), Point3::new(0.0, 1.0, 0.0)];
+/// let s = Surface::new(k.clone(), k, vec![c[0], c[3], c[1], c[2]]).unwrap();
+/// let model = PatchComplex::assemble(c.to_vec(),
+///     vec![FaceCorners { id: 5, surface: s, corners: [0, 1, 2, 3] }]).unwrap();
+/// let text = iges_model_file(&model, "square").unwrap();
+/// let de: Vec<&str> = text.lines().filter(|l| &l[72..73] == "D").collect();
+/// assert_eq!(de.len(), 2 * 5); // one surface and four edge curves
+/// assert!(de[0].starts_with("     128") && de[2].starts_with("     126"));
+/// ```
+pub fn iges_model_file(model: &PatchComplex, name: &str) -> Result<String> {
+    let mut items: Vec<CadItem> = model
+        .faces
+        .iter()
+        .map(|f| CadItem::Surface(&f.surface))
+        .collect();
+    items.extend(model.edges.iter().map(|e| CadItem::Curve(&e.curve)));
+    iges_file(&items, name)
 }
 
 /// Joins parameters with ',' and a final ';' into lines of at most `width`

@@ -29,19 +29,22 @@ pub enum CadItem<'a> {
     Surface(&'a Surface),
 }
 
-struct Writer {
+/// Entity text being written, with the next free entity id.
+pub(crate) struct Writer {
     data: String,
     next: usize,
 }
 
 impl Writer {
-    fn add(&mut self, entity: &str) -> usize {
+    /// Appends `#id=entity;` and returns the id.
+    pub(crate) fn add(&mut self, entity: &str) -> usize {
         let id = self.next;
         self.next += 1;
         let _ = writeln!(self.data, "#{id}={entity};");
         id
     }
-    fn point(&mut self, p: &Point3) -> usize {
+    /// Appends a `CARTESIAN_POINT`.
+    pub(crate) fn point(&mut self, p: &Point3) -> usize {
         self.add(&format!(
             "CARTESIAN_POINT('',({},{},{}))",
             real(p.x),
@@ -86,13 +89,13 @@ fn knots_mults(kv: &KnotVector) -> (Vec<f64>, Vec<usize>) {
     (k, m)
 }
 
-fn list<T>(items: &[T], f: impl Fn(&T) -> String) -> String {
+pub(crate) fn list<T>(items: &[T], f: impl Fn(&T) -> String) -> String {
     let v: Vec<String> = items.iter().map(f).collect();
     format!("({})", v.join(","))
 }
 
 /// Writes `curve` (clamped or not) and returns its entity id.
-fn curve_entity(w: &mut Writer, c: &Curve) -> usize {
+pub(crate) fn curve_entity(w: &mut Writer, c: &Curve) -> usize {
     let ids: Vec<usize> = c.control_points().iter().map(|p| w.point(p)).collect();
     let (k, m) = knots_mults(c.knots());
     let pts = list(&ids, |i| format!("#{i}"));
@@ -113,7 +116,7 @@ fn curve_entity(w: &mut Writer, c: &Curve) -> usize {
 }
 
 /// Writes `s` and returns its entity id.
-fn surface_entity(w: &mut Writer, s: &Surface) -> usize {
+pub(crate) fn surface_entity(w: &mut Writer, s: &Surface) -> usize {
     let (nu, nv) = s.counts();
     let (p, q) = s.degrees();
     let ids: Vec<usize> = s.control_points().iter().map(|c| w.point(c)).collect();
@@ -181,12 +184,21 @@ fn boundary_curves(s: &Surface) -> scanfit::Result<[Curve; 4]> {
     Ok([col(0)?, row(nu - 1)?, col(nv - 1)?, row(0)?])
 }
 
-/// A STEP file with `items`; `name` names the product.
-pub fn step_file(items: &[CadItem], name: &str) -> Result<String> {
-    let bad = |m: String| Error::Invalid {
-        path: name.into(),
-        message: m,
-    };
+/// The product, units and representation context every scanfit STEP file starts with.
+pub(crate) struct Preamble {
+    /// The `GEOMETRIC_REPRESENTATION_CONTEXT` entity.
+    pub ctx: usize,
+    /// The `AXIS2_PLACEMENT_3D` at the origin.
+    pub axis: usize,
+    /// The `PRODUCT_DEFINITION_SHAPE` the representation is attached to.
+    pub pds: usize,
+    /// The product name, quotes escaped.
+    pub esc: String,
+}
+
+/// Starts a file: application context, product, units (millimetres) and a
+/// representation context whose uncertainty is `uncertainty` (length units).
+pub(crate) fn begin(name: &str, uncertainty: f64) -> (Writer, Preamble) {
     let mut w = Writer {
         data: String::new(),
         next: 1,
@@ -208,7 +220,8 @@ pub fn step_file(items: &[CadItem], name: &str) -> Result<String> {
     let ang = w.add("(NAMED_UNIT(*) PLANE_ANGLE_UNIT() SI_UNIT($,.RADIAN.))");
     let sol = w.add("(NAMED_UNIT(*) SI_UNIT($,.STERADIAN.) SOLID_ANGLE_UNIT())");
     let unc = w.add(&format!(
-        "UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE(1.E-07),#{len},'distance_accuracy_value','confusion accuracy')"
+        "UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE({}),#{len},'distance_accuracy_value','confusion accuracy')",
+        real_step(uncertainty)
     ));
     let ctx = w.add(&format!(
         "(GEOMETRIC_REPRESENTATION_CONTEXT(3) GLOBAL_UNCERTAINTY_ASSIGNED_CONTEXT((#{unc})) GLOBAL_UNIT_ASSIGNED_CONTEXT((#{len},#{ang},#{sol})) REPRESENTATION_CONTEXT('Context #1','3D Context with UNIT and UNCERTAINTY'))"
@@ -218,6 +231,54 @@ pub fn step_file(items: &[CadItem], name: &str) -> Result<String> {
     let xdir = w.add("DIRECTION('',(1.,0.,0.))");
     let axis = w.add(&format!("AXIS2_PLACEMENT_3D('',#{origin},#{zdir},#{xdir})"));
 
+    (
+        w,
+        Preamble {
+            ctx,
+            axis,
+            pds,
+            esc,
+        },
+    )
+}
+
+/// The uncertainty as a STEP real; the default 1e-7 keeps its historical
+/// spelling `1.E-07` so that existing files (and the golden files) stay
+/// byte-identical.
+fn real_step(v: f64) -> String {
+    if v == 1e-7 {
+        "1.E-07".into()
+    } else {
+        real(v)
+    }
+}
+
+/// Ends a file: links `rep` to the product and wraps the data in the header.
+pub(crate) fn finish(mut w: Writer, pre: &Preamble, rep: usize, description: &str) -> String {
+    let (pds, esc) = (pre.pds, &pre.esc);
+    w.add(&format!("SHAPE_DEFINITION_REPRESENTATION(#{pds},#{rep})"));
+    let mut out = String::from("ISO-10303-21;\nHEADER;\n");
+    let _ = writeln!(out, "FILE_DESCRIPTION(('{description}'),'2;1');");
+    let _ = writeln!(
+        out,
+        "FILE_NAME('{esc}','2026-01-01T00:00:00',(''),(''),'scanfit {}','scanfit','');",
+        env!("CARGO_PKG_VERSION")
+    );
+    out.push_str("FILE_SCHEMA(('AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }'));\nENDSEC;\nDATA;\n");
+    out.push_str(&w.data);
+    out.push_str("ENDSEC;\nEND-ISO-10303-21;\n");
+    out
+}
+
+/// A STEP file with `items`; `name` names the product.
+pub fn step_file(items: &[CadItem], name: &str) -> Result<String> {
+    let bad = |m: String| Error::Invalid {
+        path: name.into(),
+        message: m,
+    };
+    let (mut w, pre) = begin(name, 1e-7);
+    let (ctx, axis) = (pre.ctx, pre.axis);
+    let esc = pre.esc.clone();
     let mut faces = Vec::new();
     let mut curves = Vec::new();
     for (k, item) in items.iter().enumerate() {
@@ -297,21 +358,7 @@ pub fn step_file(items: &[CadItem], name: &str) -> Result<String> {
         )),
         (None, None) => return Err(bad("nothing to export".into())),
     };
-    w.add(&format!("SHAPE_DEFINITION_REPRESENTATION(#{pds},#{rep})"));
-    let mut out = String::from("ISO-10303-21;\nHEADER;\n");
-    let _ = writeln!(
-        out,
-        "FILE_DESCRIPTION(('scanfit B-spline geometry'),'2;1');"
-    );
-    let _ = writeln!(
-        out,
-        "FILE_NAME('{esc}','2026-01-01T00:00:00',(''),(''),'scanfit {}','scanfit','');",
-        env!("CARGO_PKG_VERSION")
-    );
-    out.push_str("FILE_SCHEMA(('AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }'));\nENDSEC;\nDATA;\n");
-    out.push_str(&w.data);
-    out.push_str("ENDSEC;\nEND-ISO-10303-21;\n");
-    Ok(out)
+    Ok(finish(w, &pre, rep, "scanfit B-spline geometry"))
 }
 
 #[cfg(test)]
