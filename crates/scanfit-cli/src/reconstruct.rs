@@ -12,10 +12,15 @@ use scanfit::metrics::nearest_points;
 use scanfit::network::FaceFit;
 use scanfit::pde::PdeConfig;
 use scanfit::pipeline::reconstruct::{self, ReconstructConfig, ReconstructReport};
+use scanfit::topology::PatchComplex;
 use scanfit::{Point3, PointCloud};
 use scanfit_io::gltf::mesh_glb;
+use scanfit_io::iges::iges_model_file;
+use scanfit_io::json::Provenance;
+use scanfit_io::model::{self, ModelDoc, ModelReport, ModelTotals};
 use scanfit_io::ply::{mesh_obj, mesh_ply, PlyFormat};
 use scanfit_io::render::{render_surface_scene_png, Colouring, Marker, Polyline};
+use scanfit_io::step_shell::step_shell_file;
 use scanfit_io::write_all_atomic;
 
 use crate::args::pair;
@@ -269,7 +274,7 @@ fn outputs(a: &ReconstructArgs, r: &ReconstructReport, cloud: &PointCloud) -> Re
             .file_stem()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
-        files.extend(model_files(a, model, &name)?);
+        files.extend(model_files(a, r, model, &name)?);
     }
     if a.mesh.is_none() && a.png.is_none() && a.deviation_png.is_none() {
         return Ok(files);
@@ -289,7 +294,10 @@ fn outputs(a: &ReconstructArgs, r: &ReconstructReport, cloud: &PointCloud) -> Re
     opts.iso_lines = 0;
     if let Some(p) = &a.png {
         // neighbouring ids far apart on the colour map (golden-ratio steps)
-        let values: Vec<f64> = patch.iter().map(|&k| (k as f64 * 0.618_033_988_75).fract()).collect();
+        let values: Vec<f64> = patch
+            .iter()
+            .map(|&k| (k as f64 * 0.618_033_988_75).fract())
+            .collect();
         opts.legend = vec![format!(
             "{} patches, {} edges, {} corners",
             r.faces.len(),
@@ -444,12 +452,90 @@ fn json_report(
 /// `-o`, `--step` and `--iges` of the model.
 fn model_files(
     a: &ReconstructArgs,
-    model: &scanfit::topology::PatchComplex,
+    r: &ReconstructReport,
+    model: &PatchComplex,
     name: &str,
 ) -> Result<Files> {
-    let _ = (model, name);
-    if a.output.is_some() || a.step.is_some() || a.iges.is_some() {
-        bail!("the model writers are not merged yet");
+    let mut files: Files = Vec::new();
+    if let Some(o) = &a.output {
+        files.push((o.clone(), model_doc(a, r, model).to_json().into_bytes()));
     }
-    Ok(Vec::new())
+    if let Some(p) = &a.step {
+        files.push((p.clone(), step_shell_file(model, name)?.text.into_bytes()));
+    }
+    if let Some(p) = &a.iges {
+        files.push((p.clone(), iges_model_file(model, name)?.into_bytes()));
+    }
+    Ok(files)
+}
+
+/// The scanfit-model/1 document with provenance and the report.
+fn model_doc(a: &ReconstructArgs, r: &ReconstructReport, model: &PatchComplex) -> ModelDoc {
+    let stats = |s: &scanfit::metrics::ErrorStats| model::ErrorStats {
+        mean: s.mean,
+        max: s.max,
+        rmse: s.rmse,
+    };
+    let mut doc = ModelDoc::new(model);
+    let mut settings = std::collections::BTreeMap::new();
+    settings.insert("fit".into(), r_fit(a).into());
+    settings.insert("labels".into(), r.network.attribute.clone().into());
+    settings.insert("contact_radius".into(), r.network.contact_radius.into());
+    doc.provenance = Some(Provenance {
+        tool: format!("scanfit {}", env!("CARGO_PKG_VERSION")),
+        operation: "reconstruct (patch network, shared edge curves, Coons + PDE per patch)".into(),
+        parameterization: Some("closest point on the Coons patch".into()),
+        input: Some(a.input.input.display().to_string()),
+        point_count: Some(r.totals.errors.count),
+        settings,
+    });
+    doc.report = Some(ModelReport {
+        patches: r
+            .patches
+            .iter()
+            .map(|p| model::PatchReport {
+                id: p.id,
+                sides: p.sides,
+                points: p.points,
+                coons_error: Some(stats(&p.coons_errors)),
+                error: Some(stats(&p.errors)),
+                distance: Some(stats(&p.orthogonal)),
+                extra: Default::default(),
+            })
+            .collect(),
+        edges: r
+            .edges
+            .iter()
+            .enumerate()
+            .map(|(k, e)| model::EdgeReport {
+                edge: k,
+                patches: e.patches.iter().flatten().copied().collect(),
+                points: r.network.edges[k].points,
+                max_gap: e.max_gap,
+                max_normal_angle_deg: e.patches[1].map(|_| e.max_angle.to_degrees()),
+                extra: Default::default(),
+            })
+            .collect(),
+        totals: ModelTotals {
+            patches: r.patches.len(),
+            edges: r.edges.len(),
+            vertices: r.network.vertices.len(),
+            points: r.totals.errors.count,
+            max_gap: r.totals.max_gap,
+            max_normal_angle_deg: Some(r.totals.max_angle.to_degrees()),
+            error: Some(stats(&r.totals.errors)),
+            volume: r.totals.closed.then(|| model.signed_volume().abs()),
+            extra: Default::default(),
+        },
+    });
+    doc
+}
+
+/// The fit route as named in the provenance.
+fn r_fit(a: &ReconstructArgs) -> String {
+    match (a.fit.as_deref(), &a.pde) {
+        (Some("bspline"), _) => format!("bspline {}", a.ctrl),
+        (_, Some(t)) => format!("pde {t}"),
+        _ => "pde 5x5".into(),
+    }
 }

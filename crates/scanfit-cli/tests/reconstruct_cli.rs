@@ -38,7 +38,14 @@ fn write_can(path: &Path, label: impl Fn(usize, i64) -> String) {
             let z = (j as f64 + 0.5) / nz as f64 * 2.0;
             let r = 1.0 + noise();
             let l = ((t / (PI / 2.0)) as i64).min(3);
-            writeln!(out, "{:.6} {:.6} {z:.6} {}", r * t.cos(), r * t.sin(), label(k, l)).unwrap();
+            writeln!(
+                out,
+                "{:.6} {:.6} {z:.6} {}",
+                r * t.cos(),
+                r * t.sin(),
+                label(k, l)
+            )
+            .unwrap();
             k += 1;
         }
     }
@@ -99,7 +106,10 @@ fn can_report_pictures_and_mesh() {
     assert_eq!(&std::fs::read(&glb).unwrap()[0..4], b"glTF");
     // the tables name every patch and the largest gap
     let out = ok(&run(&["reconstruct", s(&input), "-q"]));
-    assert!(out.contains("6 patches, 12 edges, 8 corners, closed"), "{out}");
+    assert!(
+        out.contains("6 patches, 12 edges, 8 corners, closed"),
+        "{out}"
+    );
     assert!(out.contains("largest gap along an edge"), "{out}");
 }
 
@@ -108,7 +118,14 @@ fn ignored_cap_leaves_an_open_can() {
     let d = tmpdir("reconstruct", "ignore");
     let input = d.join("can.xyz");
     write_can(&input, |_, l| l.to_string());
-    let out = ok(&run(&["reconstruct", s(&input), "--ignore", "11", "--json", "-q"]));
+    let out = ok(&run(&[
+        "reconstruct",
+        s(&input),
+        "--ignore",
+        "11",
+        "--json",
+        "-q",
+    ]));
     let j: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(j["totals"]["faces"], 5);
     assert_eq!(j["totals"]["closed"], false);
@@ -128,7 +145,14 @@ fn bspline_route() {
     let input = d.join("can.xyz");
     write_can(&input, |_, l| l.to_string());
     let out = ok(&run(&[
-        "reconstruct", s(&input), "--fit", "bspline", "--ctrl", "6x6", "--json", "-q",
+        "reconstruct",
+        s(&input),
+        "--fit",
+        "bspline",
+        "--ctrl",
+        "6x6",
+        "--json",
+        "-q",
     ]));
     let j: serde_json::Value = serde_json::from_str(&out).unwrap();
     let t = &j["totals"];
@@ -154,7 +178,10 @@ fn refused(name: &str, label: impl Fn(usize, i64) -> String, extra: &[&str]) -> 
 #[test]
 fn one_label_points_to_coons() {
     let e = refused("single", |_, _| "3".into(), &[]);
-    assert!(e.contains("single patch") && e.contains("scanfit coons"), "{e}");
+    assert!(
+        e.contains("single patch") && e.contains("scanfit coons"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -165,18 +192,174 @@ fn float_labels_are_refused() {
 
 #[test]
 fn text_labels_are_refused() {
-    let e = refused("text", |_, l| if l == 11 { "lid".into() } else { l.to_string() }, &[]);
+    let e = refused(
+        "text",
+        |_, l| if l == 11 { "lid".into() } else { l.to_string() },
+        &[],
+    );
     assert!(e.contains("lid"), "{e}");
 }
 
 #[test]
 fn tiny_patch_is_named() {
-    let e = refused("tiny", |k, l| if k < 5 { "42".into() } else { l.to_string() }, &[]);
-    assert!(e.contains("patch 42 has 5 points") && e.contains("--ignore 42"), "{e}");
+    let e = refused(
+        "tiny",
+        |k, l| if k < 5 { "42".into() } else { l.to_string() },
+        &[],
+    );
+    assert!(
+        e.contains("patch 42 has 5 points") && e.contains("--ignore 42"),
+        "{e}"
+    );
 }
 
 #[test]
 fn missing_label_attribute_is_named() {
     let e = refused("noattr", |_, l| l.to_string(), &["--labels", "segment"]);
     assert!(e.contains("'segment'") && e.contains("label"), "{e}");
+}
+
+fn occ_available() -> bool {
+    std::process::Command::new("python3")
+        .args(["-c", "import OCP"])
+        .output()
+        .map(|o| o.status.success())
+        .unwrap_or(false)
+}
+
+/// The OpenCASCADE read-back of a model (scanfit-io's `check_model.py`), or
+/// `None`, loudly, without OpenCASCADE (a failure with SCANFIT_REQUIRE_OCC=1).
+fn occ_check(json: &Path, step: &Path) -> Option<serde_json::Value> {
+    if !occ_available() {
+        eprintln!("\n*****************************************************************");
+        eprintln!("* OpenCASCADE (pip install cadquery-ocp) is NOT installed: the  *");
+        eprintln!("* reconstructed STEP shell was NOT checked by a CAD kernel       *");
+        eprintln!("*****************************************************************\n");
+        assert!(
+            std::env::var_os("SCANFIT_REQUIRE_OCC").is_none(),
+            "SCANFIT_REQUIRE_OCC is set but OpenCASCADE is missing"
+        );
+        return None;
+    }
+    let script =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../scanfit-io/tests/occ/check_model.py");
+    let o = std::process::Command::new("python3")
+        .arg(script)
+        .arg(json)
+        .arg(step)
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(
+        o.status.success(),
+        "check_model.py: {out} {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    println!("OpenCASCADE: {out}");
+    Some(serde_json::from_str(&out).unwrap())
+}
+
+#[test]
+fn vessel_is_one_valid_solid_of_the_true_volume() {
+    let d = tmpdir("reconstruct", "vessel");
+    let input = common::examples().join("vessel_30k.ply");
+    let truth: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(common::examples().join("vessel_30k.json")).unwrap(),
+    )
+    .unwrap();
+    let (json, step, iges) = (d.join("v.json"), d.join("v.stp"), d.join("v.igs"));
+    let out = ok(&run(&[
+        "reconstruct",
+        s(&input),
+        "-o",
+        s(&json),
+        "--step",
+        s(&step),
+        "--iges",
+        s(&iges),
+        "--json",
+        "-q",
+    ]));
+    let r: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let t = &r["totals"];
+    assert_eq!(t["faces"], 14);
+    assert_eq!(t["closed"], true);
+    let diag = t["diagonal"].as_f64().unwrap();
+    assert!(t["max_gap"].as_f64().unwrap() <= 1e-9 * diag, "{t}");
+    // the fit error at the noise level (sigma 0.037, creases at the rims)
+    let sigma = truth["noise_sigma"].as_f64().unwrap();
+    assert!(
+        t["orthogonal"]["rmse"].as_f64().unwrap() < 2.5 * sigma,
+        "{t}"
+    );
+    // the model document: closed, sewn, the volume in its report
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(doc["schema"], "scanfit-model/1");
+    assert_eq!(doc["closed"], true);
+    assert_eq!(doc["patches"].as_array().unwrap().len(), 14);
+    let text = std::fs::read_to_string(&step).unwrap();
+    assert!(text.contains("CLOSED_SHELL(") && text.contains("MANIFOLD_SOLID_BREP("));
+    assert_eq!(text.matches("EDGE_CURVE(").count(), 28);
+    assert_eq!(text.matches("ADVANCED_FACE(").count(), 14);
+    assert!(std::fs::read_to_string(&iges).unwrap().lines().count() > 100);
+    let truth_volume = truth["true_volume_mesh"].as_f64().unwrap();
+    if let Some(occ) = occ_check(&json, &step) {
+        assert_eq!(occ["shells"], 1);
+        assert_eq!(occ["solids"], 1);
+        assert_eq!(occ["faces"], 14);
+        assert_eq!(occ["valid"], true, "{occ}");
+        assert_eq!(occ["free_edges"], 0, "{occ}");
+        let v = occ["volume"].as_f64().unwrap();
+        assert!(
+            (v / truth_volume - 1.0).abs() < 0.01,
+            "volume {v} vs {truth_volume}"
+        );
+        assert!(
+            occ["max_face_diff"].as_f64().unwrap() < 1e-9 * diag,
+            "{occ}"
+        );
+    }
+}
+
+#[test]
+fn umbrella_is_one_open_shell_of_three_sided_panels() {
+    let d = tmpdir("reconstruct", "umbrella");
+    let input = common::examples().join("umbrella_20k.ply");
+    let (json, step) = (d.join("u.json"), d.join("u.stp"));
+    let out = ok(&run(&[
+        "reconstruct",
+        s(&input),
+        "-o",
+        s(&json),
+        "--step",
+        s(&step),
+        "--json",
+        "-q",
+    ]));
+    let r: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(r["totals"]["faces"], 8);
+    assert_eq!(r["totals"]["corners"], 9);
+    assert_eq!(r["totals"]["edges"], 16);
+    assert_eq!(r["totals"]["closed"], false);
+    assert!(r["patches"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|p| p["sides"] == 3));
+    let diag = r["totals"]["diagonal"].as_f64().unwrap();
+    assert!(r["totals"]["max_gap"].as_f64().unwrap() <= 1e-9 * diag);
+    let text = std::fs::read_to_string(&step).unwrap();
+    assert!(text.contains("OPEN_SHELL("));
+    if let Some(occ) = occ_check(&json, &step) {
+        assert_eq!(occ["shells"], 1);
+        assert_eq!(occ["faces"], 8);
+        assert_eq!(occ["valid"], true, "{occ}");
+        // free edges only on the rim: the 8 rim edges
+        assert_eq!(occ["free_edges"], 8, "{occ}");
+        assert!(
+            occ["max_face_diff"].as_f64().unwrap() < 1e-9 * diag,
+            "{occ}"
+        );
+    }
 }

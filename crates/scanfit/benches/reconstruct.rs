@@ -83,11 +83,19 @@ fn bench(c: &mut Criterion) {
     let mut last = t0;
     let mut names = vec!["(start)".to_string()];
     for (name, t) in v.iter() {
-        eprintln!("  {:<14} {:.3} s", names.last().unwrap(), (*t - last).as_secs_f64());
+        eprintln!(
+            "  {:<14} {:.3} s",
+            names.last().unwrap(),
+            (*t - last).as_secs_f64()
+        );
         names.push(name.clone());
         last = *t;
     }
-    eprintln!("  {:<14} {:.3} s", names.last().unwrap(), (end - last).as_secs_f64());
+    eprintln!(
+        "  {:<14} {:.3} s",
+        names.last().unwrap(),
+        (end - last).as_secs_f64()
+    );
     eprintln!(
         "  {} patches, {} edges, {} corners; max gap {:.2e}; orthogonal rmse {:.2e}; total {:.3} s",
         r.patches.len(),

@@ -13,7 +13,7 @@
 //! three runs has its free runs split at their sharpest points (smallest
 //! turning angle, Coons paper eq. 12).
 
-use crate::cloud::corners::{corner_values, find_corners, CornerConfig, CornerCriterion};
+use crate::cloud::corners::{find_corners, CornerConfig};
 use crate::{Error, Point3, Result};
 
 use super::borders::Border;
@@ -174,10 +174,18 @@ fn split_free(runs: &mut Vec<Run>, pts: &[Point3], id: i64, min_length: f64) -> 
             .collect();
         return Ok(());
     }
-    let offset =
-        ((n as f64 / 100.0).round() as usize).clamp(1, n.div_ceil(2).saturating_sub(1).max(1));
-    let angles = corner_values(pts, CornerCriterion::TurningAngle, offset)
-        .map_err(|e| Error::InvalidInput(format!("patch {id}: corners of its border: {e}")))?;
+    // arc length along the loop, to measure angles over a fixed length
+    let mut arc = vec![0.0; n + 1];
+    for i in 0..n {
+        arc[i + 1] = arc[i] + (pts[(i + 1) % n] - pts[i]).norm();
+    }
+    let total = arc[n];
+    // the point `d` along the loop from position `i` (either direction)
+    let along = |i: usize, d: f64| -> Point3 {
+        let target = (arc[i] + d).rem_euclid(total);
+        let k = arc.partition_point(|&x| x <= target).clamp(1, n) - 1;
+        pts[k % n]
+    };
     while runs.len() < 4 {
         // the longest free run that can still be split
         let best = runs
@@ -206,15 +214,30 @@ fn split_free(runs: &mut Vec<Run>, pts: &[Point3], id: i64, min_length: f64) -> 
             )));
         };
         let r = runs[k];
+        // the turning angle (Coons paper eq. 12) over chords of an eighth of
+        // the run (at least the shortest run): the zig-zag of the alpha shape
+        // averages out
+        let chord = (run_length(pts, r.start, r.len) / 8.0).max(min_length);
+        let angle = |x: usize| {
+            let i = (r.start + x) % n;
+            let (a, b) = (along(i, -chord) - pts[i], along(i, chord) - pts[i]);
+            let d = a.norm() * b.norm();
+            if d > 0.0 {
+                (a.dot(&b) / d).clamp(-1.0, 1.0).acos()
+            } else {
+                std::f64::consts::PI
+            }
+        };
         // keep a tenth of the run (and two points) clear of its ends
         let margin = (r.len / 10).max(2);
-        let Some(at) = (margin..r.len.saturating_sub(margin))
-            .min_by(|&x, &y| angles[(r.start + x) % n].total_cmp(&angles[(r.start + y) % n]))
+        let Some((at, sharp)) = (margin..r.len.saturating_sub(margin))
+            .map(|x| (x, angle(x)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
         else {
             return Ok(());
         };
         // a third side is always needed; a fourth only at a real corner
-        if runs.len() >= 3 && angles[(r.start + at) % n] > SHARP_ANGLE {
+        if runs.len() >= 3 && sharp > SHARP_ANGLE {
             return Ok(());
         }
         runs[k] = Run {
