@@ -2,6 +2,8 @@
 //! network counts, the gap along every edge sampled from both sides, fit
 //! errors against the noise, and bad input.
 
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use scanfit::network::{build_network, NetworkConfig};
 use scanfit::pipeline::reconstruct::{run, ReconstructConfig};
 use scanfit::progress::NoProgress;

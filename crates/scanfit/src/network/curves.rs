@@ -56,7 +56,10 @@ fn pow2_floor(x: usize) -> usize {
 /// Fits the curve of an edge from `start` to `end` through the border points
 /// of its patches: `guide` (ordered from start to end, the first patch's
 /// border) and `others` (any order: the second patch's border). `bin` is the
-/// bin length (about one point spacing).
+/// bin length (about one point spacing). Border points closer than
+/// `clearance` to either vertex are left out: near a junction a border also
+/// runs along the next edge (within the contact radius of the patch across),
+/// and the vertices pin the ends anyway.
 ///
 /// ```
 /// use scanfit::network::{fit_edge_curve, EdgeCurveConfig};
@@ -64,7 +67,7 @@ fn pow2_floor(x: usize) -> usize {
 /// let guide: Vec<Point3> = (0..=40).map(|i| Point3::new(i as f64 * 0.025, 0.01, 0.0)).collect();
 /// let others: Vec<Point3> = (0..=40).map(|i| Point3::new(i as f64 * 0.025, -0.01, 0.0)).collect();
 /// let (a, b) = (Point3::new(0., 0., 0.), Point3::new(1., 0., 0.));
-/// let e = fit_edge_curve(a, b, &guide, &others, 0.025, &EdgeCurveConfig::default())?;
+/// let e = fit_edge_curve(a, b, &guide, &others, 0.025, 0.05, &EdgeCurveConfig::default())?;
 /// assert_eq!(e.curve.point(0.0), a);
 /// assert_eq!(e.curve.point(1.0), b);
 /// assert!(e.curve.point(0.5).y.abs() < 1e-3);
@@ -76,8 +79,14 @@ pub fn fit_edge_curve(
     guide: &[Point3],
     others: &[Point3],
     bin: f64,
+    clearance: f64,
     cfg: &EdgeCurveConfig,
 ) -> Result<EdgeCurve> {
+    if !(clearance.is_finite() && clearance >= 0.0) {
+        return Err(Error::InvalidInput(format!(
+            "edge end clearance {clearance} must be finite and >= 0"
+        )));
+    }
     if !(bin.is_finite() && bin > 0.0) {
         return Err(Error::InvalidInput(format!(
             "edge bin length {bin} must be positive"
@@ -99,7 +108,7 @@ pub fn fit_edge_curve(
         s[k] = s[k - 1] + (poly[k] - poly[k - 1]).norm();
     }
     let length = s[poly.len() - 1];
-    if !(length > 0.0) {
+    if length.is_nan() || length <= 0.0 {
         return Err(Error::InvalidInput(
             "an edge of zero length (its two corners coincide)".into(),
         ));
@@ -108,7 +117,8 @@ pub fn fit_edge_curve(
     let bins = ((length / bin).round() as usize).max(1);
     let mut acc = vec![(crate::Vector3::zeros(), 0usize); bins];
     let interior = &poly[1..poly.len() - 1];
-    for q in guide.iter().chain(others) {
+    let clear = |q: &Point3| (q - start).norm() >= clearance && (q - end).norm() >= clearance;
+    for q in guide.iter().chain(others).filter(|q| clear(q)) {
         let (k, _) = interior
             .iter()
             .enumerate()

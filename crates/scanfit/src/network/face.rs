@@ -479,7 +479,8 @@ fn bspline_fit(
     let (lo, hi) = diag
         .iter()
         .fold((f64::INFINITY, 0.0f64), |(a, b), &x| (a.min(x), b.max(x)));
-    if !((hi / lo).powi(2) <= crate::fit::CONDITION_LIMIT) {
+    let condition = (hi / lo).powi(2);
+    if condition.is_nan() || condition > crate::fit::CONDITION_LIMIT {
         return Err(singular());
     }
     let x = llt.solve(&r);

@@ -257,6 +257,9 @@ fn split_free(runs: &mut Vec<Run>, pts: &[Point3], id: i64, min_length: f64) -> 
     Ok(())
 }
 
+/// A run of a patch: (patch, run index).
+type RunRef = (usize, usize);
+
 /// Union-find over corner candidates.
 struct Dsu(Vec<usize>);
 
@@ -329,7 +332,8 @@ pub fn junctions(
     };
     // match the run of A facing B with the run of B facing A
     let mut dsu = Dsu((0..cand_pos.len()).collect());
-    let mut pairs: Vec<((usize, usize), Option<(usize, usize)>)> = Vec::new();
+    // (patch, run) of each edge's first side, and of its second if shared
+    let mut pairs: Vec<(RunRef, Option<RunRef>)> = Vec::new();
     for a in 0..all_runs.len() {
         for (ra, run) in all_runs[a].iter().enumerate() {
             if run.across.is_none() {

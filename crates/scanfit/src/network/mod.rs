@@ -233,6 +233,7 @@ pub fn build_network(
                     &guide,
                     &others,
                     spacing,
+                    radius,
                     &cfg.curves,
                 );
                 progress.advance(1);

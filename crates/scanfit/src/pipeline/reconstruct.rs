@@ -176,7 +176,7 @@ pub fn edge_uv(sides: &[Vec<NetUse>], curves: &[Curve], edge: usize, t: f64) -> 
 /// let r = run(&cloud, &ReconstructConfig::default(), &NoProgress)?;
 /// assert_eq!(r.patches.len(), 2);
 /// assert!(r.totals.max_gap <= 1e-9 * r.totals.diagonal);
-/// assert!(r.totals.errors.max < 1e-2);
+/// assert!(r.totals.orthogonal.rmse < 1e-3, "{:?}", r.totals.orthogonal);
 /// # Ok::<(), scanfit::Error>(())
 /// ```
 pub fn run(
@@ -261,9 +261,9 @@ pub fn run(
             sides: s.len(),
             edges: p.cycle.len(),
             points: p.points.len(),
-            coons_errors: f.coons_errors.clone(),
-            errors: f.errors.clone(),
-            orthogonal: f.orthogonal.clone(),
+            coons_errors: f.coons_errors,
+            errors: f.errors,
+            orthogonal: f.orthogonal,
             conversion_deviation: f.conversion_deviation,
         })
         .collect();
