@@ -187,8 +187,16 @@ mod tests {
         let (a, b) = (Point3::new(1., 0., 0.), Point3::new(0., 1., 0.));
         let mut other = side(0.99);
         other.reverse();
-        let e =
-            fit_edge_curve(a, b, &side(1.01), &other, 0.01, &EdgeCurveConfig::default()).unwrap();
+        let e = fit_edge_curve(
+            a,
+            b,
+            &side(1.01),
+            &other,
+            0.01,
+            0.03,
+            &EdgeCurveConfig::default(),
+        )
+        .unwrap();
         assert_eq!(e.curve.control_points()[0], a);
         for k in 0..=20 {
             let p = e.curve.point(k as f64 / 20.0);
