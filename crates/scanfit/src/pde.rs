@@ -355,45 +355,74 @@ pub fn fit_pde(
     // parallel, summed in order: the result does not depend on the threads)
     // a group of as many blocks as threads at a time, so that memory stays at
     // (threads) Gram matrices however many points there are
+    // The Gram matrix of the sine basis from cosine sums: with
+    // sin(a) sin(b) = (cos(a - b) - cos(a + b)) / 2 in u and in v,
+    // G[(m,n),(m',n')] = sum_i s_m(u_i) s_m'(u_i) s_n(v_i) s_n'(v_i)
+    //   = (C(|m-m'|,|n-n'|) - C(|m-m'|,n+n') - C(m+m',|n-n'|) + C(m+m',n+n')) / 4
+    // with C(p, q) = sum_i cos(p pi u_i) cos(q pi v_i): (2M+1)(2N+1) sums per
+    // point instead of (MN)^2 / 2 products.
+    let (pu, pv) = (2 * mm + 1, 2 * nn + 1);
     let block = |b: usize| {
         let r = b * BLOCK..((b + 1) * BLOCK).min(points.len());
-        let rows = r.len();
-        let mut a = Mat::<f64>::zeros(rows, kk);
-        let mut rhs = Mat::<f64>::zeros(rows, 3);
-        let mut sv = vec![0.0; nn];
-        for (row, i) in r.enumerate() {
+        let mut c = vec![0.0; pu * pv];
+        let mut rhs = Mat::<f64>::zeros(kk, 3);
+        let (mut cu, mut cv) = (vec![0.0; pu], vec![0.0; pv]);
+        let (mut su, mut sv) = (vec![0.0; mm], vec![0.0; nn]);
+        for i in r {
             let [u, v] = uv[i];
-            for (n0, s) in sv.iter_mut().enumerate() {
-                *s = sin_k_pi(n0 + 1, v);
+            for (p, x) in cu.iter_mut().enumerate() {
+                *x = (p as f64 * PI * u).cos();
             }
-            for m in 1..=mm {
-                let su = sin_k_pi(m, u);
-                for (n0, &s) in sv.iter().enumerate() {
-                    a[(row, (m - 1) * nn + n0)] = su * s;
+            for (q, x) in cv.iter_mut().enumerate() {
+                *x = (q as f64 * PI * v).cos();
+            }
+            for (p, &a) in cu.iter().enumerate() {
+                for (q, &b) in cv.iter().enumerate() {
+                    c[p * pv + q] += a * b;
                 }
             }
+            for (m0, x) in su.iter_mut().enumerate() {
+                *x = sin_k_pi(m0 + 1, u);
+            }
+            for (n0, x) in sv.iter_mut().enumerate() {
+                *x = sin_k_pi(n0 + 1, v);
+            }
             let off = points[i] - base[i];
-            for c in 0..3 {
-                rhs[(row, c)] = off[c];
+            for (m0, &a) in su.iter().enumerate() {
+                for (n0, &b) in sv.iter().enumerate() {
+                    let w = a * b;
+                    for k in 0..3 {
+                        rhs[(m0 * nn + n0, k)] += w * off[k];
+                    }
+                }
             }
         }
-        let at = a.as_ref().transpose();
-        (at * a.as_ref(), at * rhs.as_ref())
+        (c, rhs)
     };
     let nblocks = points.len().div_ceil(BLOCK);
     let group = rayon::current_num_threads().max(1);
-    let mut g = Mat::<f64>::zeros(kk, kk);
+    let mut csum = vec![0.0; pu * pv];
     let mut rhs = Mat::<f64>::zeros(kk, 3);
     for start in (0..nblocks).step_by(group) {
-        let blocks: Vec<(Mat<f64>, Mat<f64>)> = (start..(start + group).min(nblocks))
+        let blocks: Vec<(Vec<f64>, Mat<f64>)> = (start..(start + group).min(nblocks))
             .into_par_iter()
             .map(block)
             .collect();
-        for (bg, br) in &blocks {
-            g += bg;
+        for (bc, br) in &blocks {
+            for (x, y) in csum.iter_mut().zip(bc) {
+                *x += y;
+            }
             rhs += br;
         }
     }
+    let cs = |p: usize, q: usize| csum[p * pv + q];
+    let g = Mat::<f64>::from_fn(kk, kk, |a, b| {
+        let (m, n) = (a / nn + 1, a % nn + 1);
+        let (m2, n2) = (b / nn + 1, b % nn + 1);
+        let (dm, sm) = (m.abs_diff(m2), m + m2);
+        let (dn, sn) = (n.abs_diff(n2), n + n2);
+        0.25 * (cs(dm, dn) - cs(dm, sn) - cs(sm, dn) + cs(sm, sn))
+    });
     let llt = g.llt(Side::Lower).map_err(|_| Error::Singular {
         what: format!("PDE deformation least squares (eq. 13, {mm} x {nn} terms)"),
         condition: f64::INFINITY,
