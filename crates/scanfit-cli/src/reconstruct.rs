@@ -30,9 +30,9 @@ use crate::progress::Progress;
 use crate::table::{num, Table};
 
 const EXAMPLES: &str = "Examples:
-  scanfit reconstruct examples/data/pot.ply --step pot.stp --png pot.png
-  scanfit reconstruct examples/data/umbrella.ply --pde 8x8 -o umbrella.json --mesh umbrella.glb
-  scanfit reconstruct scan.ply --labels segment --ignore 0,99 --fit bspline --ctrl 12x12 --json
+  scanfit reconstruct examples/data/vessel_30k.ply --step vessel.stp --png vessel.png
+  scanfit reconstruct examples/data/umbrella_20k.ply --pde 8x8 -o umbrella.json --mesh umbrella.glb
+  scanfit reconstruct examples/data/vessel_30k.ply --labels label --ignore 14 --fit bspline --ctrl 12x12 --json
 
 Input: a point cloud whose points carry an integer patch id (PLY/PCD property
 or text column `label`, `segment`, `segment_id`, `class` or `scalar_label`,
