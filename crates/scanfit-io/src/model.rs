@@ -598,6 +598,28 @@ mod tests {
         assert!(!back.closed);
     }
 
+    #[test]
+    fn files_are_read_and_oversized_files_refused_before_reading() {
+        let dir = std::env::temp_dir().join(format!("scanfit-model-doc-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let m = two_patches();
+        let path = dir.join("m.json");
+        std::fs::write(&path, ModelDoc::new(&m).to_json()).unwrap();
+        let (_, back) = read_model(&path).unwrap();
+        assert_eq!(back, m);
+        // a sparse file just over the limit: refused by its size, not read
+        let big = dir.join("big.json");
+        let f = std::fs::File::create(&big).unwrap();
+        f.set_len(MAX_DOCUMENT_BYTES + 1).unwrap();
+        let e = read_model(&big).unwrap_err().to_string();
+        assert!(e.contains("more than the 268435456"), "{e}");
+        let e = read_model(&dir.join("missing.json"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("missing.json"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
     fn err(text: &str) -> String {
         parse_model(Path::new("bad.json"), text)
             .unwrap_err()

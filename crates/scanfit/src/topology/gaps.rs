@@ -8,6 +8,11 @@
 //! `(C(t) - p) . C'(t) = 0` (NURBS Book §6.1, eq. 6.3). Two faces sharing
 //! the edge are compared with each other the same way (`face_gap`): that is
 //! the gap a CAD system sees between the patches.
+//!
+//! [`PatchComplex::normal_angles`] measures the other defect along a shared
+//! edge: the angle between the two faces' unit normals `S_u x S_v / |.|`
+//! (zero for a tangent-continuous, G1, join), at points matched by closest
+//! point on the neighbour's side.
 
 use super::{PatchComplex, SideRef};
 use crate::bspline::{BasisWorkspace, Curve};
@@ -147,9 +152,14 @@ pub fn distance_to_curve(curve: &Curve, p: &Point3) -> (f64, f64) {
 }
 
 impl PatchComplex {
-    /// Measured gaps of every edge (see the module doc of [`super::gaps`]:
-    /// sampled, geometric). Needs [`PatchComplex::validate_structure`] to hold
-    /// for the indices; an out-of-range use is skipped.
+    /// Measured gaps of every edge: for each face side that uses it, the
+    /// two-sided Hausdorff distance between the side (the surface's boundary
+    /// iso-curve, [`super::Face::side_curve`]) and the edge's curve, and
+    /// between the two sides sharing it; estimated from dense samples (8 per
+    /// knot span of either curve, at least 33) projected onto the other curve
+    /// by Newton's iteration (NURBS Book eq. 6.3), so independent of how the
+    /// curves are parameterized. Needs [`PatchComplex::validate_structure`]
+    /// to hold for the indices; an out-of-range use is skipped.
     pub fn boundary_gaps(&self) -> Result<Vec<EdgeGap>> {
         let users = self.edge_faces();
         let mut out = Vec::with_capacity(self.edges.len());
@@ -185,6 +195,53 @@ impl PatchComplex {
         Ok(out)
     }
 
+    /// For every edge shared by two faces, the largest angle in degrees
+    /// between their unit normals along it (the G1 defect; `None` for a
+    /// border edge). Sampled at `samples` points strictly inside the edge
+    /// (at least 1), each matched to the neighbour by closest point on its
+    /// side; points where either normal is undefined (a collapsed corner, a
+    /// straight-angle corner) are skipped, and an edge with no defined
+    /// sample is `None`.
+    pub fn normal_angles(&self, samples: usize) -> Result<Vec<Option<f64>>> {
+        let n = samples.max(1);
+        let users = self.edge_faces();
+        let mut out = Vec::with_capacity(self.edges.len());
+        for uses in users.iter() {
+            let [a, b] = uses.as_slice() else {
+                out.push(None);
+                continue;
+            };
+            let (Some(fa), Some(fb)) = (self.faces.get(a.face), self.faces.get(b.face)) else {
+                out.push(None);
+                continue;
+            };
+            let cb = fb.side_curve(b.side)?;
+            let (t0, t1) = cb.domain();
+            let mut probe = Probe::new(&cb, sample_count(&cb, &cb));
+            let (pa, qa) = fa.surface.degrees();
+            let (pb, qb) = fb.surface.degrees();
+            let mut wa = (BasisWorkspace::new(pa, 1), BasisWorkspace::new(qa, 1));
+            let mut wb = (BasisWorkspace::new(pb, 1), BasisWorkspace::new(qb, 1));
+            let mut worst: Option<f64> = None;
+            for i in 0..n {
+                let s = (i as f64 + 0.5) / n as f64;
+                let (ua, va) = fa.side_parameters(a.side, s);
+                let p = fa.surface.point(ua, va);
+                let (t, _) = probe.closest(&p);
+                let sb = if t1 > t0 { (t - t0) / (t1 - t0) } else { 0.0 };
+                let (ub, vb) = fb.side_parameters(b.side, sb);
+                let na = unit_normal(&fa.surface, ua, va, &mut wa);
+                let nb = unit_normal(&fb.surface, ub, vb, &mut wb);
+                if let (Some(na), Some(nb)) = (na, nb) {
+                    let angle = na.dot(&nb).clamp(-1.0, 1.0).acos().to_degrees();
+                    worst = Some(worst.map_or(angle, |w: f64| w.max(angle)));
+                }
+            }
+            out.push(worst);
+        }
+        Ok(out)
+    }
+
     /// Largest gap over all edges: between a face side and its edge curve, or
     /// between the two faces sharing an edge.
     pub fn max_boundary_gap(&self) -> Result<f64> {
@@ -194,4 +251,21 @@ impl PatchComplex {
             .map(|g| g.curve_gap.max(g.face_gap))
             .fold(0.0f64, f64::max))
     }
+}
+
+/// `S_u x S_v / |S_u x S_v|`, or `None` where the normal is undefined (the
+/// cross product vanishes relative to `|S_u| |S_v|`).
+fn unit_normal(
+    s: &crate::bspline::Surface,
+    u: f64,
+    v: f64,
+    ws: &mut (BasisWorkspace, BasisWorkspace),
+) -> Option<Vector3> {
+    let mut d = [Vector3::zeros(); 4];
+    s.derivatives_into(u, v, &mut ws.0, &mut ws.1, 1, &mut d);
+    // d[1] = S_v, d[2] = S_u
+    let n = d[2].cross(&d[1]);
+    let len = n.norm();
+    let scale = d[2].norm() * d[1].norm();
+    (len > 1e-9 * scale && len.is_finite()).then(|| n / len)
 }

@@ -38,7 +38,9 @@
 //! curve starts and ends at its vertices, every face side coincides with its
 //! edge's curve, and every degenerate side is a single point at its vertex, all
 //! to a tolerance relative to the model's size ([`PatchComplex::scale`]).
-//! [`PatchComplex::boundary_gaps`] reports the measured gaps per edge.
+//! [`PatchComplex::boundary_gaps`] reports the measured gaps per edge and
+//! [`PatchComplex::normal_angles`] the angle between the two faces' normals
+//! along it (the G1 defect).
 //! [`PatchComplex::signed_volume`] integrates the enclosed volume of a closed
 //! complex by the divergence theorem (see [`volume`]).
 

@@ -319,3 +319,49 @@ fn volume_quadrature_is_exact_for_bicubic_faces() {
     assert!((s.point(0.3, 0.6).z - 0.09).abs() < 1e-15);
     assert!((volume::signed_volume([&s]) + 1.0 / 9.0).abs() < 1e-14);
 }
+
+#[test]
+fn normal_angles_measure_the_g1_defect() {
+    // the cube: every edge is a 90 degree crease
+    let m = cube(2.0);
+    let a = m.normal_angles(9).unwrap();
+    assert_eq!(a.len(), 12);
+    for x in &a {
+        let x = x.unwrap();
+        assert!((x - 90.0).abs() < 1e-9, "{x}");
+    }
+    // two squares folded by 30 degrees about their shared edge x = 1
+    let fold = 30f64.to_radians();
+    let p = |x: f64, y: f64| Point3::new(x, y, 0.0);
+    let q = |d: f64, y: f64| Point3::new(1.0 + d * fold.cos(), y, d * fold.sin());
+    let verts = vec![
+        p(0.0, 0.0),
+        p(1.0, 0.0),
+        q(1.0, 0.0),
+        p(0.0, 1.0),
+        p(1.0, 1.0),
+        q(1.0, 1.0),
+    ];
+    let m = PatchComplex::assemble(
+        verts.clone(),
+        vec![
+            FaceCorners {
+                id: 1,
+                surface: quad([verts[0], verts[1], verts[4], verts[3]]),
+                corners: [0, 1, 4, 3],
+            },
+            FaceCorners {
+                id: 2,
+                surface: quad([verts[1], verts[2], verts[5], verts[4]]),
+                corners: [1, 2, 5, 4],
+            },
+        ],
+    )
+    .unwrap();
+    m.validate().unwrap();
+    let a = m.normal_angles(5).unwrap();
+    let shared: Vec<f64> = a.iter().flatten().copied().collect();
+    assert_eq!(shared.len(), 1, "{a:?}");
+    assert!((shared[0] - 30.0).abs() < 1e-9, "{}", shared[0]);
+    assert_eq!(a.iter().filter(|x| x.is_none()).count(), 6);
+}
