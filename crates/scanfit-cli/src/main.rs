@@ -12,6 +12,7 @@ mod export;
 mod mba;
 mod outputs;
 mod progress;
+mod reconstruct;
 mod report;
 mod surface;
 mod table;
@@ -51,6 +52,8 @@ enum Command {
     Fit(surface::FitArgs),
     /// Bicubic surface z = f(x, y) by multilevel B-spline approximation (MBA).
     Mba(mba::MbaArgs),
+    /// Whole objects from segmented clouds: patches sharing their edge curves, one sewn model.
+    Reconstruct(reconstruct::ReconstructArgs),
     /// Deviation of points from a fitted surface: statistics and an HTML report.
     Report(report::ReportArgs),
     /// Cylinder-like clouds (heads, bottles, arms): virtual turntable parameterization and a surface closed around the axis.
@@ -190,6 +193,7 @@ fn dispatch(command: Command) -> anyhow::Result<()> {
         Command::Export(a) => export::run(a),
         Command::Fit(a) => surface::run(a),
         Command::Mba(a) => mba::run(a),
+        Command::Reconstruct(a) => reconstruct::run(a),
         Command::Report(a) => report::run(a),
         Command::Turntable(a) => turntable::run(a),
     }

@@ -27,8 +27,12 @@
 //! * [`metrics`]: surface error measures and parameterization quality.
 //! * [`project`]: point inversion (orthogonal projection onto surfaces).
 //! * [`pipeline`]: every pipeline of the command line as one call (config,
-//!   progress, report), and the one surface assessment [`pipeline::SurfaceQuality`].
+//!   progress, report), e.g. [`pipeline::reconstruct`] (a segmented cloud to
+//!   patches that share their edge curves), and the one surface assessment
+//!   [`pipeline::SurfaceQuality`].
 //! * [`quality`]: per-curve quality report (deviation, curvature, loops, length).
+//! * [`network`]: the patch network of a segmented cloud (labels, shared
+//!   corners and edges, edge curves, per-patch surfaces with exact boundaries).
 //! * [`topology`]: multi-patch models: vertices, shared edge curves, faces
 //!   and their checks (gaps along edges, enclosed volume).
 //! * [`surface`]: capability traits, [`surface::ParametricSurface`] (B-spline,
@@ -44,6 +48,7 @@ pub mod fit;
 mod geom;
 pub mod mba;
 pub mod metrics;
+pub mod network;
 pub mod par;
 pub mod param;
 pub mod pde;

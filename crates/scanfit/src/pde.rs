@@ -394,59 +394,84 @@ pub fn fit_pde(
     }
     // offsets wbar_i = P_i - S_c(u_i, v_i) (eq. 12)
     let base: Vec<Point3> = uv.par_iter().map(|t| coons.point(t[0], t[1])).collect();
-    // normal equations (eq. 13) for w_mn, assembled block by block
+    // normal equations (eq. 13) for w_mn, assembled block by block (blocks in
+    // parallel, merged in block order by crate::par: bit-identical for every
+    // thread count)
+    // The Gram matrix of the sine basis from cosine sums: with
+    // sin(a) sin(b) = (cos(a - b) - cos(a + b)) / 2 in u and in v,
+    // G[(m,n),(m',n')] = sum_i s_m(u_i) s_m'(u_i) s_n(v_i) s_n'(v_i)
+    //   = (C(|m-m'|,|n-n'|) - C(|m-m'|,n+n') - C(m+m',|n-n'|) + C(m+m',n+n')) / 4
+    // with C(p, q) = sum_i cos(p pi u_i) cos(q pi v_i): (2M+1)(2N+1) sums per
+    // point instead of (MN)^2 / 2 products.
+    let (pu, pv) = (2 * mm + 1, 2 * nn + 1);
     let block = |b: usize| {
         let r = b * BLOCK..((b + 1) * BLOCK).min(points.len());
-        let rows = r.len();
-        let mut a = Mat::<f64>::zeros(rows, kk);
-        let mut rhs = Mat::<f64>::zeros(rows, 3);
-        let mut sv = vec![0.0; nn];
-        for (row, i) in r.enumerate() {
+        let mut c = vec![0.0; pu * pv];
+        let mut rhs = Mat::<f64>::zeros(kk, 3);
+        let (mut cu, mut cv) = (vec![0.0; pu], vec![0.0; pv]);
+        let (mut su, mut sv) = (vec![0.0; mm], vec![0.0; nn]);
+        for i in r {
             let [u, v] = uv[i];
-            for (n0, s) in sv.iter_mut().enumerate() {
-                *s = sin_k_pi(n0 + 1, v);
+            for (p, x) in cu.iter_mut().enumerate() {
+                *x = (p as f64 * PI * u).cos();
             }
-            for m in 1..=mm {
-                let su = sin_k_pi(m, u);
-                for (n0, &s) in sv.iter().enumerate() {
-                    a[(row, (m - 1) * nn + n0)] = su * s;
+            for (q, x) in cv.iter_mut().enumerate() {
+                *x = (q as f64 * PI * v).cos();
+            }
+            for (p, &a) in cu.iter().enumerate() {
+                for (q, &b) in cv.iter().enumerate() {
+                    c[p * pv + q] += a * b;
                 }
             }
+            for (m0, x) in su.iter_mut().enumerate() {
+                *x = sin_k_pi(m0 + 1, u);
+            }
+            for (n0, x) in sv.iter_mut().enumerate() {
+                *x = sin_k_pi(n0 + 1, v);
+            }
             let off = points[i] - base[i];
-            for c in 0..3 {
-                rhs[(row, c)] = off[c];
+            for (m0, &a) in su.iter().enumerate() {
+                for (n0, &b) in sv.iter().enumerate() {
+                    let w = a * b;
+                    for k in 0..3 {
+                        rhs[(m0 * nn + n0, k)] += w * off[k];
+                    }
+                }
             }
         }
-        let at = a.as_ref().transpose();
-        (at * a.as_ref(), at * rhs.as_ref())
+        (c, rhs)
     };
-    // one partial per block of BLOCK points, merged in block order
-    // (crate::par): bit-identical for every thread count; at most as many
-    // kk x kk partials at a time as fit in 256 MiB
-    let max_partials = (256usize << 20) / (8 * kk * kk).max(1);
-    let (g, rhs) = crate::par::accumulate_bounded(
-        points.len().div_ceil(BLOCK),
+    let nblocks = points.len().div_ceil(BLOCK);
+    // one partial per block of BLOCK points (cosine sums and right-hand
+    // side, both small), merged in block order
+    let (csum, rhs) = crate::par::accumulate(
+        nblocks,
         1,
-        max_partials,
-        || None,
-        |acc: &mut Option<(Mat<f64>, Mat<f64>)>, blocks| {
-            // a chunk is one block: its partial is the block's product
-            *acc = blocks.map(&block).reduce(|(mut g, mut r), (bg, br)| {
-                g += &bg;
-                r += &br;
-                (g, r)
-            });
-        },
-        |total, part| {
-            if let Some((bg, br)) = part {
-                let (g, r) = total
-                    .get_or_insert_with(|| (Mat::<f64>::zeros(kk, kk), Mat::<f64>::zeros(kk, 3)));
-                *g += &bg;
-                *r += &br;
+        || (vec![0.0; pu * pv], Mat::<f64>::zeros(kk, 3)),
+        |acc: &mut (Vec<f64>, Mat<f64>), blocks| {
+            for b in blocks {
+                let (bc, br) = block(b);
+                for (x, y) in acc.0.iter_mut().zip(&bc) {
+                    *x += y;
+                }
+                acc.1 += &br;
             }
         },
-    )
-    .unwrap_or_else(|| (Mat::<f64>::zeros(kk, kk), Mat::<f64>::zeros(kk, 3)));
+        |total, (bc, br)| {
+            for (x, y) in total.0.iter_mut().zip(&bc) {
+                *x += y;
+            }
+            total.1 += &br;
+        },
+    );
+    let cs = |p: usize, q: usize| csum[p * pv + q];
+    let g = Mat::<f64>::from_fn(kk, kk, |a, b| {
+        let (m, n) = (a / nn + 1, a % nn + 1);
+        let (m2, n2) = (b / nn + 1, b % nn + 1);
+        let (dm, sm) = (m.abs_diff(m2), m + m2);
+        let (dn, sn) = (n.abs_diff(n2), n + n2);
+        0.25 * (cs(dm, dn) - cs(dm, sn) - cs(sm, dn) + cs(sm, sn))
+    });
     let llt = g.llt(Side::Lower).map_err(|_| Error::Singular {
         what: format!("PDE deformation least squares (eq. 13, {mm} x {nn} terms)"),
         condition: f64::INFINITY,

@@ -36,6 +36,8 @@
 //!   with the MBA paper's projection adjustment, with its per-level table.
 //! * [`measure`]: what `scanfit report` measures for a surface and points
 //!   (the assessment of their projections, percentiles, histogram).
+//! * [`reconstruct`]: a segmented cloud to a whole object, patches that
+//!   share their edge curves (`scanfit reconstruct`, PDE paper section 4).
 //! * [`surface_fit`]: least-squares surface through scattered points
 //!   (`scanfit fit`): parameters from the best-fit plane or given
 //!   attributes, optional Hoschek parameter correction.
@@ -47,6 +49,7 @@ pub mod coons;
 pub mod curve;
 pub mod mba;
 pub mod measure;
+pub mod reconstruct;
 pub mod surface_fit;
 pub mod turntable;
 

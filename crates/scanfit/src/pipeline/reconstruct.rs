@@ -1,0 +1,410 @@
+//! Whole-object reconstruction from a segmented cloud (issue 15): the patch
+//! network, one shared curve per edge, one surface per patch whose boundary
+//! is exactly those curves (PDE paper §§4-5, Coons paper §III).
+//!
+//! [`run`] builds the network ([`crate::network::build_network`]), groups
+//! each patch's edges into 3 or 4 sides, and fits every patch inside its
+//! side curves ([`crate::network::fit_face`]: Coons patch, closest-point
+//! parameters, PDE deformation or least-squares B-spline), the patches in
+//! parallel. It then samples every edge from each patch that uses it: the
+//! gap (which is rounding only, since the boundary control rows are the edge
+//! curves) and the angle between the two patches' normals (the G1 defect;
+//! the PDE paper makes no attempt at tangent continuity, nor does this).
+
+use rayon::prelude::*;
+
+use crate::bspline::{BasisWorkspace, Curve, Surface};
+use crate::metrics::ErrorStats;
+use crate::network::{
+    build_network, fit_face, group_sides, side_curve, side_ranges, FaceConfig, FaceFit,
+    FaceSurface, NetUse, Network, NetworkConfig,
+};
+use crate::progress::Progress;
+use crate::project::InversionConfig;
+use crate::topology::{self, PatchComplex};
+use crate::{Error, Point3, PointCloud, Result, Vector3};
+
+/// Settings of [`run`].
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct ReconstructConfig {
+    /// Labels, borders, junctions and edge curves (see [`NetworkConfig`]).
+    pub network: NetworkConfig,
+    /// The fit inside each patch's boundary: PDE deformation with 5 x 5
+    /// terms (default, the PDE paper's), or a least-squares B-spline.
+    pub fit: FaceFit,
+    /// Closest-point projection for the parameters and the orthogonal
+    /// distances (default [`InversionConfig::default`]).
+    pub inversion: InversionConfig,
+    /// Largest distance between a PDE surface and its exported B-spline
+    /// form, in data units; `None` (default): `1e-4` x the model diagonal.
+    pub tolerance: Option<f64>,
+    /// Samples per edge for the gap and normal-angle measures (default 65).
+    pub edge_samples: usize,
+}
+
+impl Default for ReconstructConfig {
+    fn default() -> Self {
+        Self {
+            network: NetworkConfig::default(),
+            fit: FaceFit::default(),
+            inversion: InversionConfig::default(),
+            tolerance: None,
+            edge_samples: 65,
+        }
+    }
+}
+
+/// One patch of the result.
+#[derive(Debug, Clone)]
+pub struct PatchReport {
+    /// The label.
+    pub id: i64,
+    /// 3 or 4.
+    pub sides: usize,
+    /// Edges around it (more than `sides` where a side holds several).
+    pub edges: usize,
+    /// Points.
+    pub points: usize,
+    /// Eq. 15 errors of its Coons patch.
+    pub coons_errors: ErrorStats,
+    /// Eq. 15 errors of the fitted surface (mean, max, RMSE).
+    pub errors: ErrorStats,
+    /// Orthogonal distances to the exported B-spline surface.
+    pub orthogonal: ErrorStats,
+    /// Distance between the PDE surface and its B-spline form.
+    pub conversion_deviation: f64,
+}
+
+/// One edge of the result.
+#[derive(Debug, Clone)]
+pub struct EdgeReport {
+    /// Its vertices.
+    pub vertices: [usize; 2],
+    /// The labels of its patches (`None`: free boundary).
+    pub patches: [Option<i64>; 2],
+    /// Largest distance, over the samples, between the edge curve and each
+    /// patch's surface along it, and between the two surfaces.
+    pub max_gap: f64,
+    /// Largest angle (radians) between the two patches' normals along it
+    /// (the G1 defect; 0 on a free edge).
+    pub max_angle: f64,
+    /// Largest distance of its fitted border points from the curve.
+    pub curve_error: f64,
+}
+
+/// Totals over the object.
+#[derive(Debug, Clone)]
+pub struct Totals {
+    /// Eq. 15 errors over every patch's points.
+    pub errors: ErrorStats,
+    /// Orthogonal distances over every patch's points.
+    pub orthogonal: ErrorStats,
+    /// Largest gap over the edges.
+    pub max_gap: f64,
+    /// Largest normal angle over the edges (radians).
+    pub max_angle: f64,
+    /// Diagonal of the labelled points' bounding box.
+    pub diagonal: f64,
+    /// Whether every edge has two patches.
+    pub closed: bool,
+}
+
+/// The result of [`run`].
+#[derive(Debug, Clone)]
+pub struct ReconstructReport {
+    /// Vertices, edges with their shared curves, patches with their cycles.
+    pub network: Network,
+    /// Per patch (in the network's order) its sides: edge uses, counter-clockwise.
+    pub sides: Vec<Vec<Vec<NetUse>>>,
+    /// Per patch its fitted surface.
+    pub faces: Vec<FaceSurface>,
+    /// Per patch its numbers.
+    pub patches: Vec<PatchReport>,
+    /// Per edge its numbers.
+    pub edges: Vec<EdgeReport>,
+    /// Totals.
+    pub totals: Totals,
+    /// The model as a [`PatchComplex`] (faces sharing edges), for the CAD
+    /// writers; `Err` says why it cannot be formed: a patch with a side made
+    /// of several edges (more than 4 corners), which the complex's one edge
+    /// per side cannot hold.
+    pub complex: std::result::Result<PatchComplex, String>,
+}
+
+/// The `(u, v)` of side `s` at side parameter `t` (counter-clockwise: side
+/// 0 `S(t, 0)`, 1 `S(1, t)`, 2 `S(1 - t, 1)`, 3 `S(0, 1 - t)`).
+pub fn side_uv(s: usize, t: f64) -> [f64; 2] {
+    match s {
+        0 => [t, 0.0],
+        1 => [1.0, t],
+        2 => [1.0 - t, 1.0],
+        _ => [0.0, 1.0 - t],
+    }
+}
+
+/// Where patch `sides` meets edge `edge` at edge parameter `t`: the `(u, v)`.
+pub fn edge_uv(sides: &[Vec<NetUse>], curves: &[Curve], edge: usize, t: f64) -> Option<[f64; 2]> {
+    for (s, uses) in sides.iter().enumerate() {
+        let ranges = side_ranges(uses, curves);
+        for (u, &(a, b)) in uses.iter().zip(&ranges) {
+            if u.edge == edge {
+                let tu = if u.reversed { 1.0 - t } else { t };
+                return Some(side_uv(s, a + (b - a) * tu));
+            }
+        }
+    }
+    None
+}
+
+/// Reconstructs the labelled `cloud` as patches sharing their edge curves.
+///
+/// ```
+/// use scanfit::pipeline::reconstruct::{run, ReconstructConfig};
+/// use scanfit::progress::NoProgress;
+/// use scanfit::{Point3, PointCloud};
+/// // a gently curved 2 x 1 sheet in two labelled halves
+/// let (mut pts, mut lab) = (Vec::new(), Vec::new());
+/// for i in 0..=60 {
+///     for j in 0..=30 {
+///         let (x, y) = (i as f64 / 30.0, j as f64 / 30.0);
+///         pts.push(Point3::new(x, y, 0.1 * (x * y).sin()));
+///         lab.push(if i < 30 { 0.0 } else { 1.0 });
+///     }
+/// }
+/// let cloud = PointCloud::new(pts)?.with_attribute("label", lab)?;
+/// let r = run(&cloud, &ReconstructConfig::default(), &NoProgress)?;
+/// assert_eq!(r.patches.len(), 2);
+/// assert!(r.totals.max_gap <= 1e-9 * r.totals.diagonal);
+/// assert!(r.totals.orthogonal.rmse < 1e-3, "{:?}", r.totals.orthogonal);
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+pub fn run(
+    cloud: &PointCloud,
+    cfg: &ReconstructConfig,
+    progress: &dyn Progress,
+) -> Result<ReconstructReport> {
+    let network = build_network(cloud, &cfg.network, progress)?;
+    let (lo, hi) = network
+        .patches
+        .iter()
+        .flat_map(|p| p.points.iter().map(|&i| cloud.points()[i].coords))
+        .fold(
+            (
+                Vector3::repeat(f64::INFINITY),
+                Vector3::repeat(f64::NEG_INFINITY),
+            ),
+            |(lo, hi), p| (lo.inf(&p), hi.sup(&p)),
+        );
+    let diagonal = (hi - lo).norm();
+    let tolerance = match cfg.tolerance {
+        Some(t) if t.is_finite() && t > 0.0 => t,
+        Some(t) => {
+            return Err(Error::InvalidInput(format!(
+                "B-spline form tolerance {t} must be a positive number of data units"
+            )))
+        }
+        None => 1e-4 * diagonal,
+    };
+    if !(2..=100_000).contains(&cfg.edge_samples) {
+        return Err(Error::InvalidInput(format!(
+            "{} edge samples: give 2 to 100000",
+            cfg.edge_samples
+        )));
+    }
+    let curves: Vec<Curve> = network.edges.iter().map(|e| e.curve.clone()).collect();
+    let sides: Vec<Vec<Vec<NetUse>>> = network
+        .patches
+        .iter()
+        .map(|p| group_sides(&p.cycle, &curves, p.id))
+        .collect::<Result<_>>()?;
+    let face_cfg = FaceConfig {
+        fit: cfg.fit,
+        inversion: cfg.inversion,
+        tolerance,
+        ..FaceConfig::new(tolerance)
+    };
+    progress.stage("patches", Some(network.patches.len() as u64));
+    let faces: Vec<FaceSurface> = network
+        .patches
+        .par_iter()
+        .zip(&sides)
+        .map(|(p, s)| {
+            let side_curves: Vec<Curve> = s
+                .iter()
+                .map(|uses| side_curve(uses, &curves))
+                .collect::<Result<_>>()?;
+            let pts: Vec<Point3> = p.points.iter().map(|&i| cloud.points()[i]).collect();
+            let f = fit_face(&pts, &side_curves, &face_cfg, p.id);
+            progress.advance(1);
+            f
+        })
+        .collect::<Result<_>>()?;
+    progress.stage("edges", Some(network.edges.len() as u64));
+    let edges: Vec<EdgeReport> = network
+        .edges
+        .par_iter()
+        .enumerate()
+        .map(|(k, e)| {
+            let r = edge_report(k, e, &network, &sides, &faces, &curves, cfg.edge_samples);
+            progress.advance(1);
+            r
+        })
+        .collect();
+    let patches: Vec<PatchReport> = network
+        .patches
+        .iter()
+        .zip(&sides)
+        .zip(&faces)
+        .map(|((p, s), f)| PatchReport {
+            id: p.id,
+            sides: s.len(),
+            edges: p.cycle.len(),
+            points: p.points.len(),
+            coons_errors: f.coons_errors,
+            errors: f.errors,
+            orthogonal: f.orthogonal,
+            conversion_deviation: f.conversion_deviation,
+        })
+        .collect();
+    let totals = Totals {
+        errors: pooled(patches.iter().map(|p| &p.errors)),
+        orthogonal: pooled(patches.iter().map(|p| &p.orthogonal)),
+        max_gap: edges.iter().map(|e| e.max_gap).fold(0.0, f64::max),
+        max_angle: edges.iter().map(|e| e.max_angle).fold(0.0, f64::max),
+        diagonal,
+        closed: network.is_closed(),
+    };
+    let complex = complex(&network, &sides, &faces);
+    Ok(ReconstructReport {
+        network,
+        sides,
+        faces,
+        patches,
+        edges,
+        totals,
+        complex,
+    })
+}
+
+/// The network and the faces as a [`PatchComplex`] (see
+/// [`ReconstructReport::complex`]).
+fn complex(
+    net: &Network,
+    sides: &[Vec<Vec<NetUse>>],
+    faces: &[FaceSurface],
+) -> std::result::Result<PatchComplex, String> {
+    let mut out = Vec::with_capacity(faces.len());
+    for ((p, s), f) in net.patches.iter().zip(sides).zip(faces) {
+        let mut uses: [Option<topology::EdgeUse>; 4] = [None; 4];
+        for (k, side) in s.iter().enumerate() {
+            match side[..] {
+                [u] => {
+                    uses[k] = Some(topology::EdgeUse {
+                        edge: u.edge,
+                        reversed: u.reversed,
+                    })
+                }
+                _ => {
+                    return Err(format!(
+                        "patch {} has {} corners, so its side {k} is made of {} edges; the model (one edge per side) cannot hold it: relabel so that every patch has 3 or 4 corners",
+                        p.id,
+                        p.cycle.len(),
+                        side.len()
+                    ))
+                }
+            }
+        }
+        out.push(topology::Face {
+            id: p.id,
+            surface: f.surface.clone(),
+            sides: uses,
+        });
+    }
+    Ok(PatchComplex {
+        vertices: net
+            .vertices
+            .iter()
+            .map(|&point| topology::Vertex { point })
+            .collect(),
+        edges: net
+            .edges
+            .iter()
+            .map(|e| topology::Edge {
+                start: e.start,
+                end: e.end,
+                curve: e.curve.clone(),
+            })
+            .collect(),
+        faces: out,
+    })
+}
+
+/// The statistics of the union of several point sets from theirs.
+fn pooled<'a>(stats: impl Iterator<Item = &'a ErrorStats>) -> ErrorStats {
+    let (mut count, mut sum, mut sq, mut max) = (0usize, 0.0, 0.0, 0.0f64);
+    for s in stats {
+        count += s.count;
+        sum += s.mean * s.count as f64;
+        sq += s.rmse * s.rmse * s.count as f64;
+        max = max.max(s.max);
+    }
+    let n = count.max(1) as f64;
+    ErrorStats {
+        count,
+        mean: sum / n,
+        max,
+        max_index: 0,
+        rmse: (sq / n).sqrt(),
+    }
+}
+
+/// Gap and normal angle along edge `k`, sampled from every patch using it.
+fn edge_report(
+    k: usize,
+    e: &crate::network::Edge,
+    net: &Network,
+    sides: &[Vec<Vec<NetUse>>],
+    faces: &[FaceSurface],
+    curves: &[Curve],
+    samples: usize,
+) -> EdgeReport {
+    let users: Vec<usize> = e.patches.iter().flatten().copied().collect();
+    let mut gap = 0.0f64;
+    let mut angle = 0.0f64;
+    let normal = |s: &Surface, uv: [f64; 2]| {
+        let (p, q) = s.degrees();
+        let (mut wu, mut wv) = (BasisWorkspace::new(p, 1), BasisWorkspace::new(q, 1));
+        s.normal(uv[0], uv[1], &mut wu, &mut wv)
+    };
+    for i in 0..samples {
+        let t = i as f64 / (samples - 1) as f64;
+        let c = e.curve.point(t);
+        let mut at: Vec<(Point3, Vector3)> = Vec::new();
+        for &f in &users {
+            if let Some(uv) = edge_uv(&sides[f], curves, k, t) {
+                let s = &faces[f].surface;
+                let p = s.point(uv[0], uv[1]);
+                gap = gap.max((p - c).norm());
+                at.push((p, normal(s, uv)));
+            }
+        }
+        if let [(a, na), (b, nb)] = at[..] {
+            gap = gap.max((a - b).norm());
+            // the ends are corners (an apex has no normal)
+            if i > 0 && i + 1 < samples && na.norm() > 0.5 && nb.norm() > 0.5 {
+                angle = angle.max(na.dot(&nb).clamp(-1.0, 1.0).acos());
+            }
+        }
+    }
+    EdgeReport {
+        vertices: [e.start, e.end],
+        patches: [
+            e.patches[0].map(|p| net.patches[p].id),
+            e.patches[1].map(|p| net.patches[p].id),
+        ],
+        max_gap: gap,
+        max_angle: angle,
+        curve_error: e.max_error,
+    }
+}

@@ -1,0 +1,408 @@
+//! Whole-object reconstruction (issue 15) on synthetic labelled objects:
+//! network counts, the gap along every edge sampled from both sides, fit
+//! errors against the noise, and bad input.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use scanfit::network::{build_network, NetworkConfig};
+use scanfit::pipeline::reconstruct::{run, ReconstructConfig};
+use scanfit::progress::NoProgress;
+use scanfit::{Point3, PointCloud};
+use std::f64::consts::{PI, TAU};
+
+/// SplitMix64 normal noise, reproducible.
+struct Rng(u64);
+impl Rng {
+    fn uniform(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn normal(&mut self) -> f64 {
+        let u = 1.0 - self.uniform();
+        let v = self.uniform();
+        (-2.0 * u.ln()).sqrt() * (TAU * v).cos()
+    }
+}
+
+fn labelled(pts: Vec<Point3>, labels: Vec<f64>) -> PointCloud {
+    PointCloud::new(pts)
+        .unwrap()
+        .with_attribute("label", labels)
+        .unwrap()
+}
+
+/// A closed cylinder (radius 1, height 2): 4 side sectors (labels 0-3) and
+/// two caps (10 bottom, 11 top), normal noise `sigma` along the normal.
+fn can(sigma: f64, seed: u64) -> PointCloud {
+    can_sectors(sigma, seed, 4)
+}
+
+fn can_sectors(sigma: f64, seed: u64, sectors: usize) -> PointCloud {
+    let mut rng = Rng(seed);
+    let h = 0.035;
+    let (mut pts, mut lab) = (Vec::new(), Vec::new());
+    let nt = (TAU / h).round() as usize;
+    let nz = (2.0 / h).round() as usize;
+    for i in 0..nt {
+        let t = (i as f64 + 0.5) / nt as f64 * TAU;
+        for j in 0..nz {
+            let z = (j as f64 + 0.5) / nz as f64 * 2.0;
+            let r = 1.0 + sigma * rng.normal();
+            pts.push(Point3::new(r * t.cos(), r * t.sin(), z));
+            lab.push(
+                (t / (TAU / sectors as f64))
+                    .floor()
+                    .min(sectors as f64 - 1.0),
+            );
+        }
+    }
+    let n = (2.0 / h).round() as i64;
+    for (z, l) in [(0.0, 10.0), (2.0, 11.0)] {
+        for i in -n..=n {
+            for j in -n..=n {
+                let (x, y) = ((i as f64 + 0.5) * h, (j as f64 + 0.5) * h);
+                if x * x + y * y < (1.0 - 0.5 * h) * (1.0 - 0.5 * h) {
+                    pts.push(Point3::new(x, y, z + sigma * rng.normal()));
+                    lab.push(l);
+                }
+            }
+        }
+    }
+    labelled(pts, lab)
+}
+
+/// A square sheet `[0, 2]^2` on a gentle dome in 2 x 2 labelled quarters.
+fn sheet(sigma: f64) -> PointCloud {
+    let mut rng = Rng(7);
+    let n = 60;
+    let (mut pts, mut lab) = (Vec::new(), Vec::new());
+    for i in 0..n {
+        for j in 0..n {
+            let (x, y) = (
+                (i as f64 + 0.5) * 2.0 / n as f64,
+                (j as f64 + 0.5) * 2.0 / n as f64,
+            );
+            let z = 0.2 * (x * (2.0 - x) + y * (2.0 - y)) / 2.0 + sigma * rng.normal();
+            pts.push(Point3::new(x, y, z));
+            lab.push(f64::from(u8::from(x > 1.0)) + 2.0 * f64::from(u8::from(y > 1.0)));
+        }
+    }
+    labelled(pts, lab)
+}
+
+/// An umbrella: a spherical cap (radius 2, 50 degrees) in 8 three-sided panels.
+fn umbrella(sigma: f64) -> PointCloud {
+    let mut rng = Rng(11);
+    let (mut pts, mut lab) = (Vec::new(), Vec::new());
+    let r = 2.0;
+    let cap = 50f64.to_radians();
+    let h = 0.04;
+    let n = (r * cap.sin() / h).ceil() as i64;
+    for i in -n..=n {
+        for j in -n..=n {
+            let (x, y) = ((i as f64 + 0.37) * h, (j as f64 + 0.21) * h);
+            let rho = (x * x + y * y).sqrt();
+            if rho >= r * cap.sin() {
+                continue;
+            }
+            let z = (r * r - rho * rho).sqrt() + sigma * rng.normal();
+            pts.push(Point3::new(x, y, z));
+            let a = y.atan2(x).rem_euclid(TAU);
+            lab.push((a / (TAU / 8.0)).floor().min(7.0));
+        }
+    }
+    labelled(pts, lab)
+}
+
+#[test]
+fn closed_can_six_faces_no_gaps() {
+    let sigma = 0.002;
+    let cloud = can(sigma, 3);
+    let r = run(&cloud, &ReconstructConfig::default(), &NoProgress).unwrap();
+    assert_eq!(r.network.patches.len(), 6);
+    assert_eq!(r.network.vertices.len(), 8, "{:?}", r.network.vertices);
+    assert_eq!(r.network.edges.len(), 12);
+    assert!(r.totals.closed);
+    assert!(r.patches.iter().all(|p| p.sides == 4 && p.edges == 4));
+    // every edge sampled from both patches: rounding only
+    let tol = 1e-9 * r.totals.diagonal;
+    for e in &r.edges {
+        assert!(
+            e.max_gap <= tol,
+            "edge {:?}: gap {:e}",
+            e.patches,
+            e.max_gap
+        );
+        assert!(e.patches[1].is_some());
+    }
+    // the shared model: valid to 1e-9 of its size, closed, outward normals,
+    // the volume of the can (pi r^2 h) within 1%
+    let model = r.complex.as_ref().unwrap();
+    model.validate_with(1e-9).unwrap();
+    assert!(model.is_closed());
+    let v = model.signed_volume();
+    assert!((v / (2.0 * PI) - 1.0).abs() < 0.01, "volume {v}");
+    // the fit follows the noise: orthogonal RMSE within 3 sigma
+    for p in &r.patches {
+        assert!(
+            p.orthogonal.rmse < 3.0 * sigma,
+            "patch {}: {:?}",
+            p.id,
+            p.orthogonal
+        );
+        assert!(
+            p.errors.rmse < 3.0 * sigma,
+            "patch {}: {:?}",
+            p.id,
+            p.errors
+        );
+        assert!(p.conversion_deviation <= 1e-4 * r.totals.diagonal);
+    }
+    // neighbouring sectors meet almost tangentially, sectors and caps at 90 degrees
+    for e in &r.edges {
+        let caps = e.patches.iter().flatten().filter(|&&id| id >= 10).count();
+        if caps == 0 {
+            assert!(
+                e.max_angle < 8f64.to_radians(),
+                "{:?}: {}",
+                e.patches,
+                e.max_angle.to_degrees()
+            );
+        } else {
+            assert!(
+                (e.max_angle - PI / 2.0).abs() < 0.35,
+                "{:?}: {}",
+                e.patches,
+                e.max_angle.to_degrees()
+            );
+        }
+    }
+}
+
+#[test]
+fn caps_with_six_corners_merge_into_four_sides() {
+    let sigma = 0.002;
+    let r = run(
+        &can_sectors(sigma, 9, 6),
+        &ReconstructConfig::default(),
+        &NoProgress,
+    )
+    .unwrap();
+    assert_eq!(r.network.vertices.len(), 12);
+    assert_eq!(r.network.edges.len(), 18);
+    for p in &r.patches {
+        assert_eq!(p.sides, 4);
+        assert_eq!(p.edges, if p.id >= 10 { 6 } else { 4 }, "patch {}", p.id);
+        assert!(
+            p.orthogonal.rmse < 3.0 * sigma,
+            "patch {}: {:?}",
+            p.id,
+            p.orthogonal
+        );
+    }
+    // the caps' sides hold two edges each: still no gap along any edge
+    assert!(
+        r.totals.max_gap <= 1e-9 * r.totals.diagonal,
+        "{:e}",
+        r.totals.max_gap
+    );
+    let e = r.complex.unwrap_err();
+    assert!(e.contains("3 or 4 corners"), "{e}");
+}
+
+#[test]
+fn closed_can_with_bspline_fit() {
+    let sigma = 0.002;
+    let cloud = can(sigma, 5);
+    let mut cfg = ReconstructConfig::default();
+    cfg.fit = scanfit::network::FaceFit::Bspline { ctrl: (8, 8) };
+    let r = run(&cloud, &cfg, &NoProgress).unwrap();
+    assert_eq!(r.patches.len(), 6);
+    assert!(
+        r.totals.max_gap <= 1e-9 * r.totals.diagonal,
+        "{:e}",
+        r.totals.max_gap
+    );
+    for p in &r.patches {
+        assert!(
+            p.orthogonal.rmse < 3.0 * sigma,
+            "patch {}: {:?}",
+            p.id,
+            p.orthogonal
+        );
+    }
+}
+
+#[test]
+fn sheet_in_four_quarters() {
+    let sigma = 0.001;
+    let r = run(&sheet(sigma), &ReconstructConfig::default(), &NoProgress).unwrap();
+    assert_eq!(r.patches.len(), 4);
+    // centre, 4 where an interface meets the free border, 4 sheet corners
+    assert_eq!(r.network.vertices.len(), 9);
+    assert_eq!(r.network.edges.len(), 12);
+    assert!(!r.totals.closed);
+    assert_eq!(r.edges.iter().filter(|e| e.patches[1].is_none()).count(), 8);
+    assert!(r.patches.iter().all(|p| p.sides == 4));
+    assert!(
+        r.totals.max_gap <= 1e-9 * r.totals.diagonal,
+        "{:e}",
+        r.totals.max_gap
+    );
+    assert!(
+        r.totals.orthogonal.rmse < 3.0 * sigma,
+        "{:?}",
+        r.totals.orthogonal
+    );
+    // the centre vertex near (1, 1)
+    let c = r
+        .network
+        .vertices
+        .iter()
+        .map(|v| ((v.x - 1.0).powi(2) + (v.y - 1.0).powi(2)).sqrt())
+        .fold(f64::INFINITY, f64::min);
+    assert!(c < 0.1, "{c}");
+}
+
+#[test]
+fn umbrella_of_three_sided_panels() {
+    let sigma = 0.002;
+    let r = run(&umbrella(sigma), &ReconstructConfig::default(), &NoProgress).unwrap();
+    assert_eq!(r.patches.len(), 8);
+    assert_eq!(r.network.vertices.len(), 9);
+    assert_eq!(r.network.edges.len(), 16);
+    assert!(r.patches.iter().all(|p| p.sides == 3));
+    let model = r.complex.as_ref().unwrap();
+    model.validate_with(1e-9).unwrap();
+    assert_eq!(model.border_edges().len(), 8);
+    assert!(
+        r.totals.max_gap <= 1e-9 * r.totals.diagonal,
+        "{:e}",
+        r.totals.max_gap
+    );
+    assert!(
+        r.totals.orthogonal.rmse < 3.0 * sigma,
+        "{:?}",
+        r.totals.orthogonal
+    );
+    // the apex: the vertex all 8 radial edges share, on top of the cap
+    let top = r
+        .network
+        .vertices
+        .iter()
+        .map(|v| v.z)
+        .fold(f64::MIN, f64::max);
+    assert!((top - 2.0).abs() < 0.02, "{top}");
+}
+
+fn err(cloud: &PointCloud) -> String {
+    build_network(cloud, &NetworkConfig::default(), &NoProgress)
+        .map(|_| ())
+        .unwrap_err()
+        .to_string()
+}
+
+#[test]
+fn single_label_points_to_coons() {
+    let c = sheet(0.0);
+    let n = c.len();
+    let c = c.with_attribute("label", vec![4.0; n]).unwrap();
+    let e = err(&c);
+    assert!(
+        e.contains("single patch") && e.contains("label 4") && e.contains("scanfit coons"),
+        "{e}"
+    );
+}
+
+#[test]
+fn tiny_patch_is_named() {
+    let c = sheet(0.0);
+    let mut lab = c.attribute("label").unwrap().to_vec();
+    lab[0] = 9.0;
+    lab[1] = 9.0;
+    let c = c.with_attribute("label", lab).unwrap();
+    let e = err(&c);
+    assert!(
+        e.contains("patch 9 has 2 points") && e.contains("--ignore 9"),
+        "{e}"
+    );
+}
+
+#[test]
+fn patch_in_two_pieces_is_named() {
+    // the sheet's left and right thirds carry label 5, the middle label 6
+    let c = sheet(0.0);
+    let lab: Vec<f64> = c
+        .points()
+        .iter()
+        .map(|p| if (p.x - 1.0).abs() < 0.34 { 6.0 } else { 5.0 })
+        .collect();
+    let c = c.with_attribute("label", lab).unwrap();
+    let e = err(&c);
+    assert!(
+        e.contains("patch 5 is not a topological disk") && e.contains("pieces"),
+        "{e}"
+    );
+}
+
+#[test]
+fn patch_with_a_hole_is_named() {
+    let c = sheet(0.0);
+    let lab: Vec<f64> = c
+        .points()
+        .iter()
+        .map(|p| {
+            if (p.x - 1.0).hypot(p.y - 1.0) < 0.4 {
+                2.0
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    let c = c.with_attribute("label", lab).unwrap();
+    let e = err(&c);
+    assert!(
+        e.contains("patch 1 is not a topological disk") && e.contains("hole"),
+        "{e}"
+    );
+}
+
+#[test]
+fn patch_between_two_others_without_corner() {
+    // a disk (label 2) in the middle of the sheet, the upper part label 1,
+    // the lower part label 3: the disk meets two patches and no free border,
+    // so it has only two corners
+    let c = sheet(0.0);
+    let lab: Vec<f64> = c
+        .points()
+        .iter()
+        .map(|p| {
+            if (p.x - 1.0).hypot(p.y - 1.0) < 0.4 {
+                2.0
+            } else if p.y > 1.0 {
+                1.0
+            } else {
+                3.0
+            }
+        })
+        .collect();
+    let c = c.with_attribute("label", lab).unwrap();
+    let e = err(&c);
+    assert!(
+        e.contains("patch 2 has only 2 corner(s)") && e.contains("three"),
+        "{e}"
+    );
+}
+
+#[test]
+fn float_labels_are_refused() {
+    let c = sheet(0.0);
+    let n = c.len();
+    let lab: Vec<f64> = (0..n).map(|i| (i % 4) as f64 + 0.25).collect();
+    let c = c.with_attribute("label", lab).unwrap();
+    let e = err(&c);
+    assert!(e.contains("integers") && e.contains("point 0"), "{e}");
+}
