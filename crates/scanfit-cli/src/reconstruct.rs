@@ -24,7 +24,7 @@ use scanfit_io::step_shell::step_shell_file;
 use scanfit_io::write_all_atomic;
 
 use crate::args::pair;
-use crate::cloud::InputArgs;
+use crate::args::InputArgs;
 use crate::outputs::{check_extensions, extension, print_written, Files};
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -109,15 +109,6 @@ pub struct ReconstructArgs {
     pub quiet: bool,
 }
 
-/// The library's progress reports shown on the CLI's spinner.
-struct Stages(Progress);
-
-impl scanfit::progress::Progress for Stages {
-    fn stage(&self, name: &str, _steps: Option<u64>) {
-        self.0.stage(name.to_string());
-    }
-}
-
 /// Runs `scanfit reconstruct`.
 pub fn run(a: ReconstructArgs) -> Result<()> {
     check_extensions(&[
@@ -130,11 +121,11 @@ pub fn run(a: ReconstructArgs) -> Result<()> {
     ])?;
     let cfg = config(&a)?;
     let t0 = Instant::now();
-    let (cloud, dropped) = a.input.load()?;
-    let stages = Stages(Progress::spinner(a.quiet));
-    let r = reconstruct::run(&cloud, &cfg, &stages)
+    let (cloud, dropped) = a.input.load_counted()?;
+    let progress = Progress::spinner(a.quiet);
+    let r = reconstruct::run(&cloud, &cfg, &progress)
         .with_context(|| format!("reconstructing {}", a.input.input.display()))?;
-    stages.0.finish();
+    progress.finish();
     let seconds = t0.elapsed().as_secs_f64();
     let files = outputs(&a, &r, &cloud)?;
     write_all_atomic(&files)?;

@@ -24,7 +24,7 @@ use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 use rayon::prelude::*;
 
-use crate::base::coons::{missing_knots, refine_to, reversed};
+use crate::bspline::ops::{missing_knots, refine_surface_to, reversed};
 use crate::base::{coons_parameters, CoonsParamConfig, CoonsPatch, CoonsProjection, Sides};
 use crate::bspline::{basis_funs, Curve, KnotVector, Surface};
 use crate::metrics::ErrorStats;
@@ -277,7 +277,7 @@ fn face_knots(coons: &CoonsPatch, spans: (usize, usize)) -> Result<(KnotVector, 
 /// to the refined side curves (not computed from the blend), so that they
 /// are the side curves' control points themselves.
 fn coons_on(coons: &CoonsPatch, ku: &KnotVector, kv: &KnotVector) -> Result<Vec<Point3>> {
-    let s = refine_to(&coons.to_bspline()?, ku, kv)?;
+    let s = refine_surface_to(&coons.to_bspline()?, ku, kv)?;
     let (nu, nv) = s.counts();
     let mut ctrl = s.control_points().to_vec();
     let on = |c: &Curve, k: &KnotVector| -> Result<Vec<Point3>> {
