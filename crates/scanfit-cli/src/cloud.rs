@@ -26,7 +26,7 @@ pub use crate::args::InputArgs;
 use crate::args::{
     choice, option_note, value_name, Angles, Indices, Parsed, ANGLES, INDICES, VECTOR3,
 };
-use crate::outputs::{check_extensions, extension, Files};
+use crate::outputs::{check_outputs, extension, Files};
 use crate::progress::Progress;
 use crate::table::{num, Table};
 
@@ -390,10 +390,13 @@ fn normal_shading(normals: &[Vector3], opts: &RenderOptions) -> Vec<[u8; 3]> {
 }
 
 fn normals(a: NormalsArgs) -> Result<()> {
-    check_extensions(&[
-        (&a.output, "--output", &["ply", "xyz"][..]),
-        (&a.png, "--png", &["png"][..]),
-    ])?;
+    check_outputs(
+        &[&a.input.input],
+        &[
+            (&a.output, "--output", &["ply", "xyz"][..]),
+            (&a.png, "--png", &["png"][..]),
+        ],
+    )?;
     let mut cfg = CloudNormalsConfig::default();
     cfg.normals.k = a.k;
     cfg.normals.orientation = match a.orient {
@@ -541,10 +544,13 @@ fn hpr_picture(a: &HprArgs, cloud: &PointCloud, view: Point3, r: &CloudHpr) -> R
 }
 
 fn hpr(a: HprArgs) -> Result<()> {
-    check_extensions(&[
-        (&a.output, "--output", &["ply", "xyz"][..]),
-        (&a.png, "--png", &["png"][..]),
-    ])?;
+    check_outputs(
+        &[&a.input.input],
+        &[
+            (&a.output, "--output", &["ply", "xyz"][..]),
+            (&a.png, "--png", &["png"][..]),
+        ],
+    )?;
     let view = Point3::from(a.viewpoint);
     let mut cfg = CloudHprConfig::from_viewpoint(view);
     cfg.hpr.gamma = a.gamma;
@@ -775,10 +781,13 @@ fn print_boundary(cloud: &PointCloud, r: &CloudBoundary, secs: f64) {
 }
 
 fn boundary(a: BoundaryArgs) -> Result<()> {
-    check_extensions(&[
-        (&a.output, "--output", &["json", "ply", "xyz"][..]),
-        (&a.png, "--png", &["png"][..]),
-    ])?;
+    check_outputs(
+        &[&a.input.input],
+        &[
+            (&a.output, "--output", &["json", "ply", "xyz"][..]),
+            (&a.png, "--png", &["png"][..]),
+        ],
+    )?;
     let mut cfg = CloudBoundaryConfig::default();
     cfg.boundary.alpha = a.alpha;
     cfg.boundary.alpha_factor = a.alpha_factor;

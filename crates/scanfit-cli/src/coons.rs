@@ -23,8 +23,8 @@ use scanfit_io::write_all_atomic;
 use crate::args::{choice, option_note, value_name as name, InputArgs, Parsed, INDICES, NXM};
 use crate::cloud::CriterionArg;
 use crate::outputs::{
-    check_extensions, points_file, print_written, provenance, quality_doc, samples_json, Deviation,
-    Files, Picture, PngStyle, SurfaceOutputArgs,
+    points_file, print_written, provenance, quality_doc, samples_json, Deviation, Files, Picture,
+    PngStyle, SurfaceOutputArgs,
 };
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -257,8 +257,10 @@ fn config(a: &CoonsArgs) -> Result<CoonsConfig> {
 
 /// Runs `scanfit coons`.
 pub fn run(a: CoonsArgs) -> Result<()> {
-    a.out.check()?;
-    check_extensions(&[(&a.points_out, "--points-out", &["ply", "xyz"][..])])?;
+    a.out.check(
+        &a.input.input,
+        &[(&a.points_out, "--points-out", &["ply", "xyz"][..])],
+    )?;
     let cfg = config(&a)?;
     let t0 = Instant::now();
     let progress = Progress::spinner(a.quiet || a.json);

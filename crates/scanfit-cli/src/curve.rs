@@ -17,7 +17,7 @@ use scanfit_io::{write_all_atomic, PointTable};
 use serde::Serialize;
 
 use crate::args::{option_note, Parsed, Vectors, VECTORS};
-use crate::outputs::provenance;
+use crate::outputs::{check_outputs, provenance};
 use crate::progress::Progress;
 use crate::table::{num, Table};
 
@@ -234,6 +234,16 @@ impl FitArgs {
 }
 
 fn fit_cmd(a: FitArgs) -> Result<()> {
+    check_outputs(
+        &[&a.input],
+        &[
+            (&a.output, "--output", &["json"][..]),
+            (&a.svg, "--svg", &["svg"][..]),
+            (&a.png, "--png", &["png"][..]),
+            (&a.step, "--step", &["stp", "step"][..]),
+            (&a.iges, "--iges", &["igs", "iges"][..]),
+        ],
+    )?;
     let config = a.config()?;
     let progress = Progress::spinner(a.quiet);
     progress.stage(format!("reading {}", a.input.display()));
@@ -373,6 +383,13 @@ struct CompareRow {
 }
 
 fn compare_cmd(a: CompareArgs) -> Result<()> {
+    check_outputs(
+        &[&a.input],
+        &[
+            (&a.output, "--output", &["svg"][..]),
+            (&a.png, "--png", &["png"][..]),
+        ],
+    )?;
     let table = crate::args::read_points_warned(&a.input)?;
     let pts = &table.points;
     let progress = Progress::bar(a.quiet, Method::ALL.len() as u64);

@@ -11,7 +11,7 @@ use scanfit_io::json::{read_curve, read_surface};
 use scanfit_io::step::{step_file, CadItem};
 use scanfit_io::write_all_atomic;
 
-use crate::outputs::check_extensions;
+use crate::outputs::check_outputs;
 
 const EXAMPLES: &str = "Examples:
   scanfit export left.json right.json top.json --step panel.stp --iges panel.igs
@@ -63,14 +63,14 @@ fn read_item(path: &Path) -> Result<Item> {
 
 /// Runs `scanfit export`.
 pub fn run(a: ExportArgs) -> Result<()> {
-    scanfit_io::check_paths(
-        &a.inputs,
-        &[&a.step, &a.iges].into_iter().flatten().collect::<Vec<_>>(),
+    let inputs: Vec<&Path> = a.inputs.iter().map(PathBuf::as_path).collect();
+    check_outputs(
+        &inputs,
+        &[
+            (&a.step, "--step", &["stp", "step"][..]),
+            (&a.iges, "--iges", &["igs", "iges"][..]),
+        ],
     )?;
-    check_extensions(&[
-        (&a.step, "--step", &["stp", "step"][..]),
-        (&a.iges, "--iges", &["igs", "iges"][..]),
-    ])?;
     if a.step.is_none() && a.iges.is_none() {
         bail!("nothing to write: give --step OUT.stp and/or --iges OUT.igs");
     }

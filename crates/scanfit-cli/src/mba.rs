@@ -191,7 +191,7 @@ fn rows(r: &MbaReport) -> Vec<Row> {
 
 /// Runs `scanfit mba`.
 pub fn run(a: MbaArgs) -> Result<()> {
-    a.out.check()?;
+    a.out.check(&a.input.input, &[])?;
     if a.levels == 0 {
         anyhow::bail!("--levels must be at least 1");
     }

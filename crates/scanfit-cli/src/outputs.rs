@@ -74,6 +74,19 @@ pub fn check_extensions(outputs: &[(&Option<PathBuf>, &str, &[&str])]) -> Result
     Ok(())
 }
 
+/// The one check every command makes before any work: each given output
+/// ends in one of its allowed extensions, no output is given twice, and no
+/// output is one of the `inputs` (after following symlinks), so a run never
+/// overwrites its own input.
+pub fn check_outputs(
+    inputs: &[&Path],
+    outputs: &[(&Option<PathBuf>, &str, &[&str])],
+) -> Result<()> {
+    check_extensions(outputs)?;
+    let given: Vec<&PathBuf> = outputs.iter().filter_map(|(p, _, _)| p.as_ref()).collect();
+    Ok(scanfit_io::check_paths(inputs, &given)?)
+}
+
 /// Output files: path and content, written together at the end.
 pub type Files = Vec<(PathBuf, Vec<u8>)>;
 
@@ -114,15 +127,17 @@ pub struct Deviation<'a> {
 
 impl SurfaceOutputArgs {
     /// Checks the output file names before any work is done.
-    pub fn check(&self) -> Result<()> {
-        check_extensions(&[
+    pub fn check(&self, input: &Path, extra: &[(&Option<PathBuf>, &str, &[&str])]) -> Result<()> {
+        let mut all: Vec<(&Option<PathBuf>, &str, &[&str])> = vec![
             (&self.output, "--output", &["json"][..]),
             (&self.mesh, "--mesh", &["obj", "ply", "glb"][..]),
             (&self.deviation_png, "--deviation-png", &["png"][..]),
             (&self.png, "--png", &["png"][..]),
             (&self.step, "--step", &["stp", "step"][..]),
             (&self.iges, "--iges", &["igs", "iges"][..]),
-        ])
+        ];
+        all.extend_from_slice(extra);
+        check_outputs(&[input], &all)
     }
 
     /// The bytes of every requested output of `surface` fitted to `points`

@@ -25,7 +25,7 @@ use scanfit_io::write_all_atomic;
 
 use crate::args::pair;
 use crate::args::InputArgs;
-use crate::outputs::{check_extensions, extension, print_written, Files};
+use crate::outputs::{check_outputs, extension, print_written, Files};
 use crate::progress::Progress;
 use crate::table::{num, Table};
 
@@ -111,14 +111,17 @@ pub struct ReconstructArgs {
 
 /// Runs `scanfit reconstruct`.
 pub fn run(a: ReconstructArgs) -> Result<()> {
-    check_extensions(&[
-        (&a.output, "--output", &["json"][..]),
-        (&a.step, "--step", &["stp", "step"][..]),
-        (&a.iges, "--iges", &["igs", "iges"][..]),
-        (&a.mesh, "--mesh", &["obj", "ply", "glb"][..]),
-        (&a.png, "--png", &["png"][..]),
-        (&a.deviation_png, "--deviation-png", &["png"][..]),
-    ])?;
+    check_outputs(
+        &[&a.input.input],
+        &[
+            (&a.output, "--output", &["json"][..]),
+            (&a.step, "--step", &["stp", "step"][..]),
+            (&a.iges, "--iges", &["igs", "iges"][..]),
+            (&a.mesh, "--mesh", &["obj", "ply", "glb"][..]),
+            (&a.png, "--png", &["png"][..]),
+            (&a.deviation_png, "--deviation-png", &["png"][..]),
+        ],
+    )?;
     let cfg = config(&a)?;
     let t0 = Instant::now();
     let (cloud, dropped) = a.input.load_counted()?;

@@ -15,6 +15,7 @@ use scanfit_io::json::{read_surface, SurfaceDoc};
 use scanfit_io::render::{render_png, render_points_png, Colouring, RenderOptions};
 use scanfit_io::write_atomic;
 
+use crate::outputs::check_outputs;
 use crate::progress::Progress;
 use crate::table::{num, Table};
 
@@ -217,6 +218,14 @@ fn page(
 
 /// Runs `scanfit report`.
 pub fn run(a: ReportArgs) -> Result<()> {
+    let out = a
+        .output
+        .clone()
+        .unwrap_or_else(|| a.surface.with_extension("html"));
+    check_outputs(
+        &[&a.surface, &a.input],
+        &[(&Some(out.clone()), "--output", &["html", "htm"][..])],
+    )?;
     let progress = Progress::spinner(a.quiet);
     progress.stage("reading");
     let (doc, surface) = read_surface(&a.surface)?;
@@ -226,10 +235,6 @@ pub fn run(a: ReportArgs) -> Result<()> {
     progress.stage("rendering");
     let pic = pictures(&a, &surface, pts, &r)?;
     progress.finish();
-    let out = a
-        .output
-        .clone()
-        .unwrap_or_else(|| a.surface.with_extension("html"));
     write_atomic(&out, page(&a, &doc, &surface, &r, &pic).as_bytes())?;
     let q = &r.assessment.quality;
     let s = &q.orthogonal;

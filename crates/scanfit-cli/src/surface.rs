@@ -14,8 +14,8 @@ use scanfit_io::{write_all_atomic, PointTable};
 
 use crate::args::{choice, option_note, InputArgs, NXM};
 use crate::outputs::{
-    check_extensions, points_file, print_written, provenance, quality_doc, quality_rows,
-    samples_json, Deviation, Picture,
+    points_file, print_written, provenance, quality_doc, quality_rows, samples_json, Deviation,
+    Picture,
 };
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -171,8 +171,10 @@ fn locate(e: scanfit::Error, table: &PointTable) -> anyhow::Error {
 
 /// Runs `scanfit fit`.
 pub fn run(a: FitArgs) -> Result<()> {
-    a.out.check()?;
-    check_extensions(&[(&a.points_out, "--points-out", &["ply", "xyz"][..])])?;
+    a.out.check(
+        &a.input.input,
+        &[(&a.points_out, "--points-out", &["ply", "xyz"][..])],
+    )?;
     let progress = Progress::spinner(a.quiet);
     progress.stage(format!("reading {}", a.input.input.display()));
     let table = a.input.table(a.json)?;

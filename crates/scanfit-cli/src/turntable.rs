@@ -20,8 +20,8 @@ use scanfit_io::write_all_atomic;
 
 use crate::args::{choice, option_note, InputArgs, Parsed, NXM};
 use crate::outputs::{
-    check_extensions, print_written, provenance, quality_doc, samples_json, Deviation, Files,
-    Picture, PngStyle, SurfaceOutputArgs,
+    print_written, provenance, quality_doc, samples_json, Deviation, Files, Picture, PngStyle,
+    SurfaceOutputArgs,
 };
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -183,8 +183,10 @@ fn config(a: &TurntableArgs) -> TurntableConfig {
 
 /// Runs `scanfit turntable`.
 pub fn run(a: TurntableArgs) -> Result<()> {
-    a.out.check()?;
-    check_extensions(&[(&a.points_out, "--points-out", &["ply", "xyz"][..])])?;
+    a.out.check(
+        &a.input.input,
+        &[(&a.points_out, "--points-out", &["ply", "xyz"][..])],
+    )?;
     let cfg = config(&a);
     let progress = Progress::bar(a.quiet || a.json, STAGES.len() as u64 + 2);
     progress.stage(format!("reading {}", a.input.input.display()));

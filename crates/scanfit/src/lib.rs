@@ -56,10 +56,10 @@ pub mod pipeline;
 pub mod progress;
 pub mod project;
 pub mod quality;
-pub mod topology;
 pub mod spatial;
 pub mod surface;
 pub mod testdata;
+pub mod topology;
 
 pub use cloud::PointCloud;
 pub use error::{Error, Result};

@@ -24,8 +24,8 @@ use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 use rayon::prelude::*;
 
-use crate::bspline::ops::{missing_knots, refine_surface_to, reversed};
 use crate::base::{coons_parameters, CoonsParamConfig, CoonsPatch, CoonsProjection, Sides};
+use crate::bspline::ops::{missing_knots, refine_surface_to, reversed};
 use crate::bspline::{basis_funs, Curve, KnotVector, Surface};
 use crate::metrics::ErrorStats;
 use crate::pde::{fit_pde, PdeConfig, PdeSurface};

@@ -33,7 +33,11 @@ impl Default for WeightComparison {
     fn default() -> Self {
         Self {
             rounds: 5,
-            weights: vec![WeightFactor::DistanceOffset, WeightFactor::PointDistance, WeightFactor::DampedDistanceOffset],
+            weights: vec![
+                WeightFactor::DistanceOffset,
+                WeightFactor::PointDistance,
+                WeightFactor::DampedDistanceOffset,
+            ],
         }
     }
 }
