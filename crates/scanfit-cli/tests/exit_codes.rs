@@ -1,5 +1,6 @@
 //! The exit codes the README documents, one run each: 0 success, 1 error,
-//! 2 usage, 141 closed stdout or stderr (broken pipe); and no panic message
+//! (also a value an option refuses), 2 usage (unknown option or command,
+//! missing argument), 141 closed stdout or stderr (broken pipe); and no panic message
 //! in any of these cases.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -35,8 +36,9 @@ fn success_is_0_error_1_usage_2() {
     assert!(err.starts_with("error: /nonexistent/points.csv:"), "{err}");
     assert_eq!(err.lines().count(), 1, "{err}");
 
+    // a value the option refuses is bad input like any other (status 1)
     let o = run(&["curve", "fit", data.to_str().unwrap(), "--degree", "three"]);
-    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("invalid value 'three'"));
     let o = run(&["no-such-command"]);
     assert_eq!(o.status.code(), Some(2));
