@@ -82,9 +82,9 @@ pub fn check_outputs(
     inputs: &[&Path],
     outputs: &[(&Option<PathBuf>, &str, &[&str])],
 ) -> Result<()> {
-    check_extensions(outputs)?;
     let given: Vec<&PathBuf> = outputs.iter().filter_map(|(p, _, _)| p.as_ref()).collect();
-    Ok(scanfit_io::check_paths(inputs, &given)?)
+    scanfit_io::check_paths(inputs, &given)?;
+    check_extensions(outputs)
 }
 
 /// Output files: path and content, written together at the end.
