@@ -339,7 +339,9 @@ pub fn read_points_warned(path: &std::path::Path) -> Result<PointTable> {
 /// The one place that tells how many non-finite points were dropped.
 pub fn note_dropped(dropped: usize, quiet: bool) {
     if dropped > 0 && !quiet {
-        eprintln!("note: {dropped} points with NaN or infinite coordinates dropped");
+        crate::print_stderr(format_args!(
+            "note: {dropped} points with NaN or infinite coordinates dropped"
+        ));
     }
 }
 

@@ -282,10 +282,11 @@ pub fn cloud_file(path: &Path, cloud: &PointCloud) -> Result<Vec<u8>> {
 }
 
 /// Prints `wrote FILE` for each file.
-fn print_files(files: &Files) {
+fn print_files(files: &Files) -> Result<()> {
     for (p, _) in files {
-        println!("wrote {}", p.display());
+        outln!("wrote {}", p.display());
     }
+    Ok(())
 }
 
 fn info(a: InfoArgs) -> Result<()> {
@@ -311,17 +312,17 @@ fn info(a: InfoArgs) -> Result<()> {
             "spacing": r.spacing.map(|s| serde_json::json!({"min": s.min, "median": s.median, "mean": s.mean, "max": s.max, "duplicates": s.duplicates})),
             "read_seconds": read_s,
         });
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        outln!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
     }
-    print_info(&a.input.input, &r, read_s);
+    print_info(&a.input.input, &r, read_s)?;
     Ok(())
 }
 
 /// The tables of `cloud info`.
-fn print_info(input: &Path, r: &CloudInfo, read_s: f64) {
+fn print_info(input: &Path, r: &CloudInfo, read_s: f64) -> Result<()> {
     let (lo, hi) = (r.bbox_min, r.bbox_max);
-    println!(
+    outln!(
         "{}: {} points (read in {:.3} s)\n",
         input.display(),
         r.points,
@@ -336,15 +337,15 @@ fn print_info(input: &Path, r: &CloudInfo, read_s: f64) {
             num(hi[k] - lo[k]),
         ]);
     }
-    print!("{}", t.render());
-    println!("bounding-box diagonal {}\n", num(r.diagonal));
+    out!("{}", t.render());
+    outln!("bounding-box diagonal {}\n", num(r.diagonal));
     if !r.attributes.is_empty() {
         let mut t = Table::new(&["attribute", "min", "max"], &[true]);
         for at in &r.attributes {
             t.row(vec![at.name.clone(), num(at.min), num(at.max)]);
         }
-        print!("{}", t.render());
-        println!();
+        out!("{}", t.render());
+        outln!();
     }
     if let Some(s) = r.spacing {
         let mut t = Table::new(&["nearest-neighbour distance", "value"], &[true]);
@@ -356,11 +357,12 @@ fn print_info(input: &Path, r: &CloudInfo, read_s: f64) {
         ] {
             t.row(vec![n.to_string(), num(v)]);
         }
-        print!("{}", t.render());
+        out!("{}", t.render());
         if s.duplicates > 0 {
-            println!("{} points coincide with another point", s.duplicates);
+            outln!("{} points coincide with another point", s.duplicates);
         }
     }
+    Ok(())
 }
 
 /// Colours that shade each point by its normal against a light from the
@@ -463,7 +465,7 @@ fn print_normals(
             "mean_variation": r.mean_variation,
             "seconds": secs,
         });
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        outln!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
     }
     let mut t = Table::new(&["normals", "value"], &[true]);
@@ -477,8 +479,8 @@ fn print_normals(
     ]);
     t.row(vec!["mean surface variation".into(), num(r.mean_variation)]);
     t.row(vec!["time (s)".into(), format!("{secs:.3}")]);
-    print!("{}", t.render());
-    print_files(files);
+    out!("{}", t.render());
+    print_files(files)?;
     Ok(())
 }
 
@@ -582,7 +584,7 @@ fn hpr(a: HprArgs) -> Result<()> {
             "gamma": a.gamma,
             "seconds": secs,
         });
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        outln!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
     }
     let mut t = Table::new(&["hidden point removal", "value"], &[true]);
@@ -595,8 +597,8 @@ fn hpr(a: HprArgs) -> Result<()> {
     ]);
     t.row(vec!["gamma".into(), a.gamma.to_string()]);
     t.row(vec!["time (s)".into(), format!("{secs:.3}")]);
-    print!("{}", t.render());
-    print_files(&files);
+    out!("{}", t.render());
+    print_files(&files)?;
     Ok(())
 }
 
@@ -725,7 +727,7 @@ fn boundary_picture(a: &BoundaryArgs, cloud: &PointCloud, r: &CloudBoundary) -> 
 }
 
 /// The tables of `cloud boundary`: the loops, then the corners.
-fn print_boundary(cloud: &PointCloud, r: &CloudBoundary, secs: f64) {
+fn print_boundary(cloud: &PointCloud, r: &CloudBoundary, secs: f64) -> Result<()> {
     let b = &r.boundary;
     let outer = r.outer();
     let mut t = Table::new(&["boundary", "value"], &[true]);
@@ -742,11 +744,11 @@ fn print_boundary(cloud: &PointCloud, r: &CloudBoundary, secs: f64) {
         num(b.areas[b.outer].abs()),
     ]);
     t.row(vec!["time (s)".into(), format!("{secs:.3}")]);
-    print!("{}", t.render());
+    out!("{}", t.render());
     let Some(c) = &r.corners else {
-        return;
+        return Ok(());
     };
-    println!();
+    outln!();
     let head = match r.criterion {
         CornerCriterion::TurningAngle => "angle (deg)",
         CornerCriterion::ThreePointCurvature => "curvature (1/unit)",
@@ -777,7 +779,8 @@ fn print_boundary(cloud: &PointCloud, r: &CloudBoundary, secs: f64) {
             c.sides[k].len().to_string(),
         ]);
     }
-    print!("{}", t.render());
+    out!("{}", t.render());
+    Ok(())
 }
 
 fn boundary(a: BoundaryArgs) -> Result<()> {
@@ -825,10 +828,10 @@ fn boundary(a: BoundaryArgs) -> Result<()> {
     write_all_atomic(&files)?;
     progress.finish();
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&doc)?);
+        outln!("{}", serde_json::to_string_pretty(&doc)?);
         return Ok(());
     }
-    print_boundary(&cloud, &r, secs);
-    print_files(&files);
+    print_boundary(&cloud, &r, secs)?;
+    print_files(&files)?;
     Ok(())
 }

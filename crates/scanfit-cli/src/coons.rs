@@ -281,8 +281,8 @@ pub fn run(a: CoonsArgs) -> Result<()> {
     if a.json {
         return print_json(&a, cloud.points(), &r, secs, &files);
     }
-    print_tables(&a, cloud.points(), &r, secs);
-    print_written(&files, a.out.png.as_deref(), exaggeration);
+    print_tables(&a, cloud.points(), &r, secs)?;
+    print_written(&files, a.out.png.as_deref(), exaggeration)?;
     Ok(())
 }
 
@@ -462,7 +462,7 @@ fn print_json(
         "seconds": secs,
         "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
     });
-    println!("{}", serde_json::to_string_pretty(&report)?);
+    outln!("{}", serde_json::to_string_pretty(&report)?);
     Ok(())
 }
 
@@ -539,16 +539,16 @@ fn steps_table(a: &CoonsArgs, points: usize, r: &CoonsReport, secs: f64) -> Tabl
 }
 
 /// The tables: the steps, then the errors.
-fn print_tables(a: &CoonsArgs, points: &[Point3], r: &CoonsReport, secs: f64) {
-    println!(
+fn print_tables(a: &CoonsArgs, points: &[Point3], r: &CoonsReport, secs: f64) -> Result<()> {
+    outln!(
         "{}: {} points -> {}-sided Coons patch -> {}\n",
         a.input.input.display(),
         points.len(),
         a.sides.count(),
         r.route
     );
-    print!("{}", steps_table(a, points.len(), r, secs).render());
-    println!();
+    out!("{}", steps_table(a, points.len(), r, secs).render());
+    outln!();
     let mut t = Table::new(
         &["error", "mean", "max", "RMSE", "unit"],
         &[true, false, false, false, true],
@@ -578,5 +578,6 @@ fn print_tables(a: &CoonsArgs, points: &[Point3], r: &CoonsReport, secs: f64) {
             "data units".into(),
         ]);
     }
-    print!("{}", t.render());
+    out!("{}", t.render());
+    Ok(())
 }

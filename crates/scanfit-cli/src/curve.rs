@@ -288,10 +288,10 @@ fn fit_cmd(a: FitArgs) -> Result<()> {
             quality: QualityDoc::from(&r.quality),
             output: a.output.as_ref().map(|p| p.display().to_string()),
         };
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        outln!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
     }
-    print_fit(&a, &r, kind, pts.len());
+    print_fit(&a, &r, kind, pts.len())?;
     Ok(())
 }
 
@@ -306,10 +306,10 @@ fn summary(q: &CurveQuality) -> String {
     )
 }
 
-fn print_fit(a: &FitArgs, r: &CurveReport, kind: &str, n: usize) {
+fn print_fit(a: &FitArgs, r: &CurveReport, kind: &str, n: usize) -> Result<()> {
     let (fit, q) = (&r.fit, &r.quality);
     let c = &fit.curve;
-    println!(
+    outln!(
         "{}: {n} points -> {} B-spline of degree {} by {kind}, {} parameterization",
         a.input.display(),
         if c.is_periodic() {
@@ -320,7 +320,7 @@ fn print_fit(a: &FitArgs, r: &CurveReport, kind: &str, n: usize) {
         c.degree(),
         fit.method
     );
-    println!(
+    outln!(
         "{} control points, {} knots, condition estimate {:.1e}\n",
         c.control_points().len(),
         c.knots().len(),
@@ -359,7 +359,7 @@ fn print_fit(a: &FitArgs, r: &CurveReport, kind: &str, n: usize) {
     for (m, v, u) in rows {
         t.row(vec![m.into(), v, u.into()]);
     }
-    print!("{}", t.render());
+    out!("{}", t.render());
     for (what, p) in [
         ("curve", &a.output),
         ("picture", &a.svg),
@@ -368,9 +368,10 @@ fn print_fit(a: &FitArgs, r: &CurveReport, kind: &str, n: usize) {
         ("IGES file", &a.iges),
     ] {
         if let Some(p) = p {
-            println!("wrote {what}: {}", p.display());
+            outln!("wrote {what}: {}", p.display());
         }
     }
+    Ok(())
 }
 
 #[derive(Serialize)]
@@ -442,10 +443,10 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
     if a.json {
         return print_compare_json(&a, &results, &table, &out);
     }
-    print_compare(&a, &results, &table);
-    println!("wrote picture: {}", out.display());
+    print_compare(&a, &results, &table)?;
+    outln!("wrote picture: {}", out.display());
     if let Some(png) = &a.png {
-        println!("wrote picture: {}", png.display());
+        outln!("wrote picture: {}", png.display());
     }
     Ok(())
 }
@@ -482,12 +483,12 @@ fn print_compare_json(
         "picture": out.display().to_string(),
         "methods": rows,
     });
-    println!("{}", serde_json::to_string_pretty(&doc)?);
+    outln!("{}", serde_json::to_string_pretty(&doc)?);
     Ok(())
 }
 
-fn print_compare(a: &CompareArgs, results: &[MethodResult], table: &PointTable) {
-    println!(
+fn print_compare(a: &CompareArgs, results: &[MethodResult], table: &PointTable) -> Result<()> {
+    outln!(
         "{}: {} points, degree-{} interpolation with every parameterization\n",
         a.input.display(),
         table.points.len(),
@@ -525,9 +526,10 @@ fn print_compare(a: &CompareArgs, results: &[MethodResult], table: &PointTable) 
             }
         }
     }
-    print!("{}", t.render());
+    out!("{}", t.render());
     for e in errors {
-        println!("  {e}");
+        outln!("  {e}");
     }
-    println!("\nlength ratio = curve length / data polygon length (1 = tight; large = bulges).");
+    outln!("\nlength ratio = curve length / data polygon length (1 = tight; large = bulges).");
+    Ok(())
 }

@@ -105,7 +105,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
         Item::Surface(_) => (c, s + 1),
     });
     for (p, _) in &files {
-        println!("wrote {} ({nc} curves, {ns} surfaces)", p.display());
+        outln!("wrote {} ({nc} curves, {ns} surfaces)", p.display());
     }
     Ok(())
 }

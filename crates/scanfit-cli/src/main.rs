@@ -3,6 +3,28 @@
 //! A thin layer over the `scanfit` library and `scanfit-io`: parse arguments,
 //! read files, call the library, print tables, write outputs.
 
+/// `println!` that returns the write error instead of panicking: a closed
+/// stdout (`scanfit ... | head`) reaches `main` through the error chain as
+/// `io::ErrorKind::BrokenPipe` and ends the program quietly with 141.
+macro_rules! outln {
+    () => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout().lock())?
+    }};
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout().lock(), $($t)*)?
+    }};
+}
+
+/// `print!` that returns the write error instead of panicking (see `outln!`).
+macro_rules! out {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        write!(std::io::stdout().lock(), $($t)*)?
+    }};
+}
+
 mod args;
 mod cad;
 mod cloud;
@@ -85,7 +107,7 @@ fn is_broken_pipe(e: &anyhow::Error) -> bool {
 
 /// Prints a line on stderr; a closed stderr is not an error of the command
 /// (nothing can be reported on it), so the failure is ignored.
-fn print_stderr(line: std::fmt::Arguments<'_>) {
+pub(crate) fn print_stderr(line: std::fmt::Arguments<'_>) {
     use std::io::Write;
     let mut err = std::io::stderr().lock();
     let _ = err.write_fmt(line).and_then(|()| err.write_all(b"\n"));
@@ -99,48 +121,11 @@ pub(crate) fn print_warnings(warnings: &[String]) {
     }
 }
 
-/// The commands print with `println!`, which panics when stdout is a closed
-/// pipe. This hook turns exactly that panic into a quiet exit 141: it acts
-/// only on the panic of the standard library's print functions, and only
-/// after a write to stdout (resp. stderr) fails with
-/// `io::ErrorKind::BrokenPipe`; every other panic goes to the default hook
-/// (exit 101, an internal error).
-fn exit_quietly_on_broken_pipe() {
-    let default_hook = std::panic::take_hook();
-    std::panic::set_hook(Box::new(move |info| {
-        use std::io::Write;
-        let payload = info
-            .payload()
-            .downcast_ref::<String>()
-            .map(String::as_str)
-            .or_else(|| info.payload().downcast_ref::<&str>().copied())
-            .unwrap_or("");
-        let broken = |probe: std::io::Result<()>| {
-            probe.is_err_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
-        };
-        // the failed print left nothing behind: a one-byte probe fails with
-        // EPIPE on a closed pipe (and then writes nothing)
-        if payload.starts_with("failed printing to stdout")
-            && broken(
-                std::io::stdout()
-                    .lock()
-                    .write_all(b"\n")
-                    .and_then(|()| std::io::stdout().flush()),
-            )
-        {
-            std::process::exit(EXIT_BROKEN_PIPE);
-        }
-        if payload.starts_with("failed printing to stderr")
-            && broken(std::io::stderr().lock().write_all(b"\n"))
-        {
-            std::process::exit(EXIT_BROKEN_PIPE);
-        }
-        default_hook(info);
-    }));
-}
-
 fn main() {
-    exit_quietly_on_broken_pipe();
+    // every print of the commands goes through `out!`/`outln!` (write
+    // errors returned) or `print_stderr` (write errors ignored), so a closed
+    // stdout reaches here as an io::ErrorKind::BrokenPipe in the error chain
+    // and no panic hook is needed
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {

@@ -251,17 +251,17 @@ pub fn run(a: MbaArgs) -> Result<()> {
             "seconds": r.seconds,
             "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
         });
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        outln!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
     }
-    print_report(&a, &r);
-    print_written(&files, a.out.png.as_deref(), exaggeration);
+    print_report(&a, &r)?;
+    print_written(&files, a.out.png.as_deref(), exaggeration)?;
     Ok(())
 }
 
-fn print_report(a: &MbaArgs, r: &MbaReport) {
+fn print_report(a: &MbaArgs, r: &MbaReport) -> Result<()> {
     let (m, n) = r.cells;
-    println!(
+    outln!(
         "{}: {} points -> bicubic B-spline surface, {} x {} control points ({} levels{}, {:.3} s)\n",
         a.input.input.display(),
         r.uv.len(),
@@ -301,8 +301,8 @@ fn print_report(a: &MbaArgs, r: &MbaReport) {
         cells.push(format!("{:.3}", l.seconds));
         t.row(cells);
     }
-    print!("{}", t.render());
-    println!("(errors in data units)\n");
+    out!("{}", t.render());
+    outln!("(errors in data units)\n");
     let q = &r.assessment.quality;
     let mut t = Table::new(
         &["final surface", "mean", "max", "RMSE", "unit"],
@@ -317,5 +317,6 @@ fn print_report(a: &MbaArgs, r: &MbaReport) {
         "data units".into(),
     ]);
     quality_rows(&mut t, q, "grid points to nearest point (eq. 17)");
-    print!("{}", t.render());
+    out!("{}", t.render());
+    Ok(())
 }

@@ -332,17 +332,18 @@ pub fn points_file(path: &Path, points: &[Point3], attributes: &[(&str, &[f64])]
 }
 
 /// Prints `wrote FILE` for each file, naming the exaggeration of `png`.
-pub fn print_written(files: &Files, png: Option<&Path>, exaggeration: f64) {
+pub fn print_written(files: &Files, png: Option<&Path>, exaggeration: f64) -> Result<()> {
     for (p, _) in files {
         if png == Some(p.as_path()) && exaggeration != 1.0 {
-            println!(
+            outln!(
                 "wrote {} (vertical exaggeration {exaggeration}x)",
                 p.display()
             );
         } else {
-            println!("wrote {}", p.display());
+            outln!("wrote {}", p.display());
         }
     }
+    Ok(())
 }
 
 /// The JSON quality record of a surface: the library's one assessment

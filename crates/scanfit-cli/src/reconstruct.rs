@@ -133,13 +133,13 @@ pub fn run(a: ReconstructArgs) -> Result<()> {
     let files = outputs(&a, &r, &cloud)?;
     write_all_atomic(&files)?;
     if a.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&json_report(&r, &a, seconds, dropped))?
         );
     } else {
-        print!("{}", tables(&r, seconds));
-        print_written(&files, None, 1.0);
+        out!("{}", tables(&r, seconds));
+        print_written(&files, None, 1.0)?;
     }
     Ok(())
 }

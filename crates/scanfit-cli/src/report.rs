@@ -249,12 +249,12 @@ pub fn run(a: ReportArgs) -> Result<()> {
             "samples_to_points": crate::outputs::samples_json(q),
             "report": out.display().to_string(),
         });
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
     let (p, qd) = surface.degrees();
     let (cu, cv) = surface.counts();
-    println!(
+    outln!(
         "{}: {} points against {} ({p} x {qd} degrees, {cu} x {cv} control points)\n",
         a.input.display(),
         pts.len(),
@@ -267,12 +267,12 @@ pub fn run(a: ReportArgs) -> Result<()> {
     for (k, v) in figures(&r) {
         t.row(vec![k.into(), num(v), "data units".into()]);
     }
-    print!("{}", t.render());
-    println!("{}", samples_line(&r));
+    out!("{}", t.render());
+    outln!("{}", samples_line(&r));
     if q.unconverged > 0 {
-        println!("note: {} point inversions did not converge", q.unconverged);
+        outln!("note: {} point inversions did not converge", q.unconverged);
     }
-    println!("wrote {}", out.display());
+    outln!("wrote {}", out.display());
     Ok(())
 }
 

@@ -231,19 +231,19 @@ pub fn run(a: FitArgs) -> Result<()> {
             "samples_to_points": samples_json(q),
             "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
         });
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        outln!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
     }
-    print_report(&a, &r);
-    print_written(&files, a.out.png.as_deref(), exaggeration);
+    print_report(&a, &r)?;
+    print_written(&files, a.out.png.as_deref(), exaggeration)?;
     Ok(())
 }
 
-fn print_report(a: &FitArgs, r: &FitReport) {
+fn print_report(a: &FitArgs, r: &FitReport) -> Result<()> {
     let q = &r.assessment.quality;
     let (p, qd) = r.surface.degrees();
     let (cu, cv) = r.surface.counts();
-    println!(
+    outln!(
         "{}: {} points -> B-spline surface of degree {p} x {qd}, {cu} x {cv} control points ({} parameters, {} knots{}{})\n",
         a.input.input.display(),
         q.points,
@@ -265,9 +265,9 @@ fn print_report(a: &FitArgs, r: &FitReport) {
         "data units".into(),
     ]);
     quality_rows(&mut t, q, "grid points to nearest point (MBA eq. 17)");
-    print!("{}", t.render());
+    out!("{}", t.render());
     let pq = &q.parameterization;
-    println!(
+    outln!(
         "\nparameterization: {} fold-overs in {} triangles, L2 stretch {:.3} (1 = uniform), max anisotropy {}",
         pq.fold_overs,
         pq.triangles,
@@ -275,13 +275,13 @@ fn print_report(a: &FitArgs, r: &FitReport) {
         num(pq.max_anisotropy)
     );
     if q.unconverged > 0 {
-        println!(
+        outln!(
             "note: {} point inversions did not converge (their distance is the best found)",
             q.unconverged
         );
     }
     if !r.rounds.is_empty() {
-        println!();
+        outln!();
         let mut t = Table::new(
             &["correction round", "RMSE", "max error", "unit"],
             &[false, false, false, true],
@@ -294,6 +294,7 @@ fn print_report(a: &FitArgs, r: &FitReport) {
                 "data units".into(),
             ]);
         }
-        print!("{}", t.render());
+        out!("{}", t.render());
     }
+    Ok(())
 }

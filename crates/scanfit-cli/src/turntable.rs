@@ -208,8 +208,8 @@ pub fn run(a: TurntableArgs) -> Result<()> {
     if a.json {
         return print_json(&a, &cloud, &r, seconds, &files);
     }
-    print_report(&a, &cloud, &r, seconds);
-    print_written(&files, a.out.png.as_deref(), exaggeration);
+    print_report(&a, &cloud, &r, seconds)?;
+    print_written(&files, a.out.png.as_deref(), exaggeration)?;
     Ok(())
 }
 
@@ -313,23 +313,28 @@ fn print_json(
         "seconds": seconds,
         "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
     });
-    println!("{}", serde_json::to_string_pretty(&report)?);
+    outln!("{}", serde_json::to_string_pretty(&report)?);
     Ok(())
 }
 
 /// The lines above the error table: axis, views, layers, base surface, parameters.
-fn print_steps(a: &TurntableArgs, cloud: &PointCloud, r: &TurntableReport, seconds: f64) {
+fn print_steps(
+    a: &TurntableArgs,
+    cloud: &PointCloud,
+    r: &TurntableReport,
+    seconds: f64,
+) -> Result<()> {
     let t = &r.turntable;
     let (ax, c) = (t.frame.axis, t.frame.centre);
     let join = |v: &[f64]| v.iter().map(|&x| num(x)).collect::<Vec<_>>().join(" -> ");
-    println!(
+    outln!(
         "{}: {} points -> bicubic B-spline surface closed around the axis, {} x {} control points ({seconds:.2} s)",
         a.input.input.display(),
         cloud.len(),
         a.ctrl.0,
         a.ctrl.1,
     );
-    println!(
+    outln!(
         "axis ({:.4}, {:.4}, {:.4}){}, centre ({}, {}, {}), radius {}, height {}",
         ax.x,
         ax.y,
@@ -350,13 +355,13 @@ fn print_steps(a: &TurntableArgs, cloud: &PointCloud, r: &TurntableReport, secon
         .iter()
         .map(|v| v.visible.len().to_string())
         .collect();
-    println!(
+    outln!(
         "views: {} (visible points {})",
         t.views.len(),
         visible.join(", ")
     );
     let counts: Vec<usize> = t.loops.iter().map(Vec::len).collect();
-    println!(
+    outln!(
         "layers: {} ({} to {} samples); projection RMSE by round ({}): {}",
         counts.len(),
         counts.iter().min().copied().unwrap_or(0),
@@ -364,7 +369,7 @@ fn print_steps(a: &TurntableArgs, cloud: &PointCloud, r: &TurntableReport, secon
         WeightFactor::from(a.weight).name(),
         join(&t.layers.rmse)
     );
-    println!(
+    outln!(
         "base surface: {} x {} grid, refinement RMSE {}; points to base surface: mean {}, max {}, RMSE {}",
         t.grid_u,
         t.heights.len(),
@@ -373,7 +378,7 @@ fn print_steps(a: &TurntableArgs, cloud: &PointCloud, r: &TurntableReport, secon
         num(t.base_errors.max),
         num(t.base_errors.rmse)
     );
-    println!(
+    outln!(
         "parameters: {} points, {} beyond the end layers ({})\n",
         cloud.len(),
         t.on_v_boundary,
@@ -382,11 +387,17 @@ fn print_steps(a: &TurntableArgs, cloud: &PointCloud, r: &TurntableReport, secon
             EndsArg::Extend => "v continued past the base surface, fitted",
         }
     );
+    Ok(())
 }
 
 /// The whole text report: steps, errors, fold-overs, the weight comparison.
-fn print_report(a: &TurntableArgs, cloud: &PointCloud, r: &TurntableReport, seconds: f64) {
-    print_steps(a, cloud, r, seconds);
+fn print_report(
+    a: &TurntableArgs,
+    cloud: &PointCloud,
+    r: &TurntableReport,
+    seconds: f64,
+) -> Result<()> {
+    print_steps(a, cloud, r, seconds)?;
     let t = &r.turntable;
     let mut tab = Table::new(
         &["error [data units]", "points", "mean", "max", "RMSE"],
@@ -406,8 +417,8 @@ fn print_report(a: &TurntableArgs, cloud: &PointCloud, r: &TurntableReport, seco
             num(e.rmse),
         ]);
     }
-    print!("{}", tab.render());
-    println!(
+    out!("{}", tab.render());
+    outln!(
         "\nfold-overs: {} of {} triangles of the fitted points ({} of {} inside the layers' range); L2 stretch {}",
         t.quality.fold_overs,
         t.quality.triangles,
@@ -415,12 +426,12 @@ fn print_report(a: &TurntableArgs, cloud: &PointCloud, r: &TurntableReport, seco
         t.quality_inside.triangles,
         num(t.quality.l2_stretch)
     );
-    println!(
+    outln!(
         "fold-overs after projecting the points onto the fitted surface (parameter correction): {} of {}",
         t.quality_fitted.fold_overs, t.quality_fitted.triangles
     );
     if let Some(cmp) = &r.weight_comparison {
-        println!("\nRMSE of the layer samples' nearest-point distances by projection round:");
+        outln!("\nRMSE of the layer samples' nearest-point distances by projection round:");
         let names: Vec<String> = cmp
             .iter()
             .map(|w| match w.weight {
@@ -439,7 +450,8 @@ fn print_report(a: &TurntableArgs, cloud: &PointCloud, r: &TurntableReport, seco
             row.extend(cmp.iter().map(|w| num(w.rmse[k])));
             tab.row(row);
         }
-        print!("{}", tab.render());
+        out!("{}", tab.render());
     }
-    println!();
+    outln!();
+    Ok(())
 }
