@@ -328,14 +328,6 @@ impl InputArgs {
     }
 }
 
-/// Reads a point file with the default options (format by extension,
-/// non-finite coordinates refused); the reader's warnings go to stderr.
-pub fn read_points_warned(path: &std::path::Path) -> Result<PointTable> {
-    let table = scanfit_io::read_points(path)?;
-    crate::print_warnings(&table.warnings);
-    Ok(table)
-}
-
 /// The one place that tells how many non-finite points were dropped.
 pub fn note_dropped(dropped: usize, quiet: bool) {
     if dropped > 0 && !quiet {

@@ -16,7 +16,7 @@ use scanfit_io::svg::{curve_panels, curve_panels_png, Panel, PanelSize};
 use scanfit_io::{write_all_atomic, PointTable};
 use serde::Serialize;
 
-use crate::args::{option_note, Parsed, Vectors, VECTORS};
+use crate::args::{option_note, InputArgs, Parsed, Vectors, VECTORS};
 use crate::outputs::{check_outputs, provenance};
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -51,8 +51,9 @@ const COMPARE_EXAMPLES: &str = "Examples:
 /// Arguments of `scanfit curve fit`.
 #[derive(Args, Debug)]
 pub struct FitArgs {
-    /// Input point file (XYZ, CSV or TXT; points in curve order).
-    pub input: PathBuf,
+    /// The input point file (points in curve order) and how to read it.
+    #[command(flatten)]
+    pub input: InputArgs,
     /// Parameterization method [default: proposed; centripetal with --closed,
     /// as the basis-maxima methods are defined for open curves only].
     #[arg(short, long = "param", value_name = "METHOD", value_parser = METHOD)]
@@ -120,8 +121,9 @@ pub struct FitArgs {
 /// Arguments of `scanfit curve compare`.
 #[derive(Args, Debug)]
 pub struct CompareArgs {
-    /// Input point file (XYZ, CSV or TXT; points in curve order).
-    pub input: PathBuf,
+    /// The input point file (points in curve order) and how to read it.
+    #[command(flatten)]
+    pub input: InputArgs,
     /// Degree of the interpolating curves.
     #[arg(short, long, default_value_t = 3)]
     pub degree: usize,
@@ -223,7 +225,7 @@ impl FitArgs {
         doc.provenance = Some(provenance(
             format!("curve fit ({kind})"),
             Some(r.fit.method.to_string()),
-            &self.input,
+            &self.input.input,
             point_count,
             settings,
         ));
@@ -235,7 +237,7 @@ impl FitArgs {
 
 fn fit_cmd(a: FitArgs) -> Result<()> {
     check_outputs(
-        &[&a.input],
+        &[&a.input.input],
         &[
             (&a.output, "--output", &["json"][..]),
             (&a.svg, "--svg", &["svg"][..]),
@@ -246,8 +248,8 @@ fn fit_cmd(a: FitArgs) -> Result<()> {
     )?;
     let config = a.config()?;
     let progress = Progress::spinner(a.quiet);
-    progress.stage(format!("reading {}", a.input.display()));
-    let table = crate::args::read_points_warned(&a.input)?;
+    progress.stage(format!("reading {}", a.input.input.display()));
+    let table = a.input.table(false)?;
     let pts = &table.points;
     let r = fit_curve(pts, &config, &progress).map_err(|e| locate(&e, &table))?;
     progress.finish();
@@ -273,11 +275,16 @@ fn fit_cmd(a: FitArgs) -> Result<()> {
         files.push((png, curve_panels_png(&[panel()], 1, "", PanelSize::SINGLE)?));
     }
     let cad = CadItem::Curve(&r.fit.curve);
-    files.extend(crate::cad::cad_files(&a.step, &a.iges, cad, &a.input)?);
+    files.extend(crate::cad::cad_files(
+        &a.step,
+        &a.iges,
+        cad,
+        &a.input.input,
+    )?);
     write_all_atomic(&files)?;
     if a.json {
         let report = FitReport {
-            input: a.input.display().to_string(),
+            input: a.input.input.display().to_string(),
             point_count: pts.len(),
             fit: kind,
             parameterization: r.fit.method.to_string(),
@@ -311,7 +318,7 @@ fn print_fit(a: &FitArgs, r: &CurveReport, kind: &str, n: usize) -> Result<()> {
     let c = &fit.curve;
     outln!(
         "{}: {n} points -> {} B-spline of degree {} by {kind}, {} parameterization",
-        a.input.display(),
+        a.input.input.display(),
         if c.is_periodic() {
             "closed (periodic)"
         } else {
@@ -385,13 +392,13 @@ struct CompareRow {
 
 fn compare_cmd(a: CompareArgs) -> Result<()> {
     check_outputs(
-        &[&a.input],
+        &[&a.input.input],
         &[
             (&a.output, "--output", &["svg"][..]),
             (&a.png, "--png", &["png"][..]),
         ],
     )?;
-    let table = crate::args::read_points_warned(&a.input)?;
+    let table = a.input.table(false)?;
     let pts = &table.points;
     let progress = Progress::bar(a.quiet, Method::ALL.len() as u64);
     let mut config = CompareConfig::default();
@@ -400,6 +407,7 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
     progress.finish();
     let out = a.output.clone().unwrap_or_else(|| {
         let stem = a
+            .input
             .input
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
@@ -426,6 +434,7 @@ fn compare_cmd(a: CompareArgs) -> Result<()> {
     let title = format!(
         "{}: degree-{} interpolation, {} points",
         a.input
+            .input
             .file_name()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default(),
@@ -477,7 +486,7 @@ fn print_compare_json(
         })
         .collect();
     let doc = serde_json::json!({
-        "input": a.input.display().to_string(),
+        "input": a.input.input.display().to_string(),
         "point_count": table.points.len(),
         "degree": a.degree,
         "picture": out.display().to_string(),
@@ -490,7 +499,7 @@ fn print_compare_json(
 fn print_compare(a: &CompareArgs, results: &[MethodResult], table: &PointTable) -> Result<()> {
     outln!(
         "{}: {} points, degree-{} interpolation with every parameterization\n",
-        a.input.display(),
+        a.input.input.display(),
         table.points.len(),
         a.degree
     );

@@ -15,6 +15,7 @@ use scanfit_io::json::{read_surface, SurfaceDoc};
 use scanfit_io::render::{render_png, render_points_png, Colouring, RenderOptions};
 use scanfit_io::write_atomic;
 
+use crate::args::InputArgs;
 use crate::outputs::check_outputs;
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -32,8 +33,9 @@ inversion); the HTML page embeds its pictures, so it can be mailed as one file."
 pub struct ReportArgs {
     /// The surface (JSON written by `scanfit fit -o`).
     pub surface: PathBuf,
-    /// The points to compare with (XYZ, CSV or TXT).
-    pub input: PathBuf,
+    /// The points to compare with and how to read them.
+    #[command(flatten)]
+    pub input: InputArgs,
     /// The HTML report [default: SURFACE with .html].
     #[arg(short, long, value_name = "OUT.html")]
     pub output: Option<PathBuf>,
@@ -153,7 +155,7 @@ fn page(
     let title = format!(
         "scanfit report: {} against {}",
         a.surface.display(),
-        a.input.display()
+        a.input.input.display()
     );
     let _ = write!(
         html,
@@ -223,13 +225,13 @@ pub fn run(a: ReportArgs) -> Result<()> {
         .clone()
         .unwrap_or_else(|| a.surface.with_extension("html"));
     check_outputs(
-        &[&a.surface, &a.input],
+        &[&a.surface, &a.input.input],
         &[(&Some(out.clone()), "--output", &["html", "htm"][..])],
     )?;
     let progress = Progress::spinner(a.quiet);
     progress.stage("reading");
     let (doc, surface) = read_surface(&a.surface)?;
-    let table = crate::args::read_points_warned(&a.input)?;
+    let table = a.input.table(false)?;
     let pts = &table.points;
     let r = measure(&surface, pts, &MeasureConfig::default(), &progress)?;
     progress.stage("rendering");
@@ -241,7 +243,7 @@ pub fn run(a: ReportArgs) -> Result<()> {
     if a.json {
         let v = serde_json::json!({
             "surface": a.surface.display().to_string(),
-            "input": a.input.display().to_string(),
+            "input": a.input.input.display().to_string(),
             "points": pts.len(),
             "mean": s.mean, "median": r.median, "p95": r.p95, "max": s.max, "rmse": s.rmse,
             "unconverged": q.unconverged,
@@ -256,7 +258,7 @@ pub fn run(a: ReportArgs) -> Result<()> {
     let (cu, cv) = surface.counts();
     outln!(
         "{}: {} points against {} ({p} x {qd} degrees, {cu} x {cv} control points)\n",
-        a.input.display(),
+        a.input.input.display(),
         pts.len(),
         a.surface.display()
     );

@@ -186,3 +186,48 @@ fn fit_takes_the_shared_input_group() {
     assert!(String::from_utf8_lossy(&o.stderr)
         .contains("unknown --format 'stl'; use ply, pcd, las or text"));
 }
+
+#[test]
+fn curve_and_report_take_the_shared_input_group() {
+    let dir = tmpdir("typed_args", "curve_input_group");
+    // data set 1 with a NaN row in the middle, under a name without a known
+    // extension: --format text reads it, --drop-non-finite drops the row
+    let text = std::fs::read_to_string(examples().join("dataset1.csv")).unwrap();
+    let mut lines: Vec<&str> = text.lines().collect();
+    lines.insert(3, "nan,1,0");
+    let data = dir.join("d1.points");
+    std::fs::write(&data, lines.join("\n")).unwrap();
+    let d = data.to_str().unwrap();
+    let o = run(&["curve", "fit", d, "-q"]);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let o = run(&["curve", "fit", d, "--format", "text", "-q"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("is NaN"));
+    let o = run(&[
+        "curve",
+        "fit",
+        d,
+        "--format",
+        "text",
+        "--drop-non-finite",
+        "-q",
+    ]);
+    let out = ok(&o);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.matches("1 points with NaN").count(), 1, "{err}");
+    let full = run(&[
+        "curve",
+        "fit",
+        examples().join("dataset1.csv").to_str().unwrap(),
+        "-q",
+    ]);
+    // the same curve as from the clean file: the tables agree line for line
+    // after the header (which names the input file)
+    let skip = |s: &str| s.lines().skip(1).collect::<Vec<_>>().join("\n");
+    assert_eq!(skip(&out), skip(&ok(&full)));
+}
