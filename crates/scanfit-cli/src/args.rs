@@ -164,6 +164,21 @@ fn indices(s: &str, what: &str) -> std::result::Result<Indices, String> {
         .map_err(|_| format!("{what} '{s}' must be positions I,J,K,... (whole numbers)"))
 }
 
+/// A list of ids (signed whole numbers), `"0,99,-1"`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Ids(pub Vec<i64>);
+
+/// `"I,J,K,..."` as signed whole numbers ([`Ids`]).
+pub const IDS: Parsed<Ids> = Parsed(ids);
+
+fn ids(s: &str, what: &str) -> std::result::Result<Ids, String> {
+    s.split(',')
+        .map(|x| x.trim().parse::<i64>())
+        .collect::<std::result::Result<Vec<_>, _>>()
+        .map(Ids)
+        .map_err(|_| format!("{what} '{s}' must be whole numbers separated by commas, e.g. 0,99"))
+}
+
 /// Camera angles in degrees: azimuth (any) and elevation in [-90, 90].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Angles {

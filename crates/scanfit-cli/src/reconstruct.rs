@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
-use clap::Args;
+use clap::{Args, ValueEnum};
 use scanfit::bspline::{tessellate, Mesh};
 use scanfit::metrics::nearest_points;
 use scanfit::network::FaceFit;
@@ -23,8 +23,7 @@ use scanfit_io::render::{render_surface_scene_png, Colouring, Marker, Polyline};
 use scanfit_io::step_shell::step_shell_file;
 use scanfit_io::write_all_atomic;
 
-use crate::args::pair;
-use crate::args::InputArgs;
+use crate::args::{choice, Ids, InputArgs, IDS, NXM};
 use crate::outputs::{check_outputs, extension, print_written, Files};
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -52,6 +51,15 @@ sampling each edge on both patches; its angle column is the angle between the
 two patches' normals along the edge (the G1 defect).";
 
 /// Arguments of `scanfit reconstruct`.
+/// `--fit`: the surface of each patch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum FitRoute {
+    /// Coons patch + thin-plate PDE deformation (PDE paper eqs. 11-14).
+    Pde,
+    /// Least-squares B-spline with the boundary rows fixed to the edge curves.
+    Bspline,
+}
+
 #[derive(Args, Debug)]
 #[command(after_help = EXAMPLES)]
 pub struct ReconstructArgs {
@@ -62,18 +70,18 @@ pub struct ReconstructArgs {
     #[arg(long, value_name = "NAME")]
     pub labels: Option<String>,
     /// Patch ids to leave out, e.g. "0,99" (negative ids always are).
-    #[arg(long, value_name = "LIST", allow_hyphen_values = true)]
-    pub ignore: Option<String>,
+    #[arg(long, value_name = "LIST", allow_hyphen_values = true, value_parser = IDS)]
+    pub ignore: Option<Ids>,
     /// Surface route: `pde` (PDE paper, default) or `bspline`.
-    #[arg(long, value_name = "ROUTE")]
-    pub fit: Option<String>,
+    #[arg(long, value_name = "ROUTE", value_parser = choice::<FitRoute>())]
+    pub fit: Option<FitRoute>,
     /// PDE deformation with M x N sine terms per patch (PDE paper: 5x5).
-    #[arg(long, value_name = "MxN")]
-    pub pde: Option<String>,
+    #[arg(long, value_name = "MxN", value_parser = NXM)]
+    pub pde: Option<(usize, usize)>,
     /// Control net of each least-squares patch (--fit bspline), at least 4x4;
     /// the side curves' knots are added, so the net can be larger.
-    #[arg(long, default_value = "8x8", value_name = "NxM")]
-    pub ctrl: String,
+    #[arg(long, default_value = "8x8", value_name = "NxM", value_parser = NXM)]
+    pub ctrl: (usize, usize),
     /// Contact radius between patches, in point spacings.
     #[arg(long, default_value_t = 3.0, value_name = "F")]
     pub contact: f64,
@@ -148,34 +156,23 @@ pub fn run(a: ReconstructArgs) -> Result<()> {
 fn config(a: &ReconstructArgs) -> Result<ReconstructConfig> {
     let mut cfg = ReconstructConfig::default();
     cfg.network.labels.attribute = a.labels.clone();
-    if let Some(list) = &a.ignore {
-        cfg.network.labels.ignore = list
-            .split(',')
-            .map(|x| x.trim().parse::<i64>())
-            .collect::<std::result::Result<_, _>>()
-            .with_context(|| {
-                format!("--ignore '{list}' must be whole numbers separated by commas, e.g. 0,99")
-            })?;
+    if let Some(Ids(list)) = &a.ignore {
+        cfg.network.labels.ignore = list.clone();
     }
     cfg.network.contact_factor = a.contact;
     cfg.tolerance = a.export_tolerance;
-    cfg.fit = match (a.fit.as_deref(), &a.pde) {
-        (Some("bspline"), Some(_)) => {
+    cfg.fit = match (a.fit, a.pde) {
+        (Some(FitRoute::Bspline), Some(_)) => {
             bail!("--fit bspline and --pde exclude each other; choose one route")
         }
-        (Some("bspline"), None) => FaceFit::Bspline {
-            ctrl: pair(&a.ctrl, "--ctrl")?,
-        },
-        (None | Some("pde"), t) => {
-            let (m, n) = t.as_deref().map_or(Ok((5, 5)), |t| pair(t, "--pde"))?;
+        (Some(FitRoute::Bspline), None) => FaceFit::Bspline { ctrl: a.ctrl },
+        (None | Some(FitRoute::Pde), t) => {
+            let (m, n) = t.unwrap_or((5, 5));
             FaceFit::Pde(PdeConfig {
                 m,
                 n,
                 ..Default::default()
             })
-        }
-        (Some(f), _) => {
-            bail!("unknown --fit '{f}'; use pde (with --pde MxN) or bspline (with --ctrl NxM)")
         }
     };
     Ok(cfg)
@@ -283,6 +280,22 @@ fn outputs(a: &ReconstructArgs, r: &ReconstructReport, cloud: &PointCloud) -> Re
         };
         files.push((m.clone(), bytes));
     }
+    if a.png.is_some() || a.deviation_png.is_some() {
+        files.extend(pictures(a, r, cloud, &mesh, &patch)?);
+    }
+    Ok(files)
+}
+
+/// The `--png` (patches in distinct colours, edge network, corners) and
+/// `--deviation-png` pictures.
+fn pictures(
+    a: &ReconstructArgs,
+    r: &ReconstructReport,
+    cloud: &PointCloud,
+    mesh: &Mesh,
+    patch: &[usize],
+) -> Result<Files> {
+    let mut files: Files = Vec::new();
     let (lines, markers) = overlay(r);
     let mut opts = a.view.options(cloud.points())?;
     opts.iso_lines = 0;
@@ -299,7 +312,7 @@ fn outputs(a: &ReconstructArgs, r: &ReconstructReport, cloud: &PointCloud) -> Re
             r.network.vertices.len()
         )];
         let png = render_surface_scene_png(
-            &mesh,
+            mesh,
             None,
             Colouring::Scalar {
                 values: &values,
@@ -312,7 +325,7 @@ fn outputs(a: &ReconstructArgs, r: &ReconstructReport, cloud: &PointCloud) -> Re
         files.push((p.clone(), png));
     }
     if let Some(p) = &a.deviation_png {
-        let dev = vertex_deviation(r, cloud, &mesh, &patch)?;
+        let dev = vertex_deviation(r, cloud, mesh, patch)?;
         let hi = r.totals.orthogonal.max.max(f64::MIN_POSITIVE);
         opts.legend = vec![
             "orthogonal distance of the nearest point (0 .. max)".into(),
@@ -324,7 +337,7 @@ fn outputs(a: &ReconstructArgs, r: &ReconstructReport, cloud: &PointCloud) -> Re
             ),
         ];
         let png = render_surface_scene_png(
-            &mesh,
+            mesh,
             None,
             Colouring::Scalar {
                 values: &dev,
@@ -527,9 +540,9 @@ fn model_doc(a: &ReconstructArgs, r: &ReconstructReport, model: &PatchComplex) -
 
 /// The fit route as named in the provenance.
 fn r_fit(a: &ReconstructArgs) -> String {
-    match (a.fit.as_deref(), &a.pde) {
-        (Some("bspline"), _) => format!("bspline {}", a.ctrl),
-        (_, Some(t)) => format!("pde {t}"),
+    match (a.fit, a.pde) {
+        (Some(FitRoute::Bspline), _) => format!("bspline {}x{}", a.ctrl.0, a.ctrl.1),
+        (_, Some((m, n))) => format!("pde {m}x{n}"),
         _ => "pde 5x5".into(),
     }
 }

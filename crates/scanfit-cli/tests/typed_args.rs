@@ -231,3 +231,26 @@ fn curve_and_report_take_the_shared_input_group() {
     let skip = |s: &str| s.lines().skip(1).collect::<Vec<_>>().join("\n");
     assert_eq!(skip(&out), skip(&ok(&full)));
 }
+
+#[test]
+fn reconstruct_options_are_typed() {
+    let v = examples().join("vessel_30k.ply");
+    let v = v.to_str().unwrap();
+    for (args, needle) in [
+        (vec!["--fit", "nurbs"], "--fit"),
+        (vec!["--pde", "5by5"], "--pde"),
+        (vec!["--ctrl", "0x8", "--fit", "bspline"], "--ctrl"),
+        (vec!["--ignore", "1,two"], "--ignore"),
+    ] {
+        let mut all = vec!["reconstruct", v, "-q"];
+        all.extend(args.iter().copied());
+        let o = run(&all);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{all:?}: {err}");
+        assert!(err.contains(needle), "{all:?}: {err}");
+    }
+    // a negative id in --ignore is a value, not a flag
+    let o = run(&["reconstruct", v, "-q", "--ignore", "-5,13", "--json"]);
+    let out = ok(&o);
+    assert!(out.contains("\"patches\""), "{out}");
+}
