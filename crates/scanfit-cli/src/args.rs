@@ -157,11 +157,9 @@ pub struct Indices(pub Vec<usize>);
 pub const INDICES: Parsed<Indices> = Parsed(indices);
 
 fn indices(s: &str, what: &str) -> std::result::Result<Indices, String> {
-    s.split(',')
-        .map(|x| x.trim().parse::<usize>())
-        .collect::<std::result::Result<Vec<_>, _>>()
+    comma_list(s)
         .map(Indices)
-        .map_err(|_| format!("{what} '{s}' must be positions I,J,K,... (whole numbers)"))
+        .ok_or_else(|| format!("{what} '{s}' must be positions I,J,K,... (whole numbers)"))
 }
 
 /// A list of ids (signed whole numbers), `"0,99,-1"`.
@@ -172,11 +170,14 @@ pub struct Ids(pub Vec<i64>);
 pub const IDS: Parsed<Ids> = Parsed(ids);
 
 fn ids(s: &str, what: &str) -> std::result::Result<Ids, String> {
-    s.split(',')
-        .map(|x| x.trim().parse::<i64>())
-        .collect::<std::result::Result<Vec<_>, _>>()
+    comma_list(s)
         .map(Ids)
-        .map_err(|_| format!("{what} '{s}' must be whole numbers separated by commas, e.g. 0,99"))
+        .ok_or_else(|| format!("{what} '{s}' must be whole numbers separated by commas, e.g. 0,99"))
+}
+
+/// `"a,b,c"` parsed item by item; `None` when any item does not parse.
+fn comma_list<T: std::str::FromStr>(s: &str) -> Option<Vec<T>> {
+    s.split(',').map(|x| x.trim().parse::<T>().ok()).collect()
 }
 
 /// Camera angles in degrees: azimuth (any) and elevation in [-90, 90].
