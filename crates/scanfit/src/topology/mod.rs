@@ -177,53 +177,44 @@ impl Face {
         let (periodic_u, periodic_v) = s.periodic();
         let weights = s.weights();
         let net = s.control_points();
-        let w_at = |i: usize, j: usize| weights.map_or(1.0, |w| w[i * nv + j]);
-        // along u (sides 0, 2): combine columns j with M_j(v_fixed)
+        // the homogeneous control points of the iso-curve at parameter `t` of
+        // the direction with knots `across` (degree `deg`): for each index
+        // `a` along the side, the net entries `at(a, c)` for the across index
+        // `c` combined with that direction's basis functions at `t`
+        let combine = |across: &KnotVector,
+                       deg: usize,
+                       t: f64,
+                       count: usize,
+                       at: &dyn Fn(usize, usize) -> usize| {
+            let span = across.find_span(t);
+            let mut ws = BasisWorkspace::new(deg, 0);
+            let basis = ws.values(across.as_slice(), span, t).to_vec();
+            (0..count)
+                .map(|along| {
+                    let mut h = [0.0; 4];
+                    for (r, &b) in basis.iter().enumerate() {
+                        let idx = at(along, span - deg + r);
+                        let w = weights.map_or(1.0, |w| w[idx]) * b;
+                        let c = net[idx];
+                        h[0] += c.x * w;
+                        h[1] += c.y * w;
+                        h[2] += c.z * w;
+                        h[3] += w;
+                    }
+                    h
+                })
+                .collect::<Vec<[f64; 4]>>()
+        };
+        // sides 0, 2 run along u (v fixed), sides 1, 3 along v (u fixed)
         let (knots, periodic, hom): (&KnotVector, bool, Vec<[f64; 4]>) = match k % 4 {
             0 | 2 => {
                 let vf = if k % 4 == 0 { v0 } else { v1 };
-                let kv = s.knots_v();
-                let span = kv.find_span(vf);
-                let mut ws = BasisWorkspace::new(q, 0);
-                let m = ws.values(kv.as_slice(), span, vf).to_vec();
-                let hom = (0..nu)
-                    .map(|i| {
-                        let mut h = [0.0; 4];
-                        for (r, &mj) in m.iter().enumerate() {
-                            let j = span - q + r;
-                            let w = w_at(i, j) * mj;
-                            let c = net[i * nv + j];
-                            h[0] += c.x * w;
-                            h[1] += c.y * w;
-                            h[2] += c.z * w;
-                            h[3] += w;
-                        }
-                        h
-                    })
-                    .collect();
+                let hom = combine(s.knots_v(), q, vf, nu, &|i, j| i * nv + j);
                 (s.knots_u(), periodic_u, hom)
             }
             _ => {
                 let uf = if k % 4 == 1 { u1 } else { u0 };
-                let ku = s.knots_u();
-                let span = ku.find_span(uf);
-                let mut ws = BasisWorkspace::new(p, 0);
-                let n = ws.values(ku.as_slice(), span, uf).to_vec();
-                let hom = (0..nv)
-                    .map(|j| {
-                        let mut h = [0.0; 4];
-                        for (r, &ni) in n.iter().enumerate() {
-                            let i = span - p + r;
-                            let w = w_at(i, j) * ni;
-                            let c = net[i * nv + j];
-                            h[0] += c.x * w;
-                            h[1] += c.y * w;
-                            h[2] += c.z * w;
-                            h[3] += w;
-                        }
-                        h
-                    })
-                    .collect();
+                let hom = combine(s.knots_u(), p, uf, nv, &|j, i| i * nv + j);
                 (s.knots_v(), periodic_v, hom)
             }
         };
