@@ -300,11 +300,7 @@ fn pictures(
     let mut opts = a.view.options(cloud.points())?;
     opts.iso_lines = 0;
     if let Some(p) = &a.png {
-        // neighbouring ids far apart on the colour map (golden-ratio steps)
-        let values: Vec<f64> = patch
-            .iter()
-            .map(|&k| (k as f64 * 0.618_033_988_75).fract())
-            .collect();
+        let colours: Vec<[u8; 3]> = patch.iter().map(|&k| patch_colour(k)).collect();
         opts.legend = vec![format!(
             "{} patches, {} edges, {} corners",
             r.faces.len(),
@@ -314,10 +310,7 @@ fn pictures(
         let png = render_surface_scene_png(
             mesh,
             None,
-            Colouring::Scalar {
-                values: &values,
-                range: (0.0, 1.0),
-            },
+            Colouring::Rgb(&colours),
             &lines,
             &markers,
             &opts,
