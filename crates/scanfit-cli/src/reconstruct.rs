@@ -141,9 +141,10 @@ pub fn run(a: ReconstructArgs) -> Result<()> {
     let files = outputs(&a, &r, &cloud)?;
     write_all_atomic(&files)?;
     if a.json {
-        outln!(
+        let report = json_report(&r, &a, seconds, dropped);
+        out!(
             "{}",
-            serde_json::to_string_pretty(&json_report(&r, &a, seconds, dropped))?
+            scanfit_io::json::finite_json(&report, "the JSON report")?
         );
     } else {
         out!("{}", tables(&r, seconds));
@@ -458,7 +459,7 @@ fn model_files(
 ) -> Result<Files> {
     let mut files: Files = Vec::new();
     if let Some(o) = &a.output {
-        files.push((o.clone(), model_doc(a, r, model).to_json().into_bytes()));
+        files.push((o.clone(), model_doc(a, r, model).to_json()?.into_bytes()));
     }
     if let Some(p) = &a.step {
         files.push((p.clone(), step_shell_file(model, name)?.text.into_bytes()));
