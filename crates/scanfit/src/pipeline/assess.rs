@@ -260,18 +260,7 @@ fn finish(
     let orthogonal = ErrorStats::of(&dist);
     let unconverged = inversions.iter().filter(|r| !r.converged).count();
     let cloud = PointCloud::new(points.to_vec())?;
-    // eq. 17 at the knot lines (u_i = s_{i+3} in the MBA paper)
-    let knots: Vec<Point3> = {
-        let (us, vs) = (
-            surface.knots_u().breakpoints(),
-            surface.knots_v().breakpoints(),
-        );
-        us.iter()
-            .flat_map(|&u| vs.iter().map(move |&v| (u, v)))
-            .map(|(u, v)| surface.point(u, v))
-            .collect()
-    };
-    let grid_rmse = crate::metrics::rmse_to_cloud(&cloud, &knots)?;
+    let grid_rmse = crate::metrics::rmse_to_cloud(&cloud, &knot_line_points(surface))?;
     let samples_to_points = sample_distances(surface, &cloud, config)?;
     let parameterization = if config.parameterization {
         // a parameter set that cannot be triangulated (all collinear) has no
@@ -295,14 +284,26 @@ fn finish(
     })
 }
 
-/// The surface-to-points distances over the sample grid of `config`.
-fn sample_distances(
+/// The surface points at the knot lines (every pair of breakpoints), where
+/// [MBA18] eq. 17 is measured (`u_i = s_{i+3}` in the MBA paper).
+pub(crate) fn knot_line_points(surface: &Surface) -> Vec<Point3> {
+    let (us, vs) = (
+        surface.knots_u().breakpoints(),
+        surface.knots_v().breakpoints(),
+    );
+    us.iter()
+        .flat_map(|&u| vs.iter().map(move |&v| (u, v)))
+        .map(|(u, v)| surface.point(u, v))
+        .collect()
+}
+
+/// The sample grid of `config` (intervals `(nu, nv)`) and its surface points.
+pub(crate) fn sample_grid(
     surface: &Surface,
-    cloud: &PointCloud,
     config: &AssessConfig,
-) -> Result<SampleDistances> {
+) -> Result<((usize, usize), Vec<Point3>)> {
+    check(config)?;
     let (cu, cv) = surface.counts();
-    // checked by `check`
     let (nu, nv) = config
         .samples
         .unwrap_or(((cu * 4).clamp(32, 200), (cv * 4).clamp(32, 200)));
@@ -316,6 +317,16 @@ fn sample_distances(
             )
         })
         .collect();
+    Ok(((nu, nv), samples))
+}
+
+/// The surface-to-points distances over the sample grid of `config`.
+fn sample_distances(
+    surface: &Surface,
+    cloud: &PointCloud,
+    config: &AssessConfig,
+) -> Result<SampleDistances> {
+    let ((nu, nv), samples) = sample_grid(surface, config)?;
     let d: Vec<f64> = cloud
         .nearest_batch(&samples)?
         .into_iter()
