@@ -18,6 +18,9 @@
 //!    the side curves, closest-point parameters, the PDE deformation (or a
 //!    least-squares B-spline) inside the fixed boundary.
 //!
+//! The labels of step 1 can also be made here: [`layout`] segments the
+//! cloud or lays patches over a smooth object.
+//!
 //! [`build_network`] runs steps 1-4; the pipeline
 //! [`crate::pipeline::reconstruct`] adds step 5 for every patch in parallel.
 
@@ -26,6 +29,7 @@ pub mod curves;
 pub mod face;
 pub mod junctions;
 pub mod labels;
+pub mod layout;
 
 pub use curves::{fit_edge_curve, EdgeCurve, EdgeCurveConfig};
 pub use face::{fit_face, group_sides, side_curve, side_ranges, FaceConfig, FaceFit, FaceSurface};

@@ -50,6 +50,7 @@ pub mod curve;
 pub mod mba;
 pub mod measure;
 pub mod reconstruct;
+pub mod segment;
 pub mod surface_fit;
 pub mod turntable;
 

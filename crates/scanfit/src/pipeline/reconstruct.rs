@@ -15,6 +15,7 @@ use rayon::prelude::*;
 
 use crate::bspline::{BasisWorkspace, Curve, Surface};
 use crate::metrics::ErrorStats;
+use crate::network::layout::{generate_labels, LabelSource, GENERATED_LABEL};
 use crate::network::{
     build_network, fit_face, group_sides, side_curve, side_ranges, FaceConfig, FaceFit,
     FaceSurface, NetUse, Network, NetworkConfig,
@@ -28,6 +29,10 @@ use crate::{Error, Point3, PointCloud, Result, Vector3};
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct ReconstructConfig {
+    /// Where the patch ids come from (default: the cloud's label attribute;
+    /// or a segmentation, or a layout, whose ids replace it: see
+    /// [`crate::network::layout`]).
+    pub source: LabelSource,
     /// Labels, borders, junctions and edge curves (see [`NetworkConfig`]).
     pub network: NetworkConfig,
     /// The fit inside each patch's boundary: PDE deformation with 5 x 5
@@ -46,6 +51,7 @@ pub struct ReconstructConfig {
 impl Default for ReconstructConfig {
     fn default() -> Self {
         Self {
+            source: LabelSource::default(),
             network: NetworkConfig::default(),
             fit: FaceFit::default(),
             inversion: InversionConfig::default(),
@@ -184,7 +190,20 @@ pub fn run(
     cfg: &ReconstructConfig,
     progress: &dyn Progress,
 ) -> Result<ReconstructReport> {
-    let network = build_network(cloud, &cfg.network, progress)?;
+    // generated ids go into the label attribute of a copy, read as hand labels are
+    let labelled;
+    let mut net_cfg = cfg.network.clone();
+    let cloud = match generate_labels(cloud, &cfg.source, progress)? {
+        None => cloud,
+        Some(ids) => {
+            labelled = cloud
+                .clone()
+                .with_attribute(GENERATED_LABEL, ids.iter().map(|&i| i as f64).collect())?;
+            net_cfg.labels.attribute = Some(GENERATED_LABEL.into());
+            &labelled
+        }
+    };
+    let network = build_network(cloud, &net_cfg, progress)?;
     let (lo, hi) = network
         .patches
         .iter()
