@@ -395,6 +395,7 @@ fn tables(r: &ReconstructReport, seconds: f64) -> String {
             "rmse",
             "orth rmse",
             "orth max",
+            "folds",
         ],
         &[],
     );
@@ -411,6 +412,7 @@ fn tables(r: &ReconstructReport, seconds: f64) -> String {
             num(p.errors.rmse),
             num(p.orthogonal.rmse),
             num(p.orthogonal.max),
+            p.fold_overs.to_string(),
         ]);
     }
     let mut e = Table::new(
@@ -468,7 +470,7 @@ fn json_report(
         "patches": r.patches.iter().map(|p| serde_json::json!({
             "id": p.id, "sides": p.sides, "edges": p.edges, "points": p.points,
             "coons": stats(&p.coons_errors), "errors": stats(&p.errors), "orthogonal": stats(&p.orthogonal),
-            "bspline_deviation": p.conversion_deviation,
+            "bspline_deviation": p.conversion_deviation, "fold_overs": p.fold_overs,
         })).collect::<Vec<_>>(),
         "edges": r.edges.iter().map(|e| serde_json::json!({
             "vertices": e.vertices, "patches": e.patches, "max_gap": e.max_gap,

@@ -27,6 +27,7 @@
 pub mod borders;
 pub mod curves;
 pub mod face;
+pub mod folds;
 pub mod junctions;
 pub mod labels;
 pub mod layout;

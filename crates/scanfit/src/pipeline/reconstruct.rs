@@ -15,6 +15,7 @@ use rayon::prelude::*;
 
 use crate::bspline::{BasisWorkspace, Curve, Surface};
 use crate::metrics::ErrorStats;
+use crate::network::folds::fold_overs;
 use crate::network::layout::{generate_labels, LabelSource, GENERATED_LABEL};
 use crate::network::{
     build_network, fit_face, group_sides, side_curve, side_ranges, FaceConfig, FaceFit,
@@ -80,6 +81,8 @@ pub struct PatchReport {
     pub orthogonal: ErrorStats,
     /// Distance between the PDE surface and its B-spline form.
     pub conversion_deviation: f64,
+    /// Points whose parameters fold over ([`crate::network::folds`]).
+    pub fold_overs: usize,
 }
 
 /// One edge of the result.
@@ -275,17 +278,21 @@ pub fn run(
         .iter()
         .zip(&sides)
         .zip(&faces)
-        .map(|((p, s), f)| PatchReport {
-            id: p.id,
-            sides: s.len(),
-            edges: p.cycle.len(),
-            points: p.points.len(),
-            coons_errors: f.coons_errors,
-            errors: f.errors,
-            orthogonal: f.orthogonal,
-            conversion_deviation: f.conversion_deviation,
+        .map(|((p, s), f)| {
+            let pts: Vec<Point3> = p.points.iter().map(|&i| cloud.points()[i]).collect();
+            Ok(PatchReport {
+                id: p.id,
+                sides: s.len(),
+                edges: p.cycle.len(),
+                points: p.points.len(),
+                coons_errors: f.coons_errors,
+                errors: f.errors,
+                orthogonal: f.orthogonal,
+                conversion_deviation: f.conversion_deviation,
+                fold_overs: fold_overs(&pts, &f.uv, &f.surface)?,
+            })
         })
-        .collect();
+        .collect::<Result<_>>()?;
     let totals = Totals {
         errors: pooled(patches.iter().map(|p| &p.errors)),
         orthogonal: pooled(patches.iter().map(|p| &p.orthogonal)),
