@@ -104,8 +104,16 @@ fn blob_as_a_cube_is_a_closed_solid_of_the_true_volume() {
     // the layout's parameters do not fold: at most 0.5% of a patch's points
     // (noise at the borders), per patch
     for p in &r.patches {
-        println!("patch {}: {} points, {} folded", p.id, p.points, p.fold_overs);
-        assert!(p.fold_overs * 200 <= p.points, "patch {}: {} folded", p.id, p.fold_overs);
+        println!(
+            "patch {}: {} points, {} folded",
+            p.id, p.points, p.fold_overs
+        );
+        assert!(
+            p.fold_overs * 200 <= p.points,
+            "patch {}: {} folded",
+            p.id,
+            p.fold_overs
+        );
     }
     assert_eq!(r.network.vertices.len(), 8);
     assert_eq!(r.network.edges.len(), 12);
