@@ -53,6 +53,7 @@ pub mod mba;
 pub mod measure;
 pub mod reconstruct;
 pub mod regularize;
+pub mod segment;
 pub mod stream;
 pub mod surface_fit;
 pub mod turntable;
