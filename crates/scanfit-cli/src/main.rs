@@ -36,6 +36,7 @@ mod outputs;
 mod progress;
 mod reconstruct;
 mod report;
+mod report_model;
 mod surface;
 mod table;
 mod turntable;
