@@ -284,10 +284,7 @@ fn outputs(a: &ReconstructArgs, r: &ReconstructReport, cloud: &PointCloud) -> Re
     let mut files: Files = Vec::new();
     let cad = a.output.is_some() || a.step.is_some() || a.iges.is_some();
     if cad {
-        let model = r
-            .complex
-            .as_ref()
-            .map_err(|e| anyhow::anyhow!("cannot write the model: {e}"))?;
+        let model = &r.complex;
         let name = a
             .input
             .input

@@ -123,7 +123,7 @@ fn blob_as_a_cube_is_a_closed_solid_of_the_true_volume() {
         "{}",
         r.totals.max_gap
     );
-    let model = r.complex.as_ref().unwrap();
+    let model = &r.complex;
     let v = model.signed_volume().abs();
     println!(
         "blob: volume {v} (true {truth}), orthogonal rmse {}",

@@ -33,7 +33,9 @@ pub mod labels;
 pub mod layout;
 
 pub use curves::{fit_edge_curve, EdgeCurve, EdgeCurveConfig};
-pub use face::{fit_face, group_sides, side_curve, side_ranges, FaceConfig, FaceFit, FaceSurface};
+pub use face::{
+    coons_uv, fit_face, group_sides, side_curve, side_ranges, FaceConfig, FaceFit, FaceSurface,
+};
 pub use junctions::{NetEdge, NetUse, NetVertex};
 pub use labels::{read_labels, LabelConfig, Labels, LABEL_NAMES};
 

@@ -135,11 +135,10 @@ pub struct ReconstructReport {
     pub edges: Vec<EdgeReport>,
     /// Totals.
     pub totals: Totals,
-    /// The model as a [`PatchComplex`] (faces sharing edges), for the CAD
-    /// writers; `Err` says why it cannot be formed: a patch with a side made
-    /// of several edges (more than 4 corners), which the complex's one edge
-    /// per side cannot hold.
-    pub complex: std::result::Result<PatchComplex, String>,
+    /// The model as a [`PatchComplex`] (faces sharing edges, a side of a
+    /// patch with more than four corners a chain of several), for the CAD
+    /// writers.
+    pub complex: PatchComplex,
 }
 
 /// The `(u, v)` of side `s` at side parameter `t` (counter-clockwise: side
@@ -328,39 +327,31 @@ fn run_centred(
 
 /// The network and the faces as a [`PatchComplex`] (see
 /// [`ReconstructReport::complex`]).
-fn complex(
-    net: &Network,
-    sides: &[Vec<Vec<NetUse>>],
-    faces: &[FaceSurface],
-) -> std::result::Result<PatchComplex, String> {
-    let mut out = Vec::with_capacity(faces.len());
-    for ((p, s), f) in net.patches.iter().zip(sides).zip(faces) {
-        let mut uses: [Option<topology::EdgeUse>; 4] = [None; 4];
-        for (k, side) in s.iter().enumerate() {
-            match side[..] {
-                [u] => {
-                    uses[k] = Some(topology::EdgeUse {
+fn complex(net: &Network, sides: &[Vec<Vec<NetUse>>], faces: &[FaceSurface]) -> PatchComplex {
+    let faces = net
+        .patches
+        .iter()
+        .zip(sides)
+        .zip(faces)
+        .map(|((p, s), f)| {
+            let mut chains: [Vec<topology::EdgeUse>; 4] = Default::default();
+            for (chain, side) in chains.iter_mut().zip(s) {
+                *chain = side
+                    .iter()
+                    .map(|u| topology::EdgeUse {
                         edge: u.edge,
                         reversed: u.reversed,
                     })
-                }
-                _ => {
-                    return Err(format!(
-                        "patch {} has {} corners, so its side {k} is made of {} edges; the model (one edge per side) cannot hold it: relabel so that every patch has 3 or 4 corners",
-                        p.id,
-                        p.cycle.len(),
-                        side.len()
-                    ))
-                }
+                    .collect();
             }
-        }
-        out.push(topology::Face {
-            id: p.id,
-            surface: f.surface.clone(),
-            sides: uses,
-        });
-    }
-    Ok(PatchComplex {
+            topology::Face {
+                id: p.id,
+                surface: f.surface.clone(),
+                sides: chains,
+            }
+        })
+        .collect();
+    PatchComplex {
         vertices: net
             .vertices
             .iter()
@@ -375,12 +366,12 @@ fn complex(
                 curve: e.curve.clone(),
             })
             .collect(),
-        faces: out,
-    })
+        faces,
+    }
 }
 
 /// The statistics of the union of several point sets from theirs.
-fn pooled<'a>(stats: impl Iterator<Item = &'a ErrorStats>) -> ErrorStats {
+pub(crate) fn pooled<'a>(stats: impl Iterator<Item = &'a ErrorStats>) -> ErrorStats {
     let (mut count, mut sum, mut sq, mut max) = (0usize, 0.0, 0.0, 0.0f64);
     for s in stats {
         count += s.count;
