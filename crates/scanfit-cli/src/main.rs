@@ -36,6 +36,7 @@ mod outputs;
 mod progress;
 mod reconstruct;
 mod report;
+mod stream;
 mod surface;
 mod table;
 mod turntable;

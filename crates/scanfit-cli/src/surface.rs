@@ -93,6 +93,11 @@ pub struct FitArgs {
     /// Write the points with u, v, residual and orthogonal distance (.ply or .xyz).
     #[arg(long, value_name = "POINTS")]
     pub points_out: Option<PathBuf>,
+    /// Read the input in chunks of N points, in passes, so memory depends on
+    /// the control net, not the point count (needs --params uv-columns and
+    /// --knots uniform; text inputs are read in chunks, others whole).
+    #[arg(long, value_name = "N")]
+    pub chunk_points: Option<usize>,
     /// Print the report as JSON on stdout instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -103,7 +108,7 @@ pub struct FitArgs {
 
 impl FitArgs {
     /// The pipeline's settings.
-    fn config(&self) -> FitConfig {
+    pub(crate) fn config(&self) -> FitConfig {
         let mut c = FitConfig::default();
         c.params = match self.params {
             ParamsArg::Plane => ParameterSource::Plane,
@@ -122,7 +127,7 @@ impl FitArgs {
     }
 
     /// The settings recorded in the surface document.
-    fn settings(&self) -> BTreeMap<String, serde_json::Value> {
+    pub(crate) fn settings(&self) -> BTreeMap<String, serde_json::Value> {
         let mut s = BTreeMap::new();
         s.insert(
             "degree".into(),
@@ -175,6 +180,9 @@ pub fn run(a: FitArgs) -> Result<()> {
         &a.input.input,
         &[(&a.points_out, "--points-out", &["ply", "xyz"][..])],
     )?;
+    if let Some(n) = a.chunk_points {
+        return crate::stream::fit(&a, n);
+    }
     let progress = Progress::spinner(a.quiet);
     progress.stage(format!("reading {}", a.input.input.display()));
     let table = a.input.table(a.json)?;
