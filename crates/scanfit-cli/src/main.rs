@@ -39,6 +39,7 @@ mod reconstruct;
 mod report;
 mod report_model;
 mod segment;
+mod stream;
 mod surface;
 mod table;
 mod turntable;

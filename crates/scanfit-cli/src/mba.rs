@@ -99,6 +99,11 @@ pub struct MbaArgs {
     pub adjust_steps: usize,
     #[command(flatten)]
     pub out: SurfaceOutputArgs,
+    /// Read the input in chunks of N points, one pass per level, so memory
+    /// depends on the lattice, not the point count (not with --adjust; text
+    /// inputs are read in chunks, others whole).
+    #[arg(long, value_name = "N")]
+    pub chunk_points: Option<usize>,
     /// Print the report as JSON on stdout instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -109,7 +114,7 @@ pub struct MbaArgs {
 
 impl MbaArgs {
     /// The pipeline's settings.
-    fn config(&self) -> MbaRunConfig {
+    pub(crate) fn config(&self) -> MbaRunConfig {
         let mut c = MbaRunConfig::default();
         c.mba.base = self.base;
         c.mba.max_levels = self.levels;
@@ -132,12 +137,16 @@ impl MbaArgs {
     }
 
     /// The settings recorded in the surface document.
-    fn settings(&self, r: &MbaReport) -> BTreeMap<String, serde_json::Value> {
+    pub(crate) fn settings(
+        &self,
+        levels: usize,
+        cells: (usize, usize),
+    ) -> BTreeMap<String, serde_json::Value> {
         let mut s = BTreeMap::new();
-        s.insert("levels".into(), r.levels.len().into());
+        s.insert("levels".into(), levels.into());
         s.insert(
             "lattice_cells".into(),
-            serde_json::json!([r.cells.0, r.cells.1]),
+            serde_json::json!([cells.0, cells.1]),
         );
         let formula = if self.hjelle {
             "hjelle"
@@ -198,6 +207,9 @@ pub fn run(a: MbaArgs) -> Result<()> {
     if a.levels == 0 {
         anyhow::bail!("--levels must be at least 1");
     }
+    if let Some(n) = a.chunk_points {
+        return crate::stream::mba(&a, n);
+    }
     let progress = Progress::spinner(a.quiet || a.json);
     progress.stage(format!("reading {}", a.input.input.display()));
     let cloud = a.input.load(a.json)?;
@@ -228,7 +240,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
         Some("xy (u = x, v = y, scaled to [0, 1])".into()),
         input,
         pts.len(),
-        a.settings(&r),
+        a.settings(r.levels.len(), r.cells),
     ));
     doc.quality = Some(quality_doc(q, Vec::new()));
     let deviation = Deviation {

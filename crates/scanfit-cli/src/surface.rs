@@ -91,6 +91,11 @@ pub struct FitArgs {
     /// Write the points with u, v, residual and orthogonal distance (.ply or .xyz).
     #[arg(long, value_name = "POINTS")]
     pub points_out: Option<PathBuf>,
+    /// Read the input in chunks of N points, in passes, so memory depends on
+    /// the control net, not the point count (needs --params uv-columns and
+    /// --knots uniform; text inputs are read in chunks, others whole).
+    #[arg(long, value_name = "N")]
+    pub chunk_points: Option<usize>,
     /// Print the report as JSON on stdout instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -101,7 +106,7 @@ pub struct FitArgs {
 
 impl FitArgs {
     /// The pipeline's settings.
-    fn config(&self) -> FitConfig {
+    pub(crate) fn config(&self) -> FitConfig {
         let mut c = FitConfig::default();
         c.params = match self.params {
             ParamsArg::Plane => ParameterSource::Plane,
@@ -127,16 +132,20 @@ impl FitArgs {
 
     /// The settings recorded in the surface document (the net and weight
     /// the fit used).
-    fn settings(&self, r: &FitReport) -> BTreeMap<String, serde_json::Value> {
+    pub(crate) fn settings(
+        &self,
+        surface: &scanfit::bspline::Surface,
+        smoothing: f64,
+    ) -> BTreeMap<String, serde_json::Value> {
         let mut s = BTreeMap::new();
         s.insert(
             "degree".into(),
             serde_json::json!([self.degree.0, self.degree.1]),
         );
-        let (cu, cv) = r.surface.counts();
+        let (cu, cv) = surface.counts();
         s.insert("ctrl".into(), serde_json::json!([cu, cv]));
         s.insert("knots".into(), name(&self.knots).into());
-        s.insert("smoothing".into(), r.smoothing.into());
+        s.insert("smoothing".into(), smoothing.into());
         s.insert("periodic_u".into(), self.periodic_u.into());
         s.insert("correction_rounds".into(), self.correct.into());
         s
@@ -181,6 +190,9 @@ pub fn run(a: FitArgs) -> Result<()> {
         &a.input.input,
         &[(&a.points_out, "--points-out", &["ply", "xyz"][..])],
     )?;
+    if let Some(n) = a.chunk_points {
+        return crate::stream::fit(&a, n);
+    }
     let progress = Progress::spinner(a.quiet);
     progress.stage(format!("reading {}", a.input.input.display()));
     let table = a.input.table(a.json)?;
@@ -200,7 +212,7 @@ pub fn run(a: FitArgs) -> Result<()> {
         Some(name(&a.params)),
         &a.input.input,
         pts.len(),
-        a.settings(&r),
+        a.settings(&r.surface, r.smoothing),
     ));
     doc.quality = Some(quality.clone());
     let dist = r.assessment.distances();

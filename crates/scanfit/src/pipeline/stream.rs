@@ -260,6 +260,9 @@ pub struct StreamedFit {
     pub passes: usize,
     /// The streamed measures (see the module documentation).
     pub quality: SurfaceQuality,
+    /// The thin-plate weight used (scaled to the point count unless
+    /// [`FitConfig::relative_smoothing`] is `None`).
+    pub smoothing: f64,
 }
 
 /// The least-squares surface of the points of `source` (parameters from
@@ -283,6 +286,8 @@ pub struct StreamedFit {
 /// cfg.params = ParameterSource::uv_attributes();
 /// cfg.fit.knots = KnotPlacement::Uniform;
 /// cfg.fit.ctrl = (8, 8);
+/// cfg.ctrl_from_density = false;
+/// cfg.relative_smoothing = None;
 /// let mut source = SliceSource { points: &p, uv: Some(&uv), chunk: 1000 };
 /// let r = fit(&mut source, &cfg, &NoProgress)?;
 /// let once = scanfit::fit::surface::fit_surface(&p, &uv, &cfg.fit)?;
@@ -314,24 +319,43 @@ pub fn fit(
             "parameter correction re-projects every point in each round and keeps their parameters; leave it out",
         ));
     }
-    let mut eq = config.fit.uniform_equations()?;
-    let (cu, cv) = config.fit.ctrl;
+    // the net from the point density needs the count first: one more pass
+    let mut passes = 2;
+    let fit = if config.ctrl_from_density {
+        progress.stage("pass 0: counting the points", None);
+        let mut n = 0usize;
+        source.pass(&mut |c| {
+            n += c.points.len();
+            Ok(())
+        })?;
+        passes += 1;
+        config.resolved_fit(n)
+    } else {
+        config.fit.clone()
+    };
+    let mut eq = fit.uniform_equations()?;
+    let (cu, cv) = fit.ctrl;
     progress.stage(
         &format!("pass 1: normal equations of {cu} x {cv} control points"),
         None,
     );
+    let mut n = 0usize;
     source.pass(&mut |c| {
         let uv = chunk_uv(&c)?;
+        n += c.points.len();
         eq.add(c.points, uv, None)
     })?;
-    let surface = eq.finish(config.fit.smoothing)?;
+    // the thin-plate weight scaled to the count, as the in-memory pipeline
+    let smoothing = config.resolved_fit(n).smoothing;
+    let surface = eq.finish(smoothing)?;
     progress.stage("pass 2: measuring", None);
     let mut assessor = StreamAssessor::new(&surface, &config.assess)?;
     source.pass(&mut |c| assessor.add(c.points, chunk_uv(&c)?))?;
     Ok(StreamedFit {
         quality: assessor.finish(),
         surface,
-        passes: 2,
+        passes,
+        smoothing,
     })
 }
 
@@ -561,6 +585,8 @@ mod tests {
         cfg.params = ParameterSource::uv_attributes();
         cfg.fit.knots = KnotPlacement::Uniform;
         cfg.fit.ctrl = (20, 14);
+        cfg.ctrl_from_density = false;
+        cfg.relative_smoothing = None;
         cfg.fit.smoothing = 1e-9;
         let once = surface_fit::run(&cloud, &cfg, &NoProgress).unwrap();
         let mut s = SliceSource {
@@ -570,6 +596,16 @@ mod tests {
         };
         let r = fit(&mut s, &cfg, &NoProgress).unwrap();
         assert_eq!(r.surface, once.surface);
+        // the safe defaults (net from the density, weight scaled to the
+        // count) give the in-memory surface too, after a counting pass
+        let mut dflt = FitConfig::default();
+        dflt.params = ParameterSource::uv_attributes();
+        dflt.fit.knots = KnotPlacement::Uniform;
+        let once_default = surface_fit::run(&cloud, &dflt, &NoProgress).unwrap();
+        let streamed_default = fit(&mut s, &dflt, &NoProgress).unwrap();
+        assert_eq!(streamed_default.passes, 3);
+        assert_eq!(streamed_default.surface, once_default.surface);
+        assert!(streamed_default.smoothing > 0.0);
         let (a, b) = (r.quality, once.assessment.quality);
         assert!(
             (a.at_parameters.rmse - b.at_parameters.rmse).abs() <= 1e-12 * b.at_parameters.rmse
