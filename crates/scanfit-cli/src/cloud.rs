@@ -41,6 +41,8 @@ pub enum CloudCommand {
     Hpr(HprArgs),
     /// Boundary loop of a sheet-like patch (alpha shape), its corners and sides.
     Boundary(BoundaryArgs),
+    /// Regions between sharp edges (normal variation, octree cells) as a `label` property.
+    Segment(crate::segment::SegmentArgs),
 }
 
 /// `--criterion`: the corner measure (`cloud boundary`, `coons`).
@@ -271,6 +273,7 @@ pub fn run(c: CloudCommand) -> Result<()> {
         CloudCommand::Normals(a) => normals(a),
         CloudCommand::Hpr(a) => hpr(a),
         CloudCommand::Boundary(a) => boundary(a),
+        CloudCommand::Segment(a) => crate::segment::run(a),
     }
 }
 

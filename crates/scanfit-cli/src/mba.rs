@@ -210,9 +210,13 @@ pub fn run(a: MbaArgs) -> Result<()> {
     ];
     let r = mba(&cloud, &a.config(), &progress)
         .map_err(|e| anyhow::anyhow!("{}: {e}{}", input.display(), option_note(&e, &options)))?;
+    let q = &r.assessment.quality;
+    a.out.guard(
+        q,
+        "remove stray points or use fewer levels (--levels) or a tolerance (--tolerance)",
+    )?;
     progress.stage("writing");
     let pts = cloud.points();
-    let q = &r.assessment.quality;
     let operation = if a.adjust {
         "mba (multilevel B-spline approximation + projection adjustment)"
     } else {
