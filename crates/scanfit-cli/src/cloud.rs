@@ -304,7 +304,7 @@ fn info(a: InfoArgs) -> Result<()> {
     .with_context(|| a.input.input.display().to_string())?;
     if a.json {
         let (lo, hi) = (r.bbox_min, r.bbox_max);
-        let report = serde_json::json!({
+        let mut report = serde_json::json!({
             "file": a.input.input.display().to_string(),
             "points": r.points,
             "dropped_non_finite": dropped,
@@ -312,9 +312,11 @@ fn info(a: InfoArgs) -> Result<()> {
             "bbox_max": [hi.x, hi.y, hi.z],
             "diagonal": r.diagonal,
             "attributes": r.attributes.iter().map(|at| serde_json::json!({"name": at.name, "min": at.min, "max": at.max})).collect::<Vec<_>>(),
-            "spacing": r.spacing.map(|s| serde_json::json!({"min": s.min, "median": s.median, "mean": s.mean, "max": s.max, "duplicates": s.duplicates})),
             "read_seconds": read_s,
         });
+        if let Some(s) = r.spacing {
+            report["spacing"] = serde_json::json!({"min": s.min, "median": s.median, "mean": s.mean, "max": s.max, "duplicates": s.duplicates, "measured_points": s.measured, "sampled": s.measured < r.points});
+        }
         out!(
             "{}",
             scanfit_io::json::finite_json(&report, "the JSON report")?
@@ -364,6 +366,13 @@ fn print_info(input: &Path, r: &CloudInfo, read_s: f64) -> Result<()> {
             t.row(vec![n.to_string(), num(v)]);
         }
         out!("{}", t.render());
+        if s.measured < r.points {
+            outln!(
+                "(nearest-neighbour distances of a seeded random sample of {} of the {} points)",
+                s.measured,
+                r.points
+            );
+        }
         if s.duplicates > 0 {
             outln!("{} points coincide with another point", s.duplicates);
         }
