@@ -40,7 +40,12 @@ fn corners_of_sparse_noisy_tilted_patches_are_within_three_percent_of_a_side() {
     ];
     let side = 0.8; // the shortest side
     let mut worst: f64 = 0.0;
-    for (n, noise, seed) in [(2000, 0.002, 1), (3000, 0.004, 2), (4000, 0.0, 3), (2500, 0.003, 4)] {
+    for (n, noise, seed) in [
+        (2000, 0.002, 1),
+        (3000, 0.004, 2),
+        (4000, 0.0, 3),
+        (2500, 0.003, 4),
+    ] {
         let pts = sample(n, noise, seed);
         let c = coons_from_cloud(&pts, &CoonsFromCloudConfig::default()).unwrap();
         let outer = c.boundary.outer_loop();
@@ -111,10 +116,17 @@ fn a_rectangle_has_clear_corners_of_ninety_degrees() {
         .collect();
     let c = coons_from_cloud(&pts, &CoonsFromCloudConfig::default()).unwrap();
     for s in &c.corner_strengths {
-        assert!((s.to_degrees() - 90.0).abs() < 15.0, "{:?}", c.corner_strengths);
+        assert!(
+            (s.to_degrees() - 90.0).abs() < 15.0,
+            "{:?}",
+            c.corner_strengths
+        );
     }
     // sides of 1/3 and 1/6 of the loop
     let mut shares = c.side_shares.clone();
     shares.sort_by(f64::total_cmp);
-    assert!((shares[0] - 1.0 / 6.0).abs() < 0.02 && (shares[3] - 1.0 / 3.0).abs() < 0.02, "{shares:?}");
+    assert!(
+        (shares[0] - 1.0 / 6.0).abs() < 0.02 && (shares[3] - 1.0 / 3.0).abs() < 0.02,
+        "{shares:?}"
+    );
 }

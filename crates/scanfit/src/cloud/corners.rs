@@ -162,7 +162,13 @@ pub fn arc_neighbour_values(
 }
 
 /// The criterion at `b` with neighbours `a` and `c` (eqs. 10-12 or `4S/(abc)`).
-fn measure(points: &[Point3], criterion: CornerCriterion, ia: usize, i: usize, ic: usize) -> Result<f64> {
+fn measure(
+    points: &[Point3],
+    criterion: CornerCriterion,
+    ia: usize,
+    i: usize,
+    ic: usize,
+) -> Result<f64> {
     let (a, b, c) = (points[ia], points[i], points[ic]);
     let d1 = a - b; // eq. 10
     let d2 = c - b; // eq. 11
@@ -364,7 +370,11 @@ fn apex(points: &[Point3], i: usize, m: usize) -> usize {
     };
     (0..=2 * m)
         .map(|k| (i + n - m + k) % n)
-        .max_by(|&x, &y| dist(&points[x]).total_cmp(&dist(&points[y])).then(y.cmp(&x)))
+        .max_by(|&x, &y| {
+            dist(&points[x])
+                .total_cmp(&dist(&points[y]))
+                .then(y.cmp(&x))
+        })
         .unwrap_or(i)
 }
 
