@@ -468,7 +468,7 @@ fn print_json(
     let (dp, dq) = r.surface.degrees();
     let q = &r.assessment.quality;
     let par = &r.parameters;
-    let report = serde_json::json!({
+    let mut report = serde_json::json!({
         "input": a.input.input.display().to_string(),
         "point_count": points.len(),
         "sides": a.sides.count(),
@@ -503,13 +503,18 @@ fn print_json(
         "fit_error": stats_json(&q.at_parameters),
         "orthogonal": stats_json(&q.orthogonal),
         "surface_to_points": samples_json(q),
-        "export_deviation": r.pde.as_ref().map(|p| p.export_deviation),
-        "export_capped": r.pde.as_ref().map(|p| p.export_capped),
         "surface": {"degree": [dp, dq], "control_points": [cu, cv]},
         "seconds": secs,
         "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
     });
-    outln!("{}", serde_json::to_string_pretty(&report)?);
+    if let Some(p) = &r.pde {
+        report["export_deviation"] = p.export_deviation.into();
+        report["export_capped"] = p.export_capped.into();
+    }
+    out!(
+        "{}",
+        scanfit_io::json::finite_json(&report, "the JSON report")?
+    );
     Ok(())
 }
 

@@ -37,6 +37,8 @@ mod outputs;
 mod progress;
 mod reconstruct;
 mod report;
+mod report_model;
+mod segment;
 mod surface;
 mod table;
 mod turntable;

@@ -165,7 +165,7 @@ impl SurfaceOutputArgs {
     ) -> Result<(Files, f64)> {
         let mut files: Files = Vec::new();
         if let Some(o) = &self.output {
-            files.push((o.clone(), doc.to_json().into_bytes()));
+            files.push((o.clone(), doc.to_json()?.into_bytes()));
         }
         files.extend(
             crate::cad::cad_files(&self.step, &self.iges, CadItem::Surface(surface), input)?

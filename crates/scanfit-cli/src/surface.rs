@@ -241,7 +241,10 @@ pub fn run(a: FitArgs) -> Result<()> {
             "samples_to_points": samples_json(q),
             "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
         });
-        outln!("{}", serde_json::to_string_pretty(&report)?);
+        out!(
+            "{}",
+            scanfit_io::json::finite_json(&report, "the JSON report")?
+        );
         return Ok(());
     }
     print_report(&a, &r)?;

@@ -293,7 +293,7 @@ fn print_json(
     let t = &r.turntable;
     let (ax, c) = (t.frame.axis, t.frame.centre);
     let quality = quality_doc(&r.assessment.quality, Vec::new());
-    let report = serde_json::json!({
+    let mut report = serde_json::json!({
         "input": a.input.input.display().to_string(),
         "point_count": cloud.len(),
         "axis": [ax.x, ax.y, ax.z],
@@ -315,11 +315,19 @@ fn print_json(
         "quality": quality,
         "fold_overs_inside_layers": t.quality_inside.fold_overs,
         "fold_overs_corrected": t.quality_fitted.fold_overs,
-        "weight_comparison": r.weight_comparison.as_ref().map(|c| c.iter().map(|w| serde_json::json!({"weight": w.weight.name(), "rmse": w.rmse})).collect::<Vec<_>>()),
         "seconds": seconds,
         "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
     });
-    outln!("{}", serde_json::to_string_pretty(&report)?);
+    if let Some(c) = &r.weight_comparison {
+        report["weight_comparison"] = c
+            .iter()
+            .map(|w| serde_json::json!({"weight": w.weight.name(), "rmse": w.rmse}))
+            .collect();
+    }
+    out!(
+        "{}",
+        scanfit_io::json::finite_json(&report, "the JSON report")?
+    );
     Ok(())
 }
 

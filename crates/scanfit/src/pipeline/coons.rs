@@ -23,6 +23,7 @@ use crate::base::{
     CoonsParameters, CoonsProjection,
 };
 use crate::bspline::Surface;
+use crate::centring::Centring;
 use crate::fit::surface::{fit_surface, SurfaceFitConfig};
 use crate::metrics::{parametric_distances, ErrorStats};
 use crate::pde::{fit_pde, BsplineConversionConfig, PdeConfig, PdeFit};
@@ -299,6 +300,18 @@ pub const STAGES: [&str; 5] = [
 /// # Ok::<(), scanfit::Error>(())
 /// ```
 pub fn run(
+    cloud: &PointCloud,
+    config: &CoonsConfig,
+    progress: &dyn Progress,
+) -> Result<CoonsReport> {
+    // computed relative to the data's centre, moved back exactly (issue 14)
+    let centring = Centring::of(cloud.points());
+    let local = centring.cloud(cloud)?;
+    Ok(centring.restore(run_centred(&local, config, progress)?))
+}
+
+/// [`run`] on data whose centre is at the origin.
+fn run_centred(
     cloud: &PointCloud,
     config: &CoonsConfig,
     progress: &dyn Progress,

@@ -17,6 +17,7 @@
 
 use crate::base::plane_parameters;
 use crate::bspline::Surface;
+use crate::centring::Centring;
 use crate::fit::correction::{correct_parameters, CorrectionConfig, CorrectionRound};
 use crate::fit::surface::{fit_surface, SurfaceFitConfig};
 use crate::pipeline::assess::{assess_surface, AssessConfig, Assessment};
@@ -166,6 +167,18 @@ pub struct FitReport {
 /// # Ok::<(), scanfit::Error>(())
 /// ```
 pub fn run(cloud: &PointCloud, config: &FitConfig, progress: &dyn Progress) -> Result<FitReport> {
+    // computed relative to the data's centre, moved back exactly (issue 14)
+    let centring = Centring::of(cloud.points());
+    let local = centring.cloud(cloud)?;
+    Ok(centring.restore(run_centred(&local, config, progress)?))
+}
+
+/// [`run`] on data whose centre is at the origin.
+fn run_centred(
+    cloud: &PointCloud,
+    config: &FitConfig,
+    progress: &dyn Progress,
+) -> Result<FitReport> {
     let pts = cloud.points();
     progress.stage("parameterizing", None);
     let mut uv: Vec<[f64; 2]> = match &config.params {
