@@ -186,6 +186,10 @@ pub struct CoonsArgs {
     /// (NU x NV)²].
     #[arg(long, value_name = "L", allow_negative_numbers = true)]
     pub smooth: Option<f64>,
+    /// Fit on the detected corners even when they are not clearly corners
+    /// (turning by less than 30 degrees, or one side over 60% of the loop).
+    #[arg(long)]
+    pub force_corners: bool,
     /// Largest deviation of the exported B-spline from the PDE surface, data
     /// units [default: 1e-4 x the bounding-box diagonal].
     #[arg(long, value_name = "T")]
@@ -258,6 +262,7 @@ fn config(a: &CoonsArgs) -> Result<CoonsConfig> {
     if a.epsilon.is_some() {
         cfg.relative_epsilon = None;
     }
+    cfg.base.force_corners = a.force_corners;
     cfg.base.boundary.alpha = a.alpha;
     cfg.base.boundary.alpha_factor = a.alpha_factor;
     cfg.base.corners.criterion = CornerCriterion::from(a.criterion);
@@ -295,7 +300,16 @@ pub fn run(a: CoonsArgs) -> Result<()> {
     let cloud = a.input.load(a.json)?;
     let r = coons(&cloud, &cfg, &progress)
         .map_err(|e| {
-            let note = option_note(&e, &[("export_tolerance", "--export-tolerance")]);
+            let note = option_note(
+                &e,
+                &[
+                    ("export_tolerance", "--export-tolerance"),
+                    (
+                        "corners",
+                        "--corners I,J,K,L with loop positions from `scanfit cloud boundary`, or --force-corners",
+                    ),
+                ],
+            );
             anyhow::anyhow!("{e}{note}")
         })
         .with_context(|| format!("Coons patch of {input} ({} sides)", a.sides.count()))?;
@@ -469,6 +483,7 @@ fn print_json(
                 "index": outer[k],
                 "point": [p.x, p.y, p.z],
                 "angle_degrees": ang.to_degrees(),
+                "turning_degrees": 180.0 - ang.to_degrees(),
             })
         }).collect::<Vec<_>>(),
         "curves": r.base.curves.iter().zip(&r.base.side_points).map(|(c, s)| serde_json::json!({
@@ -494,6 +509,7 @@ fn print_json(
     });
     if let Some(p) = &r.pde {
         report["export_deviation"] = p.export_deviation.into();
+        report["export_capped"] = p.export_capped.into();
     }
     out!(
         "{}",
@@ -518,7 +534,7 @@ fn steps_table(a: &CoonsArgs, points: usize, r: &CoonsReport, secs: f64) -> Tabl
         ),
     ]);
     t.row(vec![
-        "corners (loop position: angle)".into(),
+        "corners (loop position: angle, turn)".into(),
         join(
             r.base
                 .corners
@@ -526,7 +542,13 @@ fn steps_table(a: &CoonsArgs, points: usize, r: &CoonsReport, secs: f64) -> Tabl
                 .iter()
                 .zip(&r.base.corner_angles)
                 .enumerate()
-                .map(|(k, (q, ang))| format!("C{k} {q}: {:.0} deg", ang.to_degrees()))
+                .map(|(k, (q, ang))| {
+                    format!(
+                        "C{k} {q}: {:.0} deg, turns {:.0} deg",
+                        ang.to_degrees(),
+                        180.0 - ang.to_degrees()
+                    )
+                })
                 .collect(),
             ", ",
         ),
@@ -558,9 +580,14 @@ fn steps_table(a: &CoonsArgs, points: usize, r: &CoonsReport, secs: f64) -> Tabl
     ]);
     let export = r.pde.as_ref().map(|p| {
         format!(
-            " (B-spline form within {} of S; tolerance {})",
+            " (B-spline form within {} of S; tolerance {}{})",
             num(p.export_deviation),
-            num(p.export_tolerance)
+            num(p.export_tolerance),
+            if p.export_capped {
+                ", not reached: capped at the number of input points"
+            } else {
+                ""
+            }
         )
     });
     t.row(vec![
