@@ -99,6 +99,8 @@ pub struct MbaArgs {
     pub adjust_steps: usize,
     #[command(flatten)]
     pub out: SurfaceOutputArgs,
+    #[command(flatten)]
+    pub trim: crate::cad::TrimArgs,
     /// Print the report as JSON on stdout instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -209,6 +211,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
         .map_err(|e| anyhow::anyhow!("{}: {e}{}", input.display(), option_note(&e, &options)))?;
     progress.stage("writing");
     let pts = cloud.points();
+    let trimmed = a.trim.apply(true, &r.surface, pts, &r.uv, None)?;
     let q = &r.assessment.quality;
     let operation = if a.adjust {
         "mba (multilevel B-spline approximation + projection adjustment)"
@@ -229,8 +232,9 @@ pub fn run(a: MbaArgs) -> Result<()> {
         stats: q.at_parameters,
         name: "vertical distance |z - f(x, y)|",
     };
-    let (files, exaggeration) = a.out.files(
+    let (files, exaggeration) = a.out.files_with(
         &r.surface,
+        trimmed.as_ref(),
         &doc,
         pts,
         &deviation,
@@ -248,6 +252,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
             "levels": rows(&r),
             "quality": doc.quality,
             "samples_to_points": samples_json(q),
+            "trim": crate::cad::trim_json(trimmed.as_ref()),
             "seconds": r.seconds,
             "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
         });
@@ -255,6 +260,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
         return Ok(());
     }
     print_report(&a, &r)?;
+    crate::cad::print_trim(trimmed.as_ref())?;
     print_written(&files, a.out.png.as_deref(), exaggeration)?;
     Ok(())
 }
