@@ -93,7 +93,8 @@ impl TrimArgs {
             None => trim_to_points(surface, points, uv, &cfg),
         }
         .map_err(|e| anyhow::anyhow!("trimming the surface: {e} (or give --no-trim)"))?;
-        Ok(Some(t))
+        // a boundary that is the rectangle's own, without holes, trims nothing
+        Ok((t.outer.is_some() || !t.holes.is_empty()).then_some(t))
     }
 }
 
