@@ -4,6 +4,7 @@
 //! The pipeline is [`scanfit::pipeline::coons`]; this file parses, reads,
 //! calls, prints and writes.
 
+use scanfit::trim::TrimmedSurface;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -196,6 +197,8 @@ pub struct CoonsArgs {
     pub export_tolerance: Option<f64>,
     #[command(flatten)]
     pub out: SurfaceOutputArgs,
+    #[command(flatten)]
+    pub trim: crate::cad::TrimArgs,
     /// Write the points with u, v, coons (|P - S_c|), residual (|P - S|),
     /// distance (orthogonal) and outside (1 = outside the patch).
     #[arg(long, value_name = "POINTS")]
@@ -319,13 +322,19 @@ pub fn run(a: CoonsArgs) -> Result<()> {
         "check the corners (--corners), use fewer control points (--ctrl) or fewer PDE terms (--pde)",
     )?;
     progress.stage("writing");
-    let (files, exaggeration) = outputs(&a, cloud.points(), &r)?;
+    let pts = cloud.points();
+    let boundary = Some(&r.base.boundary);
+    let trimmed = a
+        .trim
+        .apply(true, &r.surface, pts, &r.parameters.uv, boundary)?;
+    let (files, exaggeration) = outputs(&a, pts, &r, trimmed.as_ref())?;
     write_all_atomic(&files)?;
     progress.finish();
     if a.json {
-        return print_json(&a, cloud.points(), &r, secs, &files);
+        return print_json(&a, pts, &r, secs, &files, trimmed.as_ref());
     }
-    print_tables(&a, cloud.points(), &r, secs)?;
+    print_tables(&a, pts, &r, secs)?;
+    crate::cad::print_trim(trimmed.as_ref())?;
     print_written(&files, a.out.png.as_deref(), exaggeration)?;
     Ok(())
 }
@@ -413,10 +422,16 @@ fn picture(points: &[Point3], r: &CoonsReport) -> Picture {
 }
 
 /// Every requested output file, and the exaggeration of `--png`.
-fn outputs(a: &CoonsArgs, points: &[Point3], r: &CoonsReport) -> Result<(Files, f64)> {
+fn outputs(
+    a: &CoonsArgs,
+    points: &[Point3],
+    r: &CoonsReport,
+    trimmed: Option<&TrimmedSurface>,
+) -> Result<(Files, f64)> {
     let dist = r.assessment.distances();
-    let (mut files, exaggeration) = a.out.files(
+    let (mut files, exaggeration) = a.out.files_with(
         &r.surface,
+        trimmed,
         &document(a, points.len(), r),
         points,
         &Deviation {
@@ -462,6 +477,7 @@ fn print_json(
     r: &CoonsReport,
     secs: f64,
     files: &Files,
+    trimmed: Option<&TrimmedSurface>,
 ) -> Result<()> {
     let outer = r.base.boundary.outer_loop();
     let (cu, cv) = r.surface.counts();
@@ -499,6 +515,7 @@ fn print_json(
             "mean_iterations": par.mean_iterations,
         },
         "route": r.route,
+        "trim": crate::cad::trim_json(trimmed),
         "coons_error": stats_json(&r.coons_errors),
         "fit_error": stats_json(&q.at_parameters),
         "orthogonal": stats_json(&q.orthogonal),

@@ -104,6 +104,8 @@ pub struct MbaArgs {
     /// inputs are read in chunks, others whole).
     #[arg(long, value_name = "N")]
     pub chunk_points: Option<usize>,
+    #[command(flatten)]
+    pub trim: crate::cad::TrimArgs,
     /// Print the report as JSON on stdout instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -229,6 +231,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
     )?;
     progress.stage("writing");
     let pts = cloud.points();
+    let trimmed = a.trim.apply(true, &r.surface, pts, &r.uv, None)?;
     let operation = if a.adjust {
         "mba (multilevel B-spline approximation + projection adjustment)"
     } else {
@@ -248,8 +251,9 @@ pub fn run(a: MbaArgs) -> Result<()> {
         stats: q.at_parameters,
         name: "vertical distance |z - f(x, y)|",
     };
-    let (files, exaggeration) = a.out.files(
+    let (files, exaggeration) = a.out.files_with(
         &r.surface,
+        trimmed.as_ref(),
         &doc,
         pts,
         &deviation,
@@ -267,6 +271,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
             "levels": rows(&r),
             "quality": doc.quality,
             "samples_to_points": samples_json(q),
+            "trim": crate::cad::trim_json(trimmed.as_ref()),
             "seconds": r.seconds,
             "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
         });
@@ -277,6 +282,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
         return Ok(());
     }
     print_report(&a, &r)?;
+    crate::cad::print_trim(trimmed.as_ref())?;
     print_written(&files, a.out.png.as_deref(), exaggeration)?;
     Ok(())
 }

@@ -16,12 +16,12 @@ use scanfit::pipeline::reconstruct::{self, ReconstructConfig, ReconstructReport}
 use scanfit::topology::PatchComplex;
 use scanfit::{Point3, PointCloud};
 use scanfit_io::gltf::mesh_glb;
-use scanfit_io::iges::iges_model_file;
+use scanfit_io::iges::iges_model_file_with;
 use scanfit_io::json::Provenance;
 use scanfit_io::model::{self, ModelDoc, ModelReport, ModelTotals};
 use scanfit_io::ply::{mesh_obj, mesh_ply, PlyFormat};
 use scanfit_io::render::{render_surface_scene_png, Colouring, Marker, Polyline};
-use scanfit_io::step_shell::step_shell_file;
+use scanfit_io::step_shell::step_shell_file_with;
 use scanfit_io::write_all_atomic;
 
 use crate::args::{choice, Ids, InputArgs, IDS, NXM};
@@ -121,6 +121,8 @@ pub struct ReconstructArgs {
     /// Write the model as IGES 5.3 (entity 128 per patch, 126 per edge).
     #[arg(long, value_name = "OUT.igs")]
     pub iges: Option<PathBuf>,
+    #[command(flatten)]
+    pub units: crate::cad::UnitsArgs,
     /// Write a triangle mesh (.glb, .ply or .obj), one colour per patch.
     #[arg(long, value_name = "OUT")]
     pub mesh: Option<PathBuf>,
@@ -489,10 +491,18 @@ fn model_files(
         files.push((o.clone(), model_doc(a, r, model).to_json()?.into_bytes()));
     }
     if let Some(p) = &a.step {
-        files.push((p.clone(), step_shell_file(model, name)?.text.into_bytes()));
+        files.push((
+            p.clone(),
+            step_shell_file_with(model, name, &a.units.options())?
+                .text
+                .into_bytes(),
+        ));
     }
     if let Some(p) = &a.iges {
-        files.push((p.clone(), iges_model_file(model, name)?.into_bytes()));
+        files.push((
+            p.clone(),
+            iges_model_file_with(model, name, &a.units.options())?.into_bytes(),
+        ));
     }
     Ok(files)
 }

@@ -88,6 +88,8 @@ pub struct FitArgs {
     pub correct: usize,
     #[command(flatten)]
     pub out: crate::outputs::SurfaceOutputArgs,
+    #[command(flatten)]
+    pub trim: crate::cad::TrimArgs,
     /// Write the points with u, v, residual and orthogonal distance (.ply or .xyz).
     #[arg(long, value_name = "POINTS")]
     pub points_out: Option<PathBuf>,
@@ -204,6 +206,8 @@ pub fn run(a: FitArgs) -> Result<()> {
     )?;
     progress.stage("writing");
     let pts = cloud.points();
+    let plane = matches!(a.params, ParamsArg::Plane) && !a.periodic_u;
+    let trimmed = a.trim.apply(plane, &r.surface, pts, &r.uv, None)?;
     let q = &r.assessment.quality;
     let quality = quality_doc(q, r.rounds.iter().map(|r| r.errors.rmse).collect());
     let mut doc = SurfaceDoc::new(&r.surface);
@@ -221,8 +225,9 @@ pub fn run(a: FitArgs) -> Result<()> {
         stats: q.orthogonal,
         name: "orthogonal distance",
     };
-    let (mut files, exaggeration) = a.out.files(
+    let (mut files, exaggeration) = a.out.files_with(
         &r.surface,
+        trimmed.as_ref(),
         &doc,
         pts,
         &deviation,
@@ -251,6 +256,7 @@ pub fn run(a: FitArgs) -> Result<()> {
             "parameters": name(&a.params),
             "quality": quality,
             "samples_to_points": samples_json(q),
+            "trim": crate::cad::trim_json(trimmed.as_ref()),
             "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
         });
         out!(
@@ -260,6 +266,7 @@ pub fn run(a: FitArgs) -> Result<()> {
         return Ok(());
     }
     print_report(&a, &r)?;
+    crate::cad::print_trim(trimmed.as_ref())?;
     print_written(&files, a.out.png.as_deref(), exaggeration)?;
     Ok(())
 }

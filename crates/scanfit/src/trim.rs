@@ -200,6 +200,50 @@ pub fn trim_surface(
     })
 }
 
+/// [`trim_surface`] by the boundary loops of `points` (their alpha shape,
+/// [`crate::cloud::boundary::boundary_loops`] with its defaults), mapped by
+/// the points' parameters `uv`.
+///
+/// ```
+/// use scanfit::bspline::{KnotVector, Surface};
+/// use scanfit::trim::{trim_to_points, TrimConfig};
+/// use scanfit::Point3;
+/// // a flat unit square and a disc of points on it
+/// let k = KnotVector::uniform_clamped(1, 2).unwrap();
+/// let p = |x: f64, y: f64| Point3::new(x, y, 0.0);
+/// let s = Surface::new(k.clone(), k, vec![p(0., 0.), p(0., 1.), p(1., 0.), p(1., 1.)]).unwrap();
+/// let mut pts = Vec::new();
+/// let mut uv = Vec::new();
+/// for i in 0..=50 {
+///     for j in 0..=50 {
+///         let (x, y) = (i as f64 / 50.0, j as f64 / 50.0);
+///         if (x - 0.5).hypot(y - 0.5) <= 0.5 {
+///             pts.push(p(x, y));
+///             uv.push([x, y]);
+///         }
+///     }
+/// }
+/// let t = trim_to_points(&s, &pts, &uv, &TrimConfig::default()).unwrap();
+/// assert!(t.outer.is_some() && t.holes.is_empty());
+/// assert!(t.contains(0.5, 0.5) && !t.contains(0.03, 0.03));
+/// ```
+pub fn trim_to_points(
+    surface: &Surface,
+    points: &[Point3],
+    uv: &[[f64; 2]],
+    cfg: &TrimConfig,
+) -> Result<TrimmedSurface> {
+    if uv.len() != points.len() {
+        return Err(Error::InvalidInput(format!(
+            "{} parameter pairs for {} points",
+            uv.len(),
+            points.len()
+        )));
+    }
+    let boundary = crate::cloud::boundary::boundary_loops(points, &Default::default())?;
+    trim_surface(surface, uv, &boundary, cfg)
+}
+
 fn check_in_domain(
     p: [f64; 2],
     ((u0, u1), (v0, v1)): ((f64, f64), (f64, f64)),
