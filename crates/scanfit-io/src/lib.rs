@@ -10,6 +10,7 @@
 
 mod atomic;
 mod binary;
+pub mod chunks;
 pub mod cloud;
 mod error;
 pub mod fuzz;
@@ -29,6 +30,7 @@ pub mod step_shell;
 mod stl;
 pub mod svg;
 pub mod table;
+pub mod units;
 pub mod xyz;
 
 pub use atomic::{check_paths, recover, write_all_atomic, write_atomic};
