@@ -133,6 +133,8 @@ fn corners(s: &str, what: &str) -> std::result::Result<CornersArg, String> {
 pub struct CoonsArgs {
     #[command(flatten)]
     pub input: InputArgs,
+    #[command(flatten)]
+    pub outliers: crate::args::OutlierArgs,
     /// Corners: `auto` (detected) or loop positions I,J,K[,L] of the outer boundary loop.
     #[arg(long, default_value = "auto", value_name = "auto|I,J,K,L", value_parser = CORNERS)]
     pub corners: CornersArg,
@@ -300,7 +302,7 @@ pub fn run(a: CoonsArgs) -> Result<()> {
     let progress = Progress::spinner(a.quiet || a.json);
     let input = a.input.input.display().to_string();
     progress.stage(format!("reading {input}"));
-    let cloud = a.input.load(a.json)?;
+    let cloud = a.outliers.apply(a.input.load(a.json)?, a.json)?;
     let r = coons(&cloud, &cfg, &progress)
         .map_err(|e| {
             let note = option_note(

@@ -27,6 +27,7 @@ macro_rules! out {
 
 mod args;
 mod cad;
+mod clean;
 mod cloud;
 mod coons;
 mod curve;

@@ -67,6 +67,8 @@ impl From<WeightArg> for WeightFactor {
 pub struct MbaArgs {
     #[command(flatten)]
     pub input: InputArgs,
+    #[command(flatten)]
+    pub outliers: crate::args::OutlierArgs,
     /// Cells of the first lattice, "MxN" (control net (M+3) x (N+3))
     /// [default: 1 along the shorter side, the aspect ratio along the longer].
     #[arg(long, value_name = "MxN", value_parser = NXM)]
@@ -214,7 +216,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
     }
     let progress = Progress::spinner(a.quiet || a.json);
     progress.stage(format!("reading {}", a.input.input.display()));
-    let cloud = a.input.load(a.json)?;
+    let cloud = a.outliers.apply(a.input.load(a.json)?, a.json)?;
     let input = &a.input.input;
     let options = [
         ("base", "--base"),

@@ -62,6 +62,8 @@ fn name<T: ValueEnum>(v: &T) -> String {
 pub struct FitArgs {
     #[command(flatten)]
     pub input: InputArgs,
+    #[command(flatten)]
+    pub outliers: crate::args::OutlierArgs,
     /// Where the parameters come from.
     #[arg(long, default_value = "plane", value_name = "SOURCE", value_parser = choice::<ParamsArg>())]
     pub params: ParamsArg,
@@ -197,7 +199,7 @@ pub fn run(a: FitArgs) -> Result<()> {
     }
     let progress = Progress::spinner(a.quiet);
     progress.stage(format!("reading {}", a.input.input.display()));
-    let table = a.input.table(a.json)?;
+    let table = a.outliers.apply_table(a.input.table(a.json)?, a.json)?;
     let cloud = cloud_of(&a, &table)?;
     let r = fit(&cloud, &a.config(), &progress).map_err(|e| locate(e, &table))?;
     a.out.guard(

@@ -212,8 +212,9 @@ impl TextParser {
                     return Err(perr(
                         line_no,
                         format!(
-                            "value {} is empty (two delimiters in a row, or one at the start or end of the line); write a number there (or 'nan', and read with ReadOptions {{ non_finite: NonFinite::Drop, .. }} to leave such points out)",
-                            k + 1
+                            "value {} is empty (two delimiters in a row, or one at the start or end of the line); write a number there (or 'nan', and {})",
+                            k + 1,
+                            crate::table::DROP_ADVICE
                         ),
                     ));
                 }
@@ -309,9 +310,10 @@ impl TextParser {
                 return Err(perr(
                     line_no,
                     format!(
-                        "value {} is {}; every coordinate must be a finite number (fix the line, or read with ReadOptions {{ non_finite: NonFinite::Drop, .. }} to leave such points out)",
+                        "value {} is {}; every coordinate must be a finite number (fix the line, or {})",
                         k + 1,
-                        values.get(k).copied().unwrap_or(f64::NAN)
+                        values.get(k).copied().unwrap_or(f64::NAN),
+                        crate::table::DROP_ADVICE
                     ),
                 ));
             }
