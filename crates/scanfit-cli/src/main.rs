@@ -31,6 +31,7 @@ mod cloud;
 mod coons;
 mod curve;
 mod export;
+mod extent;
 mod mba;
 mod outputs;
 mod progress;

@@ -141,9 +141,10 @@ pub fn run(a: ReconstructArgs) -> Result<()> {
     let files = outputs(&a, &r, &cloud)?;
     write_all_atomic(&files)?;
     if a.json {
-        outln!(
+        let report = json_report(&r, &a, seconds, dropped);
+        out!(
             "{}",
-            serde_json::to_string_pretty(&json_report(&r, &a, seconds, dropped))?
+            scanfit_io::json::finite_json(&report, "the JSON report")?
         );
     } else {
         out!("{}", tables(&r, seconds));
@@ -300,11 +301,7 @@ fn pictures(
     let mut opts = a.view.options(cloud.points())?;
     opts.iso_lines = 0;
     if let Some(p) = &a.png {
-        // neighbouring ids far apart on the colour map (golden-ratio steps)
-        let values: Vec<f64> = patch
-            .iter()
-            .map(|&k| (k as f64 * 0.618_033_988_75).fract())
-            .collect();
+        let colours: Vec<[u8; 3]> = patch.iter().map(|&k| patch_colour(k)).collect();
         opts.legend = vec![format!(
             "{} patches, {} edges, {} corners",
             r.faces.len(),
@@ -314,10 +311,7 @@ fn pictures(
         let png = render_surface_scene_png(
             mesh,
             None,
-            Colouring::Scalar {
-                values: &values,
-                range: (0.0, 1.0),
-            },
+            Colouring::Rgb(&colours),
             &lines,
             &markers,
             &opts,
@@ -465,7 +459,7 @@ fn model_files(
 ) -> Result<Files> {
     let mut files: Files = Vec::new();
     if let Some(o) = &a.output {
-        files.push((o.clone(), model_doc(a, r, model).to_json().into_bytes()));
+        files.push((o.clone(), model_doc(a, r, model).to_json()?.into_bytes()));
     }
     if let Some(p) = &a.step {
         files.push((p.clone(), step_shell_file(model, name)?.text.into_bytes()));

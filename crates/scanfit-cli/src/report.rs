@@ -251,7 +251,7 @@ pub fn run(a: ReportArgs) -> Result<()> {
             "samples_to_points": crate::outputs::samples_json(q),
             "report": out.display().to_string(),
         });
-        outln!("{}", serde_json::to_string_pretty(&v)?);
+        out!("{}", scanfit_io::json::finite_json(&v, "the JSON report")?);
         return Ok(());
     }
     let (p, qd) = surface.degrees();

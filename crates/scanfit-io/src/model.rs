@@ -234,7 +234,7 @@ impl ModelDoc {
     /// let s = Surface::new(k.clone(), k, vec![c[0], c[3], c[1], c[2]]).unwrap();
     /// let model = PatchComplex::assemble(c.to_vec(),
     ///     vec![FaceCorners { id: 5, surface: s, corners: [0, 1, 2, 3] }]).unwrap();
-    /// let text = ModelDoc::new(&model).to_json();
+    /// let text = ModelDoc::new(&model).to_json().unwrap();
     /// let (doc, back) = parse_model(std::path::Path::new("m.json"), &text).unwrap();
     /// assert_eq!(back, model);
     /// assert_eq!(doc.edges[0].patches, vec![5]);
@@ -288,10 +288,10 @@ impl ModelDoc {
         }
     }
 
-    /// Pretty JSON text.
-    pub fn to_json(&self) -> String {
-        // serialising plain data with string keys cannot fail
-        serde_json::to_string_pretty(self).unwrap_or_default() + "\n"
+    /// Pretty JSON text; an error if a number is not finite
+    /// ([`finite_json`](crate::json::finite_json)).
+    pub fn to_json(&self) -> crate::Result<String> {
+        crate::json::finite_json(self, "the model document")
     }
 
     /// The model this document describes, checked (see the module doc);
@@ -588,7 +588,7 @@ mod tests {
                 ..Default::default()
             },
         });
-        let text = doc.to_json();
+        let text = doc.to_json().unwrap();
         assert!(text.contains("\"pde\": ["), "{text}");
         let (back, m2) = parse_model(Path::new("m.json"), &text).unwrap();
         assert_eq!(back, doc);
@@ -604,7 +604,7 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let m = two_patches();
         let path = dir.join("m.json");
-        std::fs::write(&path, ModelDoc::new(&m).to_json()).unwrap();
+        std::fs::write(&path, ModelDoc::new(&m).to_json().unwrap()).unwrap();
         let (_, back) = read_model(&path).unwrap();
         assert_eq!(back, m);
         // a sparse file just over the limit: refused by its size, not read
@@ -629,7 +629,8 @@ mod tests {
     #[test]
     fn hostile_documents_are_refused_with_a_reason() {
         let m = two_patches();
-        let good: serde_json::Value = serde_json::from_str(&ModelDoc::new(&m).to_json()).unwrap();
+        let good: serde_json::Value =
+            serde_json::from_str(&ModelDoc::new(&m).to_json().unwrap()).unwrap();
         let with = |f: &dyn Fn(&mut serde_json::Value)| {
             let mut v = good.clone();
             f(&mut v);

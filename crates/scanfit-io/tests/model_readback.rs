@@ -247,7 +247,7 @@ fn occ_available() -> bool {
 fn check(m: &PatchComplex, name: &str) -> Option<serde_json::Value> {
     let dir = std::env::temp_dir().join(format!("scanfit-model-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let json = ModelDoc::new(m).to_json();
+    let json = ModelDoc::new(m).to_json().unwrap();
     let (_, back) = parse_model(Path::new("m.json"), &json).unwrap();
     assert_eq!(&back, m);
     let step = step_shell_file(m, name).unwrap();

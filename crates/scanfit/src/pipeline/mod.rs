@@ -38,6 +38,8 @@
 //!   (the assessment of their projections, percentiles, histogram).
 //! * [`reconstruct`]: a segmented cloud to a whole object, patches that
 //!   share their edge curves (`scanfit reconstruct`, PDE paper section 4).
+//! * [`regularize`]: the safe defaults of the least-squares fits (net from
+//!   the point density, thin-plate weight scaled to the data).
 //! * [`surface_fit`]: least-squares surface through scattered points
 //!   (`scanfit fit`): parameters from the best-fit plane or given
 //!   attributes, optional Hoschek parameter correction.
@@ -50,9 +52,11 @@ pub mod curve;
 pub mod mba;
 pub mod measure;
 pub mod reconstruct;
+pub mod regularize;
 pub mod surface_fit;
 pub mod turntable;
 
 pub use assess::{
-    assess_projected, assess_surface, AssessConfig, Assessment, SampleDistances, SurfaceQuality,
+    assess_projected, assess_surface, AssessConfig, Assessment, Extent, SampleDistances,
+    SurfaceQuality,
 };

@@ -11,6 +11,7 @@
 //! curves) and the angle between the two patches' normals (the G1 defect;
 //! the PDE paper makes no attempt at tangent continuity, nor does this).
 
+use crate::centring::Centring;
 use rayon::prelude::*;
 
 use crate::bspline::{BasisWorkspace, Curve, Surface};
@@ -180,6 +181,18 @@ pub fn edge_uv(sides: &[Vec<NetUse>], curves: &[Curve], edge: usize, t: f64) -> 
 /// # Ok::<(), scanfit::Error>(())
 /// ```
 pub fn run(
+    cloud: &PointCloud,
+    cfg: &ReconstructConfig,
+    progress: &dyn Progress,
+) -> Result<ReconstructReport> {
+    // computed relative to the data's centre, moved back exactly (issue 14)
+    let centring = Centring::of(cloud.points());
+    let local = centring.cloud(cloud)?;
+    Ok(centring.restore(run_centred(&local, cfg, progress)?))
+}
+
+/// [`run`] on data whose centre is at the origin.
+fn run_centred(
     cloud: &PointCloud,
     cfg: &ReconstructConfig,
     progress: &dyn Progress,
