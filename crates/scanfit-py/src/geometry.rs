@@ -320,7 +320,11 @@ impl PySurface {
     /// given.
     #[pyo3(signature = (path = None))]
     fn to_json(&self, py: Python<'_>, path: Option<PathBuf>) -> PyResult<Option<String>> {
-        text_out(py, SurfaceDoc::new(&self.inner).to_json(), path)
+        text_out(
+            py,
+            SurfaceDoc::new(&self.inner).to_json().map_err(io_err)?,
+            path,
+        )
     }
 
     /// A surface from ``scanfit/1`` JSON text (as ``to_json`` or the command
@@ -446,7 +450,12 @@ impl PySurface {
     /// Pickling: the JSON document, which round-trips exactly.
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
         let from = slf.get_type().getattr("from_json")?;
-        Ok((from, (SurfaceDoc::new(&slf.get().inner).to_json(),)))
+        Ok((
+            from,
+            (SurfaceDoc::new(&slf.get().inner)
+                .to_json()
+                .map_err(io_err)?,),
+        ))
     }
 }
 
@@ -637,7 +646,11 @@ impl PyCurve {
     /// ``path``.
     #[pyo3(signature = (path = None))]
     fn to_json(&self, py: Python<'_>, path: Option<PathBuf>) -> PyResult<Option<String>> {
-        text_out(py, CurveDoc::new(&self.inner).to_json(), path)
+        text_out(
+            py,
+            CurveDoc::new(&self.inner).to_json().map_err(io_err)?,
+            path,
+        )
     }
 
     /// A curve from ``scanfit/1`` JSON text.
@@ -689,6 +702,9 @@ impl PyCurve {
     /// Pickling: the JSON document.
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
         let from = slf.get_type().getattr("from_json")?;
-        Ok((from, (CurveDoc::new(&slf.get().inner).to_json(),)))
+        Ok((
+            from,
+            (CurveDoc::new(&slf.get().inner).to_json().map_err(io_err)?,),
+        ))
     }
 }

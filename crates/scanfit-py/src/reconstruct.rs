@@ -61,7 +61,11 @@ impl PyModel {
     /// written to ``path``.
     #[pyo3(signature = (path = None))]
     fn to_json(&self, py: Python<'_>, path: Option<PathBuf>) -> PyResult<Option<String>> {
-        text_out(py, ModelDoc::new(&self.inner).to_json(), path)
+        text_out(
+            py,
+            ModelDoc::new(&self.inner).to_json().map_err(io_err)?,
+            path,
+        )
     }
 
     /// One sewn STEP shell (a closed solid when every edge has two

@@ -62,19 +62,44 @@ pub fn quality<'py>(
     t.set_item("point_spacing", s.spacing)?;
     t.set_item("far_spacings", s.far_spacings)?;
     t.set_item("far_share", s.far_share)?;
+    let e = &q.extent;
+    t.set_item("outside_box", e.samples_outside)?;
+    t.set_item("outside_box_spacings", e.samples_outside_spacings)?;
+    t.set_item("control_net_outside_box", e.control_outside)?;
+    t.set_item("leaves_data", e.leaves)?;
     d.set_item("samples_to_points", t)?;
     Ok(d)
 }
 
+/// Warns (`UserWarning`) when the surface leaves the data: its samples
+/// reach farther outside the points' bounding box than the library's limit
+/// ([`scanfit::pipeline::Extent`]; the command line refuses to write such
+/// a surface unless `--allow-extrapolation`).
+fn warn_extent(py: Python<'_>, q: &SurfaceQuality) -> PyResult<()> {
+    let e = &q.extent;
+    if !e.leaves {
+        return Ok(());
+    }
+    let msg = format!(
+        "the surface leaves the data: samples reach {:.6e} ({:.0} point spacings) outside the points' bounding box and control points {:.6e} (limit {:.6e}); quality['samples_to_points'] has the numbers",
+        e.samples_outside, e.samples_outside_spacings, e.control_outside, e.limit
+    );
+    let cat = py.get_type::<pyo3::exceptions::PyUserWarning>();
+    let text = std::ffi::CString::new(msg).unwrap_or_default();
+    PyErr::warn(py, &cat, &text, 1)
+}
+
 /// Puts an assessment into `d`: `quality` (see [`quality`]), `residuals`
 /// (`|P_i - S(u_i, v_i)|` per point), `distances` (orthogonal, per point)
-/// and `converged` (per point, of the point inversion).
+/// and `converged` (per point, of the point inversion); warns when the
+/// surface leaves the data.
 pub fn assessment(
     d: &Bound<'_, PyDict>,
     a: &Assessment,
     correction_rmse: Vec<f64>,
 ) -> PyResult<()> {
     let py = d.py();
+    warn_extent(py, &a.quality)?;
     d.set_item("quality", quality(py, &a.quality, correction_rmse)?)?;
     d.set_item("residuals", vec1(py, a.residuals.clone()))?;
     d.set_item("distances", vec1(py, a.distances()))?;

@@ -7,7 +7,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use scanfit::base::turntable::{AxisChoice, Ends};
 use scanfit::base::{BoundaryFit, CoonsProjection};
-use scanfit::fit::surface::KnotPlacement;
+use scanfit::fit::surface::{KnotPlacement, SurfaceFitConfig};
 use scanfit::mba::adjust::AdjustConfig;
 use scanfit::mba::ControlFormula;
 use scanfit::pde::PdeConfig;
@@ -46,7 +46,9 @@ fn put_uv(d: &Bound<'_, PyDict>, uv: &[[f64; 2]]) -> PyResult<()> {
 ///
 /// Parameters:
 ///     points: an ``(N, 3)`` array or a ``Cloud``.
-///     ctrl: control net ``(nu, nv)`` or one int for both (default 16 x 16).
+///     ctrl: control net ``(nu, nv)`` or one int for both (default: from
+///         the point density, ``round(sqrt(points / 16))`` per direction, 5
+///         to 32).
 ///     degree: degrees ``(p, q)`` or one int (default bicubic).
 ///     params: where the points' ``(u, v)`` come from: ``"plane"`` (the
 ///         best-fit plane, scaled to the unit square; for height-field-like
@@ -55,16 +57,21 @@ fn put_uv(d: &Bound<'_, PyDict>, uv: &[[f64; 2]]) -> PyResult<()> {
 ///     knots: ``"distribution"`` (interior knots follow the parameters,
 ///         NURBS Book eq. 9.69) or ``"uniform"``.
 ///     smooth: thin-plate smoothing weight on ``∫∫ S_uu² + 2 S_uv² + S_vv²``
-///         (0 = none).
+///         (0 = the bare least-squares fit; default: scaled to the data,
+///         ``0.001 x points / (nu x nv)²``, which keeps sparsely covered
+///         spans from flying off; the weight used is ``result["smoothing"]``).
 ///     periodic_u: close the surface in ``u`` (needs given parameters).
 ///     correct: rounds of Hoschek's parameter correction (re-project, refit).
 ///
-/// Returns a dict: ``surface`` (``Surface``), ``u``, ``v`` (the points'
-/// parameters), ``quality`` (the surface document's quality: ``mean_error``,
+/// Returns a dict: ``surface`` (``Surface``), ``smoothing`` (the weight
+/// used), ``u``, ``v`` (the points' parameters), ``quality`` (the surface document's quality: ``mean_error``,
 /// ``max_error``, ``rmse`` at the parameters (PDE paper eq. 15),
 /// ``*_distance`` orthogonal, ``grid_rmse`` (MBA paper eq. 17), fold-overs,
 /// ``samples_to_points``), ``residuals`` and ``distances`` per point,
-/// ``converged`` per point, ``rounds`` (the correction rounds).
+/// ``converged`` per point, ``rounds`` (the correction rounds). A surface
+/// whose samples leave the points' bounding box by more than the library's
+/// limit (``quality["samples_to_points"]["leaves_data"]``) raises a
+/// ``UserWarning`` (the command line refuses to write it).
 ///
 /// Example::
 ///
@@ -73,7 +80,7 @@ fn put_uv(d: &Bound<'_, PyDict>, uv: &[[f64; 2]]) -> PyResult<()> {
 ///     >>> r["quality"]["rmse_distance"]  # doctest: +SKIP
 ///     29.6
 #[pyfunction]
-#[pyo3(signature = (points, ctrl = None, degree = None, params = "plane", uv = None, knots = "distribution", smooth = 0.0, periodic_u = false, correct = 0))]
+#[pyo3(signature = (points, ctrl = None, degree = None, params = "plane", uv = None, knots = "distribution", smooth = None, periodic_u = false, correct = 0))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit_surface<'py>(
     py: Python<'py>,
@@ -83,7 +90,7 @@ pub fn fit_surface<'py>(
     params: &str,
     uv: Option<Bound<'py, PyAny>>,
     knots: &str,
-    smooth: f64,
+    smooth: Option<f64>,
     periodic_u: bool,
     correct: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -91,6 +98,11 @@ pub fn fit_surface<'py>(
     let mut cfg = FitConfig::default();
     if let Some(c) = ctrl {
         cfg.fit.ctrl = pair(&c, "ctrl")?;
+        cfg.ctrl_from_density = false;
+    }
+    if let Some(l) = smooth {
+        cfg.fit.smoothing = l;
+        cfg.relative_smoothing = None;
     }
     if let Some(g) = degree {
         cfg.fit.degree = pair(&g, "degree")?;
@@ -112,13 +124,13 @@ pub fn fit_surface<'py>(
         "uniform" => KnotPlacement::Uniform,
         o => return Err(bad_choice("knots", o, &["distribution", "uniform"])),
     };
-    cfg.fit.smoothing = smooth;
     cfg.fit.periodic_u = periodic_u;
     cfg.correction_rounds = correct;
     let c = cloud.get();
     let r = py.detach(|| run_fit(c, &cfg, &NoProgress)).map_err(err)?;
     let d = PyDict::new(py);
     d.set_item("surface", PySurface::new(r.surface.clone()))?;
+    d.set_item("smoothing", r.smoothing)?;
     put_uv(&d, &r.uv)?;
     assessment(
         &d,
@@ -240,7 +252,8 @@ pub fn mba<'py>(
 /// the PDE paper (``pde=(m, n)``; ``scanfit coons``): boundary loop (alpha
 /// shape), corners, one B-spline per side, the bilinearly blended Coons
 /// patch, the points' parameters on it, then a least-squares B-spline
-/// surface (``ctrl``, ``degree``) or the thin-plate PDE deformation with
+/// surface (``ctrl``, default from the point density; ``degree``; ``smooth``,
+/// default scaled to the data, as ``fit_surface``) or the thin-plate PDE deformation with
 /// ``m x n`` sine terms (PDE paper eqs. 11-14), exported as a B-spline
 /// within ``export_tolerance`` (default 1e-4 x the bounding-box diagonal).
 ///
@@ -252,8 +265,9 @@ pub fn mba<'py>(
 ///     alpha, alpha_factor: the alpha shape (as ``boundary``).
 ///     curves: ``"lsq"`` (end-pinned least squares, ``curve_ctrl`` control
 ///         points, default automatic) or ``"interpolate"``.
-///     params: ``"grid"`` (the Coons paper's grid iteration with ``h`` and
-///         ``epsilon``; default on the B-spline route) or ``"closest"``
+///     params: ``"grid"`` (the Coons paper's grid iteration with step ``h``
+///         and threshold ``epsilon`` in data units, default 1e-3 x the
+///         bounding-box diagonal; default on the B-spline route) or ``"closest"``
 ///         (exact closest point; default on the PDE route).
 ///     rigidity: the PDE's ``D`` (default 1).
 ///
@@ -270,7 +284,7 @@ pub fn mba<'py>(
 ///     >>> r["quality"]["rmse"]  # doctest: +SKIP
 ///     0.0699
 #[pyfunction]
-#[pyo3(signature = (points, pde = None, ctrl = None, degree = None, rigidity = 1.0, export_tolerance = None, params = None, h = 0.001, epsilon = 0.01, corners = None, sides = 4, criterion = "angle", alpha = None, alpha_factor = 2.5, curves = "lsq", curve_ctrl = None))]
+#[pyo3(signature = (points, pde = None, ctrl = None, degree = None, smooth = None, rigidity = 1.0, export_tolerance = None, params = None, h = 0.001, epsilon = None, corners = None, sides = 4, criterion = "angle", alpha = None, alpha_factor = 2.5, curves = "lsq", curve_ctrl = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn coons<'py>(
     py: Python<'py>,
@@ -278,11 +292,12 @@ pub fn coons<'py>(
     pde: Option<Bound<'py, PyAny>>,
     ctrl: Option<Bound<'py, PyAny>>,
     degree: Option<Bound<'py, PyAny>>,
+    smooth: Option<f64>,
     rigidity: f64,
     export_tolerance: Option<f64>,
     params: Option<&str>,
     h: f64,
-    epsilon: f64,
+    epsilon: Option<f64>,
     corners: Option<Vec<usize>>,
     sides: usize,
     criterion: &str,
@@ -295,9 +310,9 @@ pub fn coons<'py>(
     let mut cfg = CoonsConfig::default();
     cfg.route = match pde {
         Some(t) => {
-            if ctrl.is_some() || degree.is_some() {
+            if ctrl.is_some() || degree.is_some() || smooth.is_some() {
                 return Err(value_err(
-                    "pde and ctrl/degree exclude each other: the PDE route has sine terms, the B-spline route a control net; choose one".into(),
+                    "pde and ctrl/degree/smooth exclude each other: the PDE route has sine terms, the B-spline route a control net; choose one".into(),
                 ));
             }
             let (m, n) = pair(&t, "pde")?;
@@ -306,33 +321,43 @@ pub fn coons<'py>(
                 export_tolerance,
             }
         }
-        None => CoonsRoute::bspline(
-            degree
-                .map(|g| pair(&g, "degree"))
-                .transpose()?
-                .unwrap_or((3, 3)),
-            ctrl.map(|c| pair(&c, "ctrl"))
-                .transpose()?
-                .unwrap_or((20, 20)),
-        ),
+        None => {
+            let mut f = SurfaceFitConfig {
+                degree: degree
+                    .map(|g| pair(&g, "degree"))
+                    .transpose()?
+                    .unwrap_or((3, 3)),
+                ..Default::default()
+            };
+            if let Some(c) = ctrl {
+                f.ctrl = pair(&c, "ctrl")?;
+                cfg.ctrl_from_density = false;
+            }
+            if let Some(l) = smooth {
+                f.smoothing = l;
+                cfg.relative_smoothing = None;
+            }
+            CoonsRoute::Bspline(f)
+        }
     };
+    // the grid iteration's epsilon: given in data units, else relative to the diagonal
+    let grid = GridIterationConfig {
+        h,
+        epsilon: epsilon.unwrap_or(GridIterationConfig::default().epsilon),
+        ..Default::default()
+    };
+    if epsilon.is_some() {
+        cfg.relative_epsilon = None;
+    }
     cfg.projection = match params {
+        None if matches!(cfg.route, CoonsRoute::Bspline(_)) => {
+            Some(CoonsProjection::GridIteration(grid))
+        }
         None => None,
-        Some("grid") => Some(CoonsProjection::GridIteration(GridIterationConfig {
-            h,
-            epsilon,
-            ..Default::default()
-        })),
+        Some("grid") => Some(CoonsProjection::GridIteration(grid)),
         Some("closest") => Some(CoonsProjection::Inversion(InversionConfig::default())),
         Some(o) => return Err(bad_choice("params", o, &["grid", "closest"])),
     };
-    if cfg.projection.is_none() && matches!(cfg.route, CoonsRoute::Bspline(_)) {
-        cfg.projection = Some(CoonsProjection::GridIteration(GridIterationConfig {
-            h,
-            epsilon,
-            ..Default::default()
-        }));
-    }
     if !(sides == 3 || sides == 4) {
         return Err(value_err(format!(
             "sides = {sides}: a Coons patch has 4 or 3 sides"
@@ -413,7 +438,9 @@ pub fn coons<'py>(
 ///         direction ``(x, y, z)``.
 ///     grid: grid points per view and layer (default 32).
 ///     rounds: most projection rounds of the layer curves (default 10).
-///     margin: fraction of the height left out at each end (default 0.03).
+///     margin: fraction of the height left out at each closed end (default
+///         0.03; an end the data show to be open, a rim with no points near
+///         the axis, gets none: ``open_ends`` says which).
 ///     ends: ``"exclude"`` (points beyond the end layers are left out of
 ///         the fit) or ``"extend"``.
 ///     compare_weights: also run the paper's Tables 1-2 comparison of the
@@ -505,6 +532,7 @@ pub fn turntable<'py>(
     d.set_item("refine_rmse", t.refine_rmse.clone())?;
     d.set_item("base_distance", stats(py, &t.base_errors)?)?;
     d.set_item("beyond_end_layers", t.on_v_boundary)?;
+    d.set_item("open_ends", (t.end_shapes[0].open, t.end_shapes[1].open))?;
     d.set_item("distance_all_points", stats(py, &t.errors_all)?)?;
     d.set_item("surface_to_cloud", stats(py, &t.surface_to_cloud)?)?;
     d.set_item("parametric", stats(py, &r.parametric)?)?;

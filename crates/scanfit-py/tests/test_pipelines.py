@@ -100,15 +100,18 @@ def test_fit_surface_with_given_periodic_parameters():
     u, v = np.meshgrid(np.linspace(0, 1, 60, endpoint=False), np.linspace(0, 1, 20))
     u, v = u.ravel(), v.ravel()
     pts = np.column_stack([2 * np.cos(2 * np.pi * u), 2 * np.sin(2 * np.pi * u), 5 * v])
-    r = scanfit.fit_surface(pts, uv=np.column_stack([u, v]), periodic_u=True, ctrl=(16, 4))
+    r = scanfit.fit_surface(pts, uv=np.column_stack([u, v]), periodic_u=True, ctrl=(16, 4), smooth=0)
     s = r["surface"]
     assert s.periodic == (True, False)
-    assert r["quality"]["max_error"] < 2e-3
+    assert r["quality"]["max_error"] < 2e-3 and r["smoothing"] == 0
+    # by default the thin-plate weight is scaled to the data: 0.001 x points / (nu x nv)^2
+    dflt = scanfit.fit_surface(pts, uv=np.column_stack([u, v]), periodic_u=True, ctrl=(16, 4))
+    assert dflt["smoothing"] == pytest.approx(0.001 * 1200 / (16 * 4) ** 2, rel=1e-12)
     assert np.allclose(r["u"], u) and np.allclose(r["v"], v)
     # the seam closes: S(0, v) = S(1, v)
     assert np.abs(s.evaluate(0.0, 0.5) - s.evaluate(1.0, 0.5)).max() < 1e-12
     c = scanfit.Cloud(pts, {"u": u, "v": v})
-    r2 = scanfit.fit_surface(c, params="uv", periodic_u=True, ctrl=(16, 4))
+    r2 = scanfit.fit_surface(c, params="uv", periodic_u=True, ctrl=(16, 4), smooth=0)
     assert r2["surface"] == s
     corrected = scanfit.fit_surface(scanfit.Cloud(pts), ctrl=(6, 6), correct=3)
     assert corrected["rounds"][0]["round"] == 0

@@ -131,9 +131,15 @@ fn turntable_is_scale_free() {
     let b = turntable::run(&big, &cfg, &NoProgress).unwrap();
     let (ta, tb) = (&a.turntable, &b.turntable);
     // the bottom (low end along the axis, or high if the axis points down) is closed, the rim open
-    let open = |t: &scanfit::base::turntable::Turntable| [t.end_shapes[0].open, t.end_shapes[1].open];
+    let open =
+        |t: &scanfit::base::turntable::Turntable| [t.end_shapes[0].open, t.end_shapes[1].open];
     assert_eq!(open(ta), open(tb));
-    assert_eq!(open(ta).iter().filter(|&&o| o).count(), 1, "{:?}", ta.end_shapes);
+    assert_eq!(
+        open(ta).iter().filter(|&&o| o).count(),
+        1,
+        "{:?}",
+        ta.end_shapes
+    );
     let m = mismatch(&ta.surface, &tb.surface, big.diagonal());
     assert!(m < 1e-7, "{m}");
 }

@@ -26,8 +26,8 @@ pub use axis::{principal_axis, AxisChoice, CylinderFrame};
 pub use base_surface::{aligned_samples, initial_base_surface, refine_round, RefineConfig};
 pub use ends::{end_shapes, EndShape};
 pub use layers::{
-    closed_curve, compare_weights, layer_heights, layer_heights_between, layer_loops, project_layers, uniform_samples,
-    LayerConfig, LayerCurves, Rounds,
+    closed_curve, compare_weights, layer_heights, layer_heights_between, layer_loops,
+    project_layers, uniform_samples, LayerConfig, LayerCurves, Rounds,
 };
 pub use views::{layer_polygon, turntable_views, View, ViewConfig};
 
