@@ -208,6 +208,54 @@ pub fn closest_point_near(
     best
 }
 
+/// Closest points on `curve` to each of `points`: Newton by
+/// [`closest_point_near`] started at the nearest of `samples_per_span`
+/// uniform samples per knot span (at least 1), in parallel. Returns
+/// `(u, distance)` per point, in order.
+///
+/// ```
+/// use scanfit::bspline::{Curve, KnotVector};
+/// use scanfit::quality::closest_points;
+/// use scanfit::Point3;
+///
+/// // the straight line from (0, 0, 0) to (3, 0, 0), degree 1
+/// let kv = KnotVector::new(vec![0.0, 0.0, 1.0, 1.0], 1)?;
+/// let c = Curve::new(kv, vec![Point3::origin(), Point3::new(3.0, 0.0, 0.0)])?;
+/// let r = closest_points(&c, &[Point3::new(1.5, 2.0, 0.0)], 4);
+/// assert!((r[0].0 - 0.5).abs() < 1e-12 && (r[0].1 - 2.0).abs() < 1e-12);
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+pub fn closest_points(
+    curve: &Curve,
+    points: &[Point3],
+    samples_per_span: usize,
+) -> Vec<(f64, f64)> {
+    use rayon::prelude::*;
+    let n = samples_per_span.max(1);
+    let bps = curve.knots().breakpoints();
+    let mut us = Vec::with_capacity(bps.len() * n + 1);
+    for w in bps.windows(2) {
+        us.extend((0..n).map(|k| w[0] + (w[1] - w[0]) * k as f64 / n as f64));
+    }
+    us.extend(bps.last());
+    let mut samples = vec![Point3::origin(); us.len()];
+    curve.eval_many(&us, &mut samples);
+    points
+        .par_iter()
+        .map_init(
+            || BasisWorkspace::new(curve.degree(), 2),
+            |ws, q| {
+                let start = samples
+                    .iter()
+                    .zip(&us)
+                    .map(|(s, &u)| ((s - q).norm_squared(), u))
+                    .fold((f64::INFINITY, us[0]), |a, b| if b.0 < a.0 { b } else { a });
+                closest_point_near(curve, q, start.1, ws)
+            },
+        )
+        .collect()
+}
+
 /// Unit normal of the least-squares plane through `pts` (eigenvector of the
 /// smallest eigenvalue of their covariance); `z` for degenerate input.
 pub(crate) fn plane_normal(pts: &[Point3]) -> Vector3 {
