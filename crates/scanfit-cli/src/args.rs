@@ -242,6 +242,33 @@ fn vector(s: &str, what: &str) -> std::result::Result<Vector3, String> {
     }
 }
 
+/// `"xmin,ymin,zmin,xmax,ymax,zmax"`: an axis-aligned box (`--box`).
+pub const BOX: Parsed<[f64; 6]> = Parsed(crop_box);
+
+fn crop_box(s: &str, what: &str) -> std::result::Result<[f64; 6], String> {
+    match numbers(s).as_deref() {
+        Some(&[a, b, c, d, e, f]) if a <= d && b <= e && c <= f => Ok([a, b, c, d, e, f]),
+        Some(&[_, _, _, _, _, _]) => Err(format!(
+            "{what} '{s}': each minimum must be at most its maximum (xmin,ymin,zmin,xmax,ymax,zmax)"
+        )),
+        _ => Err(format!(
+            "{what} '{s}' must be six finite numbers xmin,ymin,zmin,xmax,ymax,zmax"
+        )),
+    }
+}
+
+/// `"x,y,z,r"`: a ball (`--sphere`), the radius > 0.
+pub const SPHERE: Parsed<[f64; 4]> = Parsed(sphere);
+
+fn sphere(s: &str, what: &str) -> std::result::Result<[f64; 4], String> {
+    match numbers(s).as_deref() {
+        Some(&[x, y, z, r]) if r > 0.0 => Ok([x, y, z, r]),
+        _ => Err(format!(
+            "{what} '{s}' must be four finite numbers x,y,z,r with the radius r > 0"
+        )),
+    }
+}
+
 /// A list of vectors, `"x,y,z;x,y,z;..."`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Vectors(pub Vec<Vector3>);
@@ -282,6 +309,10 @@ pub enum FormatArg {
     /// Text: XYZ, CSV, TXT, PTS, ASC.
     #[value(alias = "xyz", alias = "csv", alias = "txt")]
     Text,
+    /// STL mesh (binary or ascii): its vertices, normals from the triangles.
+    Stl,
+    /// OBJ mesh: its vertices, normals from `vn` or the faces.
+    Obj,
 }
 
 impl From<FormatArg> for Format {
@@ -291,6 +322,8 @@ impl From<FormatArg> for Format {
             FormatArg::Pcd => Format::Pcd,
             FormatArg::Las => Format::Las,
             FormatArg::Text => Format::Text,
+            FormatArg::Stl => Format::Stl,
+            FormatArg::Obj => Format::Obj,
         }
     }
 }
@@ -299,7 +332,8 @@ impl From<FormatArg> for Format {
 /// `--format`, `--drop-non-finite`).
 #[derive(Args, Debug, Clone)]
 pub struct InputArgs {
-    /// Input point file (.ply, .pcd, .las/.laz, .xyz/.csv/.txt/.pts/.asc).
+    /// Input point file (.ply, .pcd, .las/.laz, .xyz/.csv/.txt/.pts/.asc),
+    /// or a mesh read as its vertices (.stl, .obj, .ply with faces).
     pub input: PathBuf,
     /// Read as this format whatever the extension.
     #[arg(long, value_name = "FORMAT", value_parser = choice::<FormatArg>())]
@@ -330,17 +364,28 @@ impl InputArgs {
     /// Reads the file with this group's options; the reader's warnings (a
     /// header count that disagrees with the data, ...) go to stderr.
     fn read(&self) -> Result<PointTable> {
-        let options = ReadOptions {
+        let table = read_cloud(&self.input, &self.options()).map_err(|e| {
+            e.with_advice(
+                "give --drop-non-finite to leave such points out",
+                "give --format FORMAT",
+            )
+        })?;
+        crate::print_warnings(&table.warnings);
+        Ok(table)
+    }
+}
+
+impl InputArgs {
+    /// The reader's options from `--format` and `--drop-non-finite`.
+    pub fn options(&self) -> ReadOptions {
+        ReadOptions {
             format: self.format.map(Format::from),
             non_finite: if self.drop_non_finite {
                 NonFinite::Drop
             } else {
                 NonFinite::Reject
             },
-        };
-        let table = read_cloud(&self.input, &options)?;
-        crate::print_warnings(&table.warnings);
-        Ok(table)
+        }
     }
 }
 
@@ -426,5 +471,70 @@ mod tests {
         );
         assert!(vectors("1,0,0;", "--end-tangents").is_err());
         assert_eq!(or_list(&["a".into(), "b".into(), "c".into()]), "a, b or c");
+    }
+}
+
+/// `--remove-outliers` of the surface commands: statistical outlier
+/// removal (the `cloud clean --outliers` defaults) before the fit.
+#[derive(Args, Debug, Clone, Default)]
+pub struct OutlierArgs {
+    /// Remove stray points before the fit: statistical outlier removal with
+    /// the defaults of `scanfit cloud clean --outliers` (mean distance to 50
+    /// neighbours above mean + 1 std and above twice the median); says how
+    /// many it removed.
+    #[arg(long)]
+    pub remove_outliers: bool,
+}
+
+impl OutlierArgs {
+    /// The cloud without its outliers when asked for (a note on stderr says
+    /// how many went unless `quiet`), else the cloud as it is.
+    pub fn apply(&self, cloud: PointCloud, quiet: bool) -> Result<PointCloud> {
+        Ok(match self.clean(&cloud, quiet)? {
+            Some(r) => r.cloud,
+            None => cloud,
+        })
+    }
+
+    /// The table without its outliers when asked for (its rows keep their
+    /// places in the file, for messages), else the table as it is.
+    pub fn apply_table(&self, mut table: PointTable, quiet: bool) -> Result<PointTable> {
+        if !self.remove_outliers {
+            return Ok(table);
+        }
+        let cloud = PointCloud::new(table.points.clone())?;
+        if let Some(r) = self.clean(&cloud, quiet)? {
+            let mut keep = vec![false; cloud.len()];
+            for i in r.kept {
+                keep[i] = true;
+            }
+            table.retain(&keep);
+        }
+        Ok(table)
+    }
+
+    /// The outlier removal when asked for, its note on stderr.
+    fn clean(
+        &self,
+        cloud: &PointCloud,
+        quiet: bool,
+    ) -> Result<Option<scanfit::pipeline::cloud::CloudClean>> {
+        if !self.remove_outliers {
+            return Ok(None);
+        }
+        let r = scanfit::pipeline::cloud::clean(
+            cloud,
+            &scanfit::pipeline::cloud::CloudCleanConfig::remove_outliers(),
+            &scanfit::progress::NoProgress,
+        )?;
+        if !quiet {
+            crate::print_stderr(format_args!(
+                "note: --remove-outliers removed {} of {} points ({})",
+                cloud.len() - r.cloud.len(),
+                cloud.len(),
+                r.steps.first().map_or("", |s| s.detail.as_str())
+            ));
+        }
+        Ok(Some(r))
     }
 }

@@ -41,6 +41,10 @@ pub enum CloudCommand {
     Hpr(HprArgs),
     /// Boundary loop of a sheet-like patch (alpha shape), its corners and sides.
     Boundary(BoundaryArgs),
+    /// Remove stray points and fragments, crop, thin; report what each step removed.
+    Clean(crate::clean::CleanArgs),
+    /// Regions between sharp edges (normal variation, octree cells) as a `label` property.
+    Segment(crate::segment::SegmentArgs),
 }
 
 /// `--criterion`: the corner measure (`cloud boundary`, `coons`).
@@ -271,6 +275,8 @@ pub fn run(c: CloudCommand) -> Result<()> {
         CloudCommand::Normals(a) => normals(a),
         CloudCommand::Hpr(a) => hpr(a),
         CloudCommand::Boundary(a) => boundary(a),
+        CloudCommand::Clean(a) => crate::clean::run(a),
+        CloudCommand::Segment(a) => crate::segment::run(a),
     }
 }
 
@@ -301,7 +307,7 @@ fn info(a: InfoArgs) -> Result<()> {
     .with_context(|| a.input.input.display().to_string())?;
     if a.json {
         let (lo, hi) = (r.bbox_min, r.bbox_max);
-        let report = serde_json::json!({
+        let mut report = serde_json::json!({
             "file": a.input.input.display().to_string(),
             "points": r.points,
             "dropped_non_finite": dropped,
@@ -309,9 +315,11 @@ fn info(a: InfoArgs) -> Result<()> {
             "bbox_max": [hi.x, hi.y, hi.z],
             "diagonal": r.diagonal,
             "attributes": r.attributes.iter().map(|at| serde_json::json!({"name": at.name, "min": at.min, "max": at.max})).collect::<Vec<_>>(),
-            "spacing": r.spacing.map(|s| serde_json::json!({"min": s.min, "median": s.median, "mean": s.mean, "max": s.max, "duplicates": s.duplicates})),
             "read_seconds": read_s,
         });
+        if let Some(s) = r.spacing {
+            report["spacing"] = serde_json::json!({"min": s.min, "median": s.median, "mean": s.mean, "max": s.max, "duplicates": s.duplicates, "measured_points": s.measured, "sampled": s.measured < r.points});
+        }
         out!(
             "{}",
             scanfit_io::json::finite_json(&report, "the JSON report")?
@@ -361,6 +369,13 @@ fn print_info(input: &Path, r: &CloudInfo, read_s: f64) -> Result<()> {
             t.row(vec![n.to_string(), num(v)]);
         }
         out!("{}", t.render());
+        if s.measured < r.points {
+            outln!(
+                "(nearest-neighbour distances of a seeded random sample of {} of the {} points)",
+                s.measured,
+                r.points
+            );
+        }
         if s.duplicates > 0 {
             outln!("{} points coincide with another point", s.duplicates);
         }
@@ -417,6 +432,7 @@ fn normals(a: NormalsArgs) -> Result<()> {
     let r = estimate(&cloud, &cfg, &progress)
         .with_context(|| format!("normals of {}", a.input.input.display()))?;
     let secs = t0.elapsed().as_secs_f64();
+    warn_disagreement(r.normals.disagreement);
     let mut files: Files = Vec::new();
     if let Some(o) = &a.output {
         files.push((o.clone(), cloud_file(o, &r.cloud)?));
@@ -448,6 +464,20 @@ fn normals(a: NormalsArgs) -> Result<()> {
     print_normals(&a, cloud.len(), &r, secs, &files)
 }
 
+/// Share of disagreeing neighbour pairs above which `cloud normals` warns.
+const DISAGREEMENT_WARNING: f64 = 0.01;
+
+/// Warns on stderr when more than 1% of the same-sheet neighbour pairs
+/// disagree after orientation (a region flipped).
+fn warn_disagreement(d: Option<f64>) {
+    if let Some(d) = d.filter(|&d| d > DISAGREEMENT_WARNING) {
+        crate::print_stderr(format_args!(
+            "warning: {:.1}% of neighbouring normals disagree after orientation (a region is flipped); try --orient view:X,Y,Z from outside the object, a smaller --k, or another --hint",
+            100.0 * d
+        ));
+    }
+}
+
 /// The report of `cloud normals`: JSON or a table, then the files written.
 fn print_normals(
     a: &NormalsArgs,
@@ -466,6 +496,7 @@ fn print_normals(
             "components": n.components,
             "degenerate": n.degenerate.len(),
             "mean_variation": r.mean_variation,
+            "disagreeing_neighbours": n.disagreement,
             "seconds": secs,
         });
         out!(
@@ -484,6 +515,9 @@ fn print_normals(
         n.degenerate.len().to_string(),
     ]);
     t.row(vec!["mean surface variation".into(), num(r.mean_variation)]);
+    if let Some(d) = n.disagreement {
+        t.row(vec!["disagreeing neighbours (%)".into(), num(100.0 * d)]);
+    }
     t.row(vec!["time (s)".into(), format!("{secs:.3}")]);
     out!("{}", t.render());
     print_files(files)?;

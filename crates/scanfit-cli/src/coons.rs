@@ -4,6 +4,7 @@
 //! The pipeline is [`scanfit::pipeline::coons`]; this file parses, reads,
 //! calls, prints and writes.
 
+use scanfit::trim::TrimmedSurface;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -132,6 +133,8 @@ fn corners(s: &str, what: &str) -> std::result::Result<CornersArg, String> {
 pub struct CoonsArgs {
     #[command(flatten)]
     pub input: InputArgs,
+    #[command(flatten)]
+    pub outliers: crate::args::OutlierArgs,
     /// Corners: `auto` (detected) or loop positions I,J,K[,L] of the outer boundary loop.
     #[arg(long, default_value = "auto", value_name = "auto|I,J,K,L", value_parser = CORNERS)]
     pub corners: CornersArg,
@@ -186,12 +189,18 @@ pub struct CoonsArgs {
     /// (NU x NV)²].
     #[arg(long, value_name = "L", allow_negative_numbers = true)]
     pub smooth: Option<f64>,
+    /// Fit on the detected corners even when they are not clearly corners
+    /// (turning by less than 30 degrees, or one side over 60% of the loop).
+    #[arg(long)]
+    pub force_corners: bool,
     /// Largest deviation of the exported B-spline from the PDE surface, data
     /// units [default: 1e-4 x the bounding-box diagonal].
     #[arg(long, value_name = "T")]
     pub export_tolerance: Option<f64>,
     #[command(flatten)]
     pub out: SurfaceOutputArgs,
+    #[command(flatten)]
+    pub trim: crate::cad::TrimArgs,
     /// Write the points with u, v, coons (|P - S_c|), residual (|P - S|),
     /// distance (orthogonal) and outside (1 = outside the patch).
     #[arg(long, value_name = "POINTS")]
@@ -258,6 +267,7 @@ fn config(a: &CoonsArgs) -> Result<CoonsConfig> {
     if a.epsilon.is_some() {
         cfg.relative_epsilon = None;
     }
+    cfg.base.force_corners = a.force_corners;
     cfg.base.boundary.alpha = a.alpha;
     cfg.base.boundary.alpha_factor = a.alpha_factor;
     cfg.base.corners.criterion = CornerCriterion::from(a.criterion);
@@ -292,10 +302,19 @@ pub fn run(a: CoonsArgs) -> Result<()> {
     let progress = Progress::spinner(a.quiet || a.json);
     let input = a.input.input.display().to_string();
     progress.stage(format!("reading {input}"));
-    let cloud = a.input.load(a.json)?;
+    let cloud = a.outliers.apply(a.input.load(a.json)?, a.json)?;
     let r = coons(&cloud, &cfg, &progress)
         .map_err(|e| {
-            let note = option_note(&e, &[("export_tolerance", "--export-tolerance")]);
+            let note = option_note(
+                &e,
+                &[
+                    ("export_tolerance", "--export-tolerance"),
+                    (
+                        "corners",
+                        "--corners I,J,K,L with loop positions from `scanfit cloud boundary`, or --force-corners",
+                    ),
+                ],
+            );
             anyhow::anyhow!("{e}{note}")
         })
         .with_context(|| format!("Coons patch of {input} ({} sides)", a.sides.count()))?;
@@ -305,13 +324,19 @@ pub fn run(a: CoonsArgs) -> Result<()> {
         "check the corners (--corners), use fewer control points (--ctrl) or fewer PDE terms (--pde)",
     )?;
     progress.stage("writing");
-    let (files, exaggeration) = outputs(&a, cloud.points(), &r)?;
+    let pts = cloud.points();
+    let boundary = Some(&r.base.boundary);
+    let trimmed = a
+        .trim
+        .apply(true, &r.surface, pts, &r.parameters.uv, boundary)?;
+    let (files, exaggeration) = outputs(&a, pts, &r, trimmed.as_ref())?;
     write_all_atomic(&files)?;
     progress.finish();
     if a.json {
-        return print_json(&a, cloud.points(), &r, secs, &files);
+        return print_json(&a, pts, &r, secs, &files, trimmed.as_ref());
     }
-    print_tables(&a, cloud.points(), &r, secs)?;
+    print_tables(&a, pts, &r, secs)?;
+    crate::cad::print_trim(trimmed.as_ref())?;
     print_written(&files, a.out.png.as_deref(), exaggeration)?;
     Ok(())
 }
@@ -399,10 +424,16 @@ fn picture(points: &[Point3], r: &CoonsReport) -> Picture {
 }
 
 /// Every requested output file, and the exaggeration of `--png`.
-fn outputs(a: &CoonsArgs, points: &[Point3], r: &CoonsReport) -> Result<(Files, f64)> {
+fn outputs(
+    a: &CoonsArgs,
+    points: &[Point3],
+    r: &CoonsReport,
+    trimmed: Option<&TrimmedSurface>,
+) -> Result<(Files, f64)> {
     let dist = r.assessment.distances();
-    let (mut files, exaggeration) = a.out.files(
+    let (mut files, exaggeration) = a.out.files_with(
         &r.surface,
+        trimmed,
         &document(a, points.len(), r),
         points,
         &Deviation {
@@ -448,6 +479,7 @@ fn print_json(
     r: &CoonsReport,
     secs: f64,
     files: &Files,
+    trimmed: Option<&TrimmedSurface>,
 ) -> Result<()> {
     let outer = r.base.boundary.outer_loop();
     let (cu, cv) = r.surface.counts();
@@ -469,6 +501,7 @@ fn print_json(
                 "index": outer[k],
                 "point": [p.x, p.y, p.z],
                 "angle_degrees": ang.to_degrees(),
+                "turning_degrees": 180.0 - ang.to_degrees(),
             })
         }).collect::<Vec<_>>(),
         "curves": r.base.curves.iter().zip(&r.base.side_points).map(|(c, s)| serde_json::json!({
@@ -484,6 +517,7 @@ fn print_json(
             "mean_iterations": par.mean_iterations,
         },
         "route": r.route,
+        "trim": crate::cad::trim_json(trimmed),
         "coons_error": stats_json(&r.coons_errors),
         "fit_error": stats_json(&q.at_parameters),
         "orthogonal": stats_json(&q.orthogonal),
@@ -494,6 +528,7 @@ fn print_json(
     });
     if let Some(p) = &r.pde {
         report["export_deviation"] = p.export_deviation.into();
+        report["export_capped"] = p.export_capped.into();
     }
     out!(
         "{}",
@@ -518,7 +553,7 @@ fn steps_table(a: &CoonsArgs, points: usize, r: &CoonsReport, secs: f64) -> Tabl
         ),
     ]);
     t.row(vec![
-        "corners (loop position: angle)".into(),
+        "corners (loop position: angle, turn)".into(),
         join(
             r.base
                 .corners
@@ -526,7 +561,13 @@ fn steps_table(a: &CoonsArgs, points: usize, r: &CoonsReport, secs: f64) -> Tabl
                 .iter()
                 .zip(&r.base.corner_angles)
                 .enumerate()
-                .map(|(k, (q, ang))| format!("C{k} {q}: {:.0} deg", ang.to_degrees()))
+                .map(|(k, (q, ang))| {
+                    format!(
+                        "C{k} {q}: {:.0} deg, turns {:.0} deg",
+                        ang.to_degrees(),
+                        180.0 - ang.to_degrees()
+                    )
+                })
                 .collect(),
             ", ",
         ),
@@ -558,9 +599,14 @@ fn steps_table(a: &CoonsArgs, points: usize, r: &CoonsReport, secs: f64) -> Tabl
     ]);
     let export = r.pde.as_ref().map(|p| {
         format!(
-            " (B-spline form within {} of S; tolerance {})",
+            " (B-spline form within {} of S; tolerance {}{})",
             num(p.export_deviation),
-            num(p.export_tolerance)
+            num(p.export_tolerance),
+            if p.export_capped {
+                ", not reached: capped at the number of input points"
+            } else {
+                ""
+            }
         )
     });
     t.row(vec![

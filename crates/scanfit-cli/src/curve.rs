@@ -110,6 +110,8 @@ pub struct FitArgs {
     /// Write the same as an IGES 5.3 file (entity 126 or 128).
     #[arg(long, value_name = "OUT.igs")]
     pub iges: Option<PathBuf>,
+    #[command(flatten)]
+    pub units: crate::cad::UnitsArgs,
     /// Print the result as JSON on stdout instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -281,6 +283,7 @@ fn fit_cmd(a: FitArgs) -> Result<()> {
         &a.iges,
         cad,
         &a.input.input,
+        &a.units.options(),
     )?);
     write_all_atomic(&files)?;
     if a.json {

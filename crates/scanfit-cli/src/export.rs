@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use scanfit::bspline::{Curve, Surface};
-use scanfit_io::iges::iges_file;
+use scanfit_io::iges::iges_file_with;
 use scanfit_io::json::{read_curve, read_surface};
-use scanfit_io::step::{step_file, CadItem};
+use scanfit_io::step::{step_file_with, CadItem};
 use scanfit_io::write_all_atomic;
 
 use crate::outputs::check_outputs;
@@ -37,6 +37,8 @@ pub struct ExportArgs {
     /// Product name in the files [default: the first input's file stem].
     #[arg(long)]
     pub name: Option<String>,
+    #[command(flatten)]
+    pub units: crate::cad::UnitsArgs,
 }
 
 /// A curve or a surface read from a document.
@@ -94,10 +96,16 @@ pub fn run(a: ExportArgs) -> Result<()> {
     });
     let mut files: Vec<(&Path, Vec<u8>)> = Vec::new();
     if let Some(s) = &a.step {
-        files.push((s, step_file(&cad, &name)?.into_bytes()));
+        files.push((
+            s,
+            step_file_with(&cad, &name, &a.units.options())?.into_bytes(),
+        ));
     }
     if let Some(i) = &a.iges {
-        files.push((i, iges_file(&cad, &name)?.into_bytes()));
+        files.push((
+            i,
+            iges_file_with(&cad, &name, &a.units.options())?.into_bytes(),
+        ));
     }
     write_all_atomic(&files)?;
     let (nc, ns) = items.iter().fold((0, 0), |(c, s), i| match i {

@@ -27,6 +27,7 @@ macro_rules! out {
 
 mod args;
 mod cad;
+mod clean;
 mod cloud;
 mod coons;
 mod curve;
@@ -37,6 +38,9 @@ mod outputs;
 mod progress;
 mod reconstruct;
 mod report;
+mod report_model;
+mod segment;
+mod stream;
 mod surface;
 mod table;
 mod turntable;

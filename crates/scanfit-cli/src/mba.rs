@@ -67,6 +67,8 @@ impl From<WeightArg> for WeightFactor {
 pub struct MbaArgs {
     #[command(flatten)]
     pub input: InputArgs,
+    #[command(flatten)]
+    pub outliers: crate::args::OutlierArgs,
     /// Cells of the first lattice, "MxN" (control net (M+3) x (N+3))
     /// [default: 1 along the shorter side, the aspect ratio along the longer].
     #[arg(long, value_name = "MxN", value_parser = NXM)]
@@ -99,6 +101,13 @@ pub struct MbaArgs {
     pub adjust_steps: usize,
     #[command(flatten)]
     pub out: SurfaceOutputArgs,
+    /// Read the input in chunks of N points, one pass per level, so memory
+    /// depends on the lattice, not the point count (not with --adjust; text
+    /// inputs are read in chunks, others whole).
+    #[arg(long, value_name = "N")]
+    pub chunk_points: Option<usize>,
+    #[command(flatten)]
+    pub trim: crate::cad::TrimArgs,
     /// Print the report as JSON on stdout instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -109,7 +118,7 @@ pub struct MbaArgs {
 
 impl MbaArgs {
     /// The pipeline's settings.
-    fn config(&self) -> MbaRunConfig {
+    pub(crate) fn config(&self) -> MbaRunConfig {
         let mut c = MbaRunConfig::default();
         c.mba.base = self.base;
         c.mba.max_levels = self.levels;
@@ -132,12 +141,16 @@ impl MbaArgs {
     }
 
     /// The settings recorded in the surface document.
-    fn settings(&self, r: &MbaReport) -> BTreeMap<String, serde_json::Value> {
+    pub(crate) fn settings(
+        &self,
+        levels: usize,
+        cells: (usize, usize),
+    ) -> BTreeMap<String, serde_json::Value> {
         let mut s = BTreeMap::new();
-        s.insert("levels".into(), r.levels.len().into());
+        s.insert("levels".into(), levels.into());
         s.insert(
             "lattice_cells".into(),
-            serde_json::json!([r.cells.0, r.cells.1]),
+            serde_json::json!([cells.0, cells.1]),
         );
         let formula = if self.hjelle {
             "hjelle"
@@ -198,9 +211,12 @@ pub fn run(a: MbaArgs) -> Result<()> {
     if a.levels == 0 {
         anyhow::bail!("--levels must be at least 1");
     }
+    if let Some(n) = a.chunk_points {
+        return crate::stream::mba(&a, n);
+    }
     let progress = Progress::spinner(a.quiet || a.json);
     progress.stage(format!("reading {}", a.input.input.display()));
-    let cloud = a.input.load(a.json)?;
+    let cloud = a.outliers.apply(a.input.load(a.json)?, a.json)?;
     let input = &a.input.input;
     let options = [
         ("base", "--base"),
@@ -217,6 +233,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
     )?;
     progress.stage("writing");
     let pts = cloud.points();
+    let trimmed = a.trim.apply(true, &r.surface, pts, &r.uv, None)?;
     let operation = if a.adjust {
         "mba (multilevel B-spline approximation + projection adjustment)"
     } else {
@@ -228,7 +245,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
         Some("xy (u = x, v = y, scaled to [0, 1])".into()),
         input,
         pts.len(),
-        a.settings(&r),
+        a.settings(r.levels.len(), r.cells),
     ));
     doc.quality = Some(quality_doc(q, Vec::new()));
     let deviation = Deviation {
@@ -236,8 +253,9 @@ pub fn run(a: MbaArgs) -> Result<()> {
         stats: q.at_parameters,
         name: "vertical distance |z - f(x, y)|",
     };
-    let (files, exaggeration) = a.out.files(
+    let (files, exaggeration) = a.out.files_with(
         &r.surface,
+        trimmed.as_ref(),
         &doc,
         pts,
         &deviation,
@@ -255,6 +273,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
             "levels": rows(&r),
             "quality": doc.quality,
             "samples_to_points": samples_json(q),
+            "trim": crate::cad::trim_json(trimmed.as_ref()),
             "seconds": r.seconds,
             "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
         });
@@ -265,6 +284,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
         return Ok(());
     }
     print_report(&a, &r)?;
+    crate::cad::print_trim(trimmed.as_ref())?;
     print_written(&files, a.out.png.as_deref(), exaggeration)?;
     Ok(())
 }

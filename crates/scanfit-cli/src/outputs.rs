@@ -11,6 +11,7 @@ use clap::Args;
 use scanfit::bspline::{tessellate, Surface};
 use scanfit::metrics::{nearest_points, ErrorStats};
 use scanfit::pipeline::SurfaceQuality;
+use scanfit::trim::TrimmedSurface;
 use scanfit::Point3;
 use scanfit_io::gltf::mesh_glb;
 use scanfit_io::json::{Provenance, SurfaceDoc, SurfaceQualityDoc};
@@ -52,6 +53,8 @@ pub struct SurfaceOutputArgs {
     /// of its diagonal).
     #[arg(long)]
     pub allow_extrapolation: bool,
+    #[command(flatten)]
+    pub units: crate::cad::UnitsArgs,
     #[command(flatten)]
     pub view: crate::view::ViewArgs,
 }
@@ -163,12 +166,30 @@ impl SurfaceOutputArgs {
         input: &Path,
         picture: &Picture,
     ) -> Result<(Files, f64)> {
+        self.files_with(surface, None, doc, points, deviation, input, picture)
+    }
+
+    /// [`Self::files`] of a surface that may be trimmed: with `trimmed`,
+    /// the CAD files hold the trimmed face and the mesh and pictures show
+    /// only the trimmed part.
+    #[allow(clippy::too_many_arguments)]
+    pub fn files_with(
+        &self,
+        surface: &Surface,
+        trimmed: Option<&TrimmedSurface>,
+        doc: &SurfaceDoc,
+        points: &[Point3],
+        deviation: &Deviation,
+        input: &Path,
+        picture: &Picture,
+    ) -> Result<(Files, f64)> {
         let mut files: Files = Vec::new();
         if let Some(o) = &self.output {
             files.push((o.clone(), doc.to_json()?.into_bytes()));
         }
+        let item = trimmed.map_or(CadItem::Surface(surface), CadItem::Trimmed);
         files.extend(
-            crate::cad::cad_files(&self.step, &self.iges, CadItem::Surface(surface), input)?
+            crate::cad::cad_files(&self.step, &self.iges, item, input, &self.units.options())?
                 .into_iter()
                 .map(|(p, b)| (p.to_path_buf(), b)),
         );
@@ -177,7 +198,11 @@ impl SurfaceOutputArgs {
             return Ok((files, 1.0));
         }
         let (cu, cv) = surface.counts();
-        let mesh = tessellate(surface, (cu * 4).clamp(32, 400), (cv * 4).clamp(32, 400));
+        let (nu, nv) = ((cu * 4).clamp(32, 400), (cv * 4).clamp(32, 400));
+        let mesh = match trimmed {
+            Some(t) => t.tessellate(nu, nv),
+            None => tessellate(surface, nu, nv),
+        };
         // the local fit error on the surface: each mesh vertex shows the
         // deviation of its nearest input point, on the scale of the error table
         let vertex_dev = if self.deviation_png.is_some()

@@ -62,6 +62,8 @@ fn name<T: ValueEnum>(v: &T) -> String {
 pub struct FitArgs {
     #[command(flatten)]
     pub input: InputArgs,
+    #[command(flatten)]
+    pub outliers: crate::args::OutlierArgs,
     /// Where the parameters come from.
     #[arg(long, default_value = "plane", value_name = "SOURCE", value_parser = choice::<ParamsArg>())]
     pub params: ParamsArg,
@@ -88,9 +90,16 @@ pub struct FitArgs {
     pub correct: usize,
     #[command(flatten)]
     pub out: crate::outputs::SurfaceOutputArgs,
+    #[command(flatten)]
+    pub trim: crate::cad::TrimArgs,
     /// Write the points with u, v, residual and orthogonal distance (.ply or .xyz).
     #[arg(long, value_name = "POINTS")]
     pub points_out: Option<PathBuf>,
+    /// Read the input in chunks of N points, in passes, so memory depends on
+    /// the control net, not the point count (needs --params uv-columns and
+    /// --knots uniform; text inputs are read in chunks, others whole).
+    #[arg(long, value_name = "N")]
+    pub chunk_points: Option<usize>,
     /// Print the report as JSON on stdout instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -101,7 +110,7 @@ pub struct FitArgs {
 
 impl FitArgs {
     /// The pipeline's settings.
-    fn config(&self) -> FitConfig {
+    pub(crate) fn config(&self) -> FitConfig {
         let mut c = FitConfig::default();
         c.params = match self.params {
             ParamsArg::Plane => ParameterSource::Plane,
@@ -127,16 +136,20 @@ impl FitArgs {
 
     /// The settings recorded in the surface document (the net and weight
     /// the fit used).
-    fn settings(&self, r: &FitReport) -> BTreeMap<String, serde_json::Value> {
+    pub(crate) fn settings(
+        &self,
+        surface: &scanfit::bspline::Surface,
+        smoothing: f64,
+    ) -> BTreeMap<String, serde_json::Value> {
         let mut s = BTreeMap::new();
         s.insert(
             "degree".into(),
             serde_json::json!([self.degree.0, self.degree.1]),
         );
-        let (cu, cv) = r.surface.counts();
+        let (cu, cv) = surface.counts();
         s.insert("ctrl".into(), serde_json::json!([cu, cv]));
         s.insert("knots".into(), name(&self.knots).into());
-        s.insert("smoothing".into(), r.smoothing.into());
+        s.insert("smoothing".into(), smoothing.into());
         s.insert("periodic_u".into(), self.periodic_u.into());
         s.insert("correction_rounds".into(), self.correct.into());
         s
@@ -181,9 +194,12 @@ pub fn run(a: FitArgs) -> Result<()> {
         &a.input.input,
         &[(&a.points_out, "--points-out", &["ply", "xyz"][..])],
     )?;
+    if let Some(n) = a.chunk_points {
+        return crate::stream::fit(&a, n);
+    }
     let progress = Progress::spinner(a.quiet);
     progress.stage(format!("reading {}", a.input.input.display()));
-    let table = a.input.table(a.json)?;
+    let table = a.outliers.apply_table(a.input.table(a.json)?, a.json)?;
     let cloud = cloud_of(&a, &table)?;
     let r = fit(&cloud, &a.config(), &progress).map_err(|e| locate(e, &table))?;
     a.out.guard(
@@ -192,6 +208,8 @@ pub fn run(a: FitArgs) -> Result<()> {
     )?;
     progress.stage("writing");
     let pts = cloud.points();
+    let plane = matches!(a.params, ParamsArg::Plane) && !a.periodic_u;
+    let trimmed = a.trim.apply(plane, &r.surface, pts, &r.uv, None)?;
     let q = &r.assessment.quality;
     let quality = quality_doc(q, r.rounds.iter().map(|r| r.errors.rmse).collect());
     let mut doc = SurfaceDoc::new(&r.surface);
@@ -200,7 +218,7 @@ pub fn run(a: FitArgs) -> Result<()> {
         Some(name(&a.params)),
         &a.input.input,
         pts.len(),
-        a.settings(&r),
+        a.settings(&r.surface, r.smoothing),
     ));
     doc.quality = Some(quality.clone());
     let dist = r.assessment.distances();
@@ -209,8 +227,9 @@ pub fn run(a: FitArgs) -> Result<()> {
         stats: q.orthogonal,
         name: "orthogonal distance",
     };
-    let (mut files, exaggeration) = a.out.files(
+    let (mut files, exaggeration) = a.out.files_with(
         &r.surface,
+        trimmed.as_ref(),
         &doc,
         pts,
         &deviation,
@@ -239,6 +258,7 @@ pub fn run(a: FitArgs) -> Result<()> {
             "parameters": name(&a.params),
             "quality": quality,
             "samples_to_points": samples_json(q),
+            "trim": crate::cad::trim_json(trimmed.as_ref()),
             "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
         });
         out!(
@@ -248,6 +268,7 @@ pub fn run(a: FitArgs) -> Result<()> {
         return Ok(());
     }
     print_report(&a, &r)?;
+    crate::cad::print_trim(trimmed.as_ref())?;
     print_written(&files, a.out.png.as_deref(), exaggeration)?;
     Ok(())
 }

@@ -100,6 +100,8 @@ fn axis(s: &str, what: &str) -> std::result::Result<AxisChoice, String> {
 pub struct TurntableArgs {
     #[command(flatten)]
     pub input: InputArgs,
+    #[command(flatten)]
+    pub outliers: crate::args::OutlierArgs,
     /// Turntable axis: x, y (the paper's), z, a direction "X,Y,Z", or "auto"
     /// (the cloud's principal axis).
     #[arg(long, default_value = "auto", value_name = "AXIS", allow_hyphen_values = true, value_parser = AXIS)]
@@ -191,7 +193,7 @@ pub fn run(a: TurntableArgs) -> Result<()> {
     let cfg = config(&a);
     let progress = Progress::bar(a.quiet || a.json, STAGES.len() as u64 + 2);
     progress.stage(format!("reading {}", a.input.input.display()));
-    let cloud = a.input.load(a.json)?;
+    let cloud = a.outliers.apply(a.input.load(a.json)?, a.json)?;
     progress.inc();
     let t0 = Instant::now();
     let r = turntable(&cloud, &cfg, &progress)

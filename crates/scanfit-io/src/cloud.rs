@@ -8,11 +8,14 @@ use scanfit::PointCloud;
 
 use crate::ply::{points_ply, points_xyz, PlyFormat};
 use crate::table::{Format, PointTable, ReadOptions};
-use crate::{las, pcd, ply_read, write_atomic, xyz, Error, Result};
+use crate::{las, obj, pcd, ply_read, stl, write_atomic, xyz, Error, Result};
 
-/// Reads a point file: PLY, PCD, LAS/LAZ or text (XYZ, CSV, TXT, PTS, ASC),
-/// the format chosen by [`ReadOptions::format`], else by the extension, else
-/// (no extension) by the first bytes. Errors name the file and the line, byte
+/// Reads a point file: PLY, PCD, LAS/LAZ, text (XYZ, CSV, TXT, PTS, ASC) or
+/// a mesh as its vertices (STL, OBJ, PLY with faces; normals from the
+/// triangles), the format chosen by [`ReadOptions::format`], else by the
+/// extension (a text extension on a file whose first bytes say PLY, LAS,
+/// PCD or STL is read as what it is, with a warning), else (no extension)
+/// by the first bytes. Errors name the file and the line, byte
 /// offset or point where the content is wrong, and what to change.
 pub fn read_cloud(path: &Path, options: &ReadOptions) -> Result<PointTable> {
     if options.format.is_none() {
@@ -29,16 +32,36 @@ pub fn read_cloud(path: &Path, options: &ReadOptions) -> Result<PointTable> {
 /// Reads a point file's content from memory (`path` names it in messages and
 /// gives its extension when [`ReadOptions::format`] is `None`).
 pub fn parse_cloud(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<PointTable> {
+    let mut note = None;
     let format = match options.format {
         Some(f) => f,
-        None => Format::from_path(path)?.unwrap_or_else(|| Format::sniff(bytes)),
+        None => match Format::from_path(path)? {
+            Some(Format::Text) => match Format::magic(bytes) {
+                Some(f) => {
+                    note = Some(format!(
+                        "{}: the content is {} (by its first bytes), not text; read as {}",
+                        path.display(),
+                        f.name(),
+                        f.name()
+                    ));
+                    f
+                }
+                None => Format::Text,
+            },
+            Some(f) => f,
+            None => Format::sniff(bytes),
+        },
     };
-    match format {
+    let mut table = match format {
         Format::Ply => ply_read::parse(path, bytes, options),
         Format::Pcd => pcd::parse(path, bytes, options),
         Format::Las => las::parse(path, bytes, options),
         Format::Text => xyz::parse_bytes(path, bytes, options.non_finite),
-    }
+        Format::Stl => stl::parse(path, bytes, options),
+        Format::Obj => obj::parse(path, bytes, options),
+    }?;
+    table.warnings.extend(note);
+    Ok(table)
 }
 
 /// The formats [`write_cloud`] writes.
@@ -202,14 +225,16 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(
-            e.starts_with("scan.dat: '.dat' files are not supported; give a point file with one of the extensions .ply, .pcd, .las, .laz, .xyz, .csv, .txt, .pts, .asc"),
+            e.starts_with("scan.dat: '.dat' files are not supported; give a point file with one of the extensions .ply, .pcd, .las, .laz, .xyz, .csv, .txt, .pts, .asc, .stl, .obj"),
             "{e}"
         );
-        // a PLY named .xyz is read as text: the error says where
-        let e = parse_cloud(Path::new("scan.xyz"), &bytes, &opts)
-            .unwrap_err()
-            .to_string();
-        assert!(e.starts_with("scan.xyz:"), "{e}");
+        // a PLY named .xyz is recognised by its first bytes, with a warning
+        let t = parse_cloud(Path::new("scan.xyz"), &bytes, &opts).unwrap();
+        assert_eq!((t.format, t.points.len()), (Format::Ply, 3));
+        assert_eq!(
+            t.warnings,
+            ["scan.xyz: the content is PLY (by its first bytes), not text; read as PLY"]
+        );
         assert_eq!(column_name("a b,c"), "a_b_c");
         assert_eq!(column_name("1e5"), "_1e5");
         assert_eq!(column_name(""), "attribute");

@@ -62,3 +62,48 @@ pub enum Error {
 
 /// Result alias of the IO crate.
 pub type Result<T> = std::result::Result<T, Error>;
+
+impl Error {
+    /// The error with the readers' library advice ([`crate::table::DROP_ADVICE`],
+    /// [`crate::table::FORMAT_ADVICE`]) replaced by a front's own words
+    /// (the CLI's `use --drop-non-finite to leave such points out`).
+    ///
+    /// ```
+    /// use scanfit_io::{parse_cloud, ReadOptions};
+    /// let e = parse_cloud("p.xyz".as_ref(), b"1 2 nan\n", &ReadOptions::default())
+    ///     .unwrap_err()
+    ///     .with_advice("give --drop-non-finite", "give --format");
+    /// assert!(e.to_string().ends_with("(fix the line, or give --drop-non-finite)"), "{e}");
+    /// ```
+    pub fn with_advice(self, drop: &str, format: &str) -> Self {
+        let fix = |m: String| {
+            m.replace(crate::table::DROP_ADVICE, drop)
+                .replace(crate::table::FORMAT_ADVICE, format)
+        };
+        match self {
+            Error::Parse {
+                path,
+                line,
+                message,
+            } => Error::Parse {
+                path,
+                line,
+                message: fix(message),
+            },
+            Error::Binary {
+                path,
+                offset,
+                message,
+            } => Error::Binary {
+                path,
+                offset,
+                message: fix(message),
+            },
+            Error::Invalid { path, message } => Error::Invalid {
+                path,
+                message: fix(message),
+            },
+            other => other,
+        }
+    }
+}

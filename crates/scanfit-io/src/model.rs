@@ -16,6 +16,10 @@
 //!   "patches": [
 //!     {"id": 3, "sides": [{"edge": 0, "reversed": false}, {"edge": 4, "reversed": true},
 //!                         {"edge": 5, "reversed": false}, null],
+//!      "surface": {"schema": "scanfit/1", "type": "bspline_surface", ...}},
+//!     {"id": 9, "sides": [{"edge": 6, "reversed": false}, {"edge": 7, "reversed": false},
+//!                         [{"edge": 8, "reversed": true}, {"edge": 9, "reversed": true}],
+//!                         {"edge": 10, "reversed": false}],
 //!      "surface": {"schema": "scanfit/1", "type": "bspline_surface", ...}}
 //!   ],
 //!   "provenance": {"tool": "scanfit 0.1.0", "operation": "reconstruct", ...},
@@ -31,8 +35,12 @@
 //!   four parameter sides in counter-clockwise order: `S(u, v0)` for `u` up,
 //!   `S(u1, v)` for `v` up, `S(u, v1)` for `u` down, `S(u0, v)` for `v` down.
 //!   Each is the edge it lies on and whether it runs against the edge's
-//!   direction, or `null` for a side collapsed to a vertex (a three-sided
-//!   patch). See [`scanfit::topology`] for the model's rules.
+//!   direction; a list of such objects, in order along the side, when the
+//!   side runs over several edges (a patch with more than four corners: the
+//!   surface's side is the edges' curves joined); or `null` for a side
+//!   collapsed to a vertex (a three-sided patch). See [`scanfit::topology`]
+//!   for the model's rules. One-edge sides are written as the single object
+//!   (as documents did before chains), so older documents read unchanged.
 //! * `closed` is true when every edge has two patches (the patches bound a
 //!   solid).
 //! * `report` (optional) holds the pipeline's measurements: per patch
@@ -75,6 +83,44 @@ pub struct SideDoc {
     pub reversed: bool,
 }
 
+/// A patch side in the document: one edge, or a chain of edges in order
+/// along the side.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum SideChain {
+    /// A side on one edge (a JSON object).
+    One(SideDoc),
+    /// A side over several edges (a JSON list of objects).
+    Chain(Vec<SideDoc>),
+}
+
+impl SideChain {
+    /// The document form of a side's chain (`None` for a collapsed side).
+    pub fn of(chain: &[EdgeUse]) -> Option<Self> {
+        let doc = |u: &EdgeUse| SideDoc {
+            edge: u.edge,
+            reversed: u.reversed,
+        };
+        match chain {
+            [] => None,
+            [u] => Some(SideChain::One(doc(u))),
+            more => Some(SideChain::Chain(more.iter().map(doc).collect())),
+        }
+    }
+
+    /// The edges of the side, in order.
+    pub fn uses(&self) -> Vec<EdgeUse> {
+        let use_of = |d: &SideDoc| EdgeUse {
+            edge: d.edge,
+            reversed: d.reversed,
+        };
+        match self {
+            SideChain::One(d) => vec![use_of(d)],
+            SideChain::Chain(v) => v.iter().map(use_of).collect(),
+        }
+    }
+}
+
 /// An edge in the document.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct EdgeDoc {
@@ -93,8 +139,8 @@ pub struct EdgeDoc {
 pub struct PatchDoc {
     /// The patch label.
     pub id: i64,
-    /// The four sides (`null` = collapsed).
-    pub sides: [Option<SideDoc>; 4],
+    /// The four sides (`null` = collapsed; a list = a chain of edges).
+    pub sides: [Option<SideChain>; 4],
     /// The surface.
     pub surface: SurfaceDoc,
 }
@@ -274,12 +320,7 @@ impl ModelDoc {
                 .iter()
                 .map(|f| PatchDoc {
                     id: f.id,
-                    sides: f.sides.map(|s| {
-                        s.map(|u| SideDoc {
-                            edge: u.edge,
-                            reversed: u.reversed,
-                        })
-                    }),
+                    sides: [0, 1, 2, 3].map(|k| SideChain::of(&f.sides[k])),
                     surface: SurfaceDoc::new(&f.surface),
                 })
                 .collect(),
@@ -396,15 +437,19 @@ impl ModelDoc {
                 }
             }
             let surface = s.surface().map_err(|err| bad(format!("{name}: {err}")))?;
+            let mut sides: [Vec<EdgeUse>; 4] = Default::default();
+            for (k, (side, doc)) in sides.iter_mut().zip(&p.sides).enumerate() {
+                *side = doc.as_ref().map(SideChain::uses).unwrap_or_default();
+                if side.is_empty() && doc.is_some() {
+                    return Err(bad(format!(
+                        "{name}: side {k} is an empty list; write null for a side collapsed to a vertex"
+                    )));
+                }
+            }
             faces.push(Face {
                 id: p.id,
                 surface,
-                sides: p.sides.map(|s| {
-                    s.map(|u| EdgeUse {
-                        edge: u.edge,
-                        reversed: u.reversed,
-                    })
-                }),
+                sides,
             });
         }
         let model = PatchComplex {
@@ -596,6 +641,42 @@ mod tests {
         let shared = doc.edges.iter().filter(|e| e.patches.len() == 2).count();
         assert_eq!(shared, 1);
         assert!(!back.closed);
+    }
+
+    #[test]
+    fn side_chains_are_lists_and_one_edge_sides_objects() {
+        let m = two_patches();
+        let doc = ModelDoc::new(&m);
+        // one-edge sides are written as the single object (the old form)
+        assert!(doc.patches[0]
+            .sides
+            .iter()
+            .all(|s| matches!(s, Some(SideChain::One(_)))));
+        let text = doc.to_json().unwrap();
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        // the same side as a one-edge list reads to the same model
+        let side = v["patches"][0]["sides"][1].clone();
+        v["patches"][0]["sides"][1] = serde_json::json!([side]);
+        let (_, m2) = parse_model(Path::new("m.json"), &v.to_string()).unwrap();
+        assert_eq!(m2, m);
+        // a chain of several edges round-trips as a list
+        let mut chained = m.clone();
+        chained.faces[0].sides[1] = vec![m.faces[0].sides[1][0]; 2];
+        let d = ModelDoc::new(&chained);
+        assert!(matches!(&d.patches[0].sides[1], Some(SideChain::Chain(c)) if c.len() == 2));
+        let back: ModelDoc = serde_json::from_str(&d.to_json().unwrap()).unwrap();
+        assert_eq!(back.patches[0].sides, d.patches[0].sides);
+        // which the topology check then refuses (not a cycle), naming the patch
+        let e = parse_model(Path::new("m.json"), &d.to_json().unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("closed cycle"), "{e}");
+        // an empty list is not a collapsed side
+        v["patches"][0]["sides"][1] = serde_json::json!([]);
+        let e = parse_model(Path::new("m.json"), &v.to_string())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("side 1 is an empty list"), "{e}");
     }
 
     #[test]

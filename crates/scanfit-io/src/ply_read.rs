@@ -5,7 +5,9 @@
 //! property as an extra column by name (nx, red, label, u, ...); list
 //! properties of the vertex element are skipped. Elements before the vertex
 //! element are skipped (in binary files by reading their list lengths),
-//! elements after it are not read. Binary vertices without list properties
+//! elements after it are not read, except a `face` element with a
+//! `vertex_indices` list: when the vertices carry no normals, area-weighted
+//! vertex normals are taken from its triangles (`ply_faces.rs`). Binary vertices without list properties
 //! are fixed-size records, decoded column by column with a byte-offset plan
 //! (see `binary.rs`); every size is checked against the body before anything
 //! is allocated, so a header claiming 10^12 vertices is an error, not an
@@ -15,7 +17,11 @@ use std::path::Path;
 
 use scanfit::Point3;
 
+#[path = "ply_faces.rs"]
+mod faces;
+
 use crate::binary::{decode_column, decode_points, Column, Scalar};
+use crate::mesh::attach_normals;
 use crate::table::{capacity, split_lines, Format, Origin, PointTable, ReadOptions, MAX_COLUMNS};
 use crate::{Error, Result};
 
@@ -375,6 +381,23 @@ pub(crate) fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<
     };
     if header.encoding == Encoding::Ascii {
         ascii_trailing(path, bytes, &header, &mut table, after);
+    }
+    if let Some(face) = faces::face_element(&header) {
+        match faces::read(path, bytes, &header, face, table.points.len()) {
+            Ok(triangles) => attach_normals(&mut table, &triangles),
+            Err(err) => {
+                // (a truncated element after the vertices is reported once)
+                if !table
+                    .warnings
+                    .iter()
+                    .any(|w| w.contains("the 'face' element"))
+                {
+                    table.warnings.push(format!(
+                        "{err} (the 'face' element is not needed for the points, which were read; no normals were taken from it)"
+                    ));
+                }
+            }
+        }
     }
     table.finish(options.non_finite)
 }
@@ -923,7 +946,7 @@ mod tests {
         let e = read(&b).unwrap_err().to_string();
         assert_eq!(
             e,
-            format!("t.ply: byte offset {}: vertex 1: z is NaN; every coordinate must be a finite number (fix the file, or read it with ReadOptions {{ non_finite: NonFinite::Drop, .. }} to leave such points out)", h + 13)
+            format!("t.ply: byte offset {}: vertex 1: z is NaN; every coordinate must be a finite number (fix the file, or read with ReadOptions {{ non_finite: NonFinite::Drop, .. }} to leave such points out)", h + 13)
         );
         let opts = ReadOptions {
             non_finite: NonFinite::Drop,
@@ -1045,7 +1068,12 @@ mod tests {
         let faces = format!(
             "{head}element face 1\nproperty list uchar int vertex_indices\nend_header\n1 2 3\n4 5 6\n3 0 1 0\n"
         );
-        assert!(read(faces.as_bytes()).unwrap().warnings.is_empty());
+        // (its one face is degenerate: no normals, and a warning that says why)
+        let w = read(faces.as_bytes()).unwrap().warnings;
+        assert!(
+            w.len() == 1 && w[0].contains("2 of 2 vertices lie on no triangle of non-zero area"),
+            "{w:?}"
+        );
         // binary: a third record after the declared two
         let mut b = "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
             .as_bytes()

@@ -20,10 +20,15 @@ pub enum Format {
     Las,
     /// Text: XYZ, CSV, TXT, PTS, ASC (one point per line).
     Text,
+    /// STL, binary or ascii: the triangles' corners (welded) with
+    /// area-weighted vertex normals.
+    Stl,
+    /// Wavefront OBJ: the `v` vertices with normals from `vn` or the faces.
+    Obj,
 }
 
 /// File extensions the readers know, with their format.
-pub const EXTENSIONS: [(&str, Format); 9] = [
+pub const EXTENSIONS: [(&str, Format); 11] = [
     ("ply", Format::Ply),
     ("pcd", Format::Pcd),
     ("las", Format::Las),
@@ -33,6 +38,8 @@ pub const EXTENSIONS: [(&str, Format); 9] = [
     ("txt", Format::Text),
     ("pts", Format::Text),
     ("asc", Format::Text),
+    ("stl", Format::Stl),
+    ("obj", Format::Obj),
 ];
 
 impl Format {
@@ -49,7 +56,7 @@ impl Format {
             None => Err(Error::Invalid {
                 path: path.to_path_buf(),
                 message: format!(
-                    "'.{ext}' files are not supported; give a point file with one of the extensions {} (or choose the format with ReadOptions::format)",
+                    "'.{ext}' files are not supported; give a point file with one of the extensions {} (or {FORMAT_ADVICE})",
                     EXTENSIONS
                         .iter()
                         .map(|(e, _)| format!(".{e}"))
@@ -61,28 +68,67 @@ impl Format {
     }
 
     /// The format of a file by its first bytes: PLY (`ply`), LAS (`LASF`),
-    /// PCD (`# .PCD` or `VERSION`), otherwise text.
+    /// PCD (`# .PCD` or `VERSION`), STL (ascii `solid` with facets, or a
+    /// binary file whose size matches its triangle count), OBJ (a first
+    /// statement `v`, `vn`, `o`, ...), otherwise text.
     pub fn sniff(bytes: &[u8]) -> Format {
-        if bytes.starts_with(b"ply") {
-            Format::Ply
+        match Format::magic(bytes) {
+            Some(f) => f,
+            None if crate::obj::sniff(bytes) => Format::Obj,
+            None => Format::Text,
+        }
+    }
+
+    /// The format of a file whose first bytes say it without doubt, as a
+    /// file named `.xyz` may still be a PLY: `ply` followed by a line end,
+    /// `LASF`, `# .PCD`, an ascii STL (`solid` with facets) or a binary STL
+    /// whose size matches its count.
+    pub fn magic(bytes: &[u8]) -> Option<Format> {
+        if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r") {
+            Some(Format::Ply)
         } else if bytes.starts_with(b"LASF") {
-            Format::Las
+            Some(Format::Las)
         } else if bytes.starts_with(b"# .PCD") || bytes.starts_with(b"VERSION") {
-            Format::Pcd
+            Some(Format::Pcd)
+        } else if crate::stl::sniff(bytes) {
+            Some(Format::Stl)
+        } else if bytes.starts_with(b"ply") {
+            Some(Format::Ply)
         } else {
-            Format::Text
+            None
+        }
+    }
+
+    /// The format's name in messages (`PLY`, `text`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Ply => "PLY",
+            Format::Pcd => "PCD",
+            Format::Las => "LAS/LAZ",
+            Format::Text => "text",
+            Format::Stl => "STL",
+            Format::Obj => "OBJ",
         }
     }
 
     /// The word for one record of the format in messages (`vertex` for PLY).
     pub fn record_noun(self) -> &'static str {
         match self {
-            Format::Ply => "vertex",
+            Format::Ply | Format::Stl | Format::Obj => "vertex",
             Format::Las => "point record",
             Format::Pcd | Format::Text => "point",
         }
     }
 }
+
+/// The advice in reader messages on dropping non-finite points; a front
+/// with its own words for it replaces it ([`Error::with_advice`]).
+pub const DROP_ADVICE: &str =
+    "read with ReadOptions { non_finite: NonFinite::Drop, .. } to leave such points out";
+
+/// The advice in reader messages on choosing the format whatever the
+/// extension; replaced as [`DROP_ADVICE`] is.
+pub const FORMAT_ADVICE: &str = "choose the format with ReadOptions::format";
 
 /// What to do with points whose x, y or z is NaN or infinite.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -276,7 +322,7 @@ impl PointTable {
                     return Err(self.error_at(
                         i,
                         format!(
-                            "{axis} is {v}; every coordinate must be a finite number (fix the file, or read it with ReadOptions {{ non_finite: NonFinite::Drop, .. }} to leave such points out)"
+                            "{axis} is {v}; every coordinate must be a finite number (fix the file, or {DROP_ADVICE})"
                         ),
                     ));
                 }
@@ -308,6 +354,26 @@ impl PointTable {
             .par_iter()
             .map(|p| p.coords.iter().all(|v| v.is_finite()))
             .collect();
+        let before = self.points.len();
+        self.retain(&keep);
+        self.dropped_non_finite += before - self.points.len();
+    }
+
+    /// Keeps the points `i` with `keep[i]` (a missing entry keeps), with
+    /// their columns, and where they are in the file (lines, offsets, record
+    /// indices), so messages about the kept points still name their place.
+    ///
+    /// ```
+    /// use scanfit_io::{parse_cloud, ReadOptions};
+    /// let mut t = parse_cloud("p.xyz".as_ref(), b"0 0 0\n1 1 1\n2 2 2\n", &ReadOptions::default())?;
+    /// t.retain(&[true, false, true]);
+    /// assert_eq!((t.points.len(), t.locate(1)), (2, "p.xyz:3".to_string()));
+    /// # Ok::<(), scanfit_io::Error>(())
+    /// ```
+    pub fn retain(&mut self, keep: &[bool]) {
+        let keep: Vec<bool> = (0..self.points.len())
+            .map(|i| keep.get(i).copied().unwrap_or(true))
+            .collect();
         fn filter<T: Copy>(v: &[T], keep: &[bool]) -> Vec<T> {
             v.iter()
                 .zip(keep)
@@ -323,7 +389,6 @@ impl PointTable {
                 .map(|(i, _)| i)
                 .collect(),
         };
-        let before = self.points.len();
         self.points = filter(&self.points, &keep);
         for c in &mut self.extra {
             *c = filter(c, &keep);
@@ -333,7 +398,6 @@ impl PointTable {
             Origin::Offsets(o) => *o = filter(o, &keep),
             Origin::Records { .. } | Origin::Indices => {}
         }
-        self.dropped_non_finite += before - self.points.len();
         self.file_index = Some(index);
     }
 }

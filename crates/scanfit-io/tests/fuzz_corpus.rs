@@ -24,6 +24,8 @@ fn feed(target: &str, data: &[u8]) -> bool {
         "las" => scanfit_io::fuzz::point_file("f.las", data),
         "laz" => scanfit_io::fuzz::point_file("f.laz", data),
         "text" => scanfit_io::fuzz::point_file("f.xyz", data),
+        "stl" => scanfit_io::fuzz::point_file("f.stl", data),
+        "obj" => scanfit_io::fuzz::point_file("f.obj", data),
         "curve_json" => scanfit_io::fuzz::curve_document(data),
         "surface_json" => scanfit_io::fuzz::surface_document(data),
         other => panic!("unknown fuzz target directory '{other}'"),
@@ -70,8 +72,10 @@ fn seed_corpora_replay_and_the_intact_seeds_are_accepted() {
             "curve_json",
             "las",
             "laz",
+            "obj",
             "pcd",
             "ply",
+            "stl",
             "surface_json",
             "text"
         ]

@@ -175,16 +175,13 @@ pub fn reconstruct<'py>(
     let c = cloud.get();
     let r = py.detach(|| run(c, &cfg, &NoProgress)).map_err(err)?;
     let d = PyDict::new(py);
-    match &r.complex {
-        Ok(m) => {
-            d.set_item("model", PyModel { inner: m.clone() })?;
-            d.set_item("model_error", py.None())?;
-        }
-        Err(e) => {
-            d.set_item("model", py.None())?;
-            d.set_item("model_error", e)?;
-        }
-    }
+    d.set_item(
+        "model",
+        PyModel {
+            inner: r.complex.clone(),
+        },
+    )?;
+    d.set_item("model_error", py.None())?;
     let patches = PyList::empty(py);
     for (p, f) in r.patches.iter().zip(&r.faces) {
         let e = PyDict::new(py);

@@ -61,6 +61,7 @@ pub mod spatial;
 pub mod surface;
 pub mod testdata;
 pub mod topology;
+pub mod trim;
 
 pub use cloud::PointCloud;
 pub use error::{Error, Result};

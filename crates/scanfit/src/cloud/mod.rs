@@ -15,15 +15,21 @@
 //!   ([Katz07]).
 //! * [`boundary`]: boundary loops of a sheet-like patch from the alpha shape
 //!   of its projection on the best-fit plane.
+//! * [`clean`]: statistical outliers, small fragments, crops and voxel
+//!   thinning (which points to keep).
 //! * [`corners`]: corners of a closed boundary loop (smallest turning angle or
 //!   largest three-point curvature) and the loop's split into sides.
+//! * [`segment`]: regions bounded by sharp edges, by octree cells subdivided
+//!   where the normals vary ([COONS19]).
 
 pub mod boundary;
+pub mod clean;
 pub mod corners;
 pub mod hpr;
 pub mod hull;
 pub mod neighbours;
 pub mod normals;
+pub mod segment;
 #[cfg(test)]
 pub(crate) mod testutil;
 

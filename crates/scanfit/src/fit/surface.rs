@@ -80,6 +80,33 @@ pub const MAX_SURFACE_CONTROL_POINTS: usize = 1 << 22;
 
 /// Fits a surface to `points` with parameters `uv` in `[0, 1]^2`.
 pub fn fit_surface(points: &[Point3], uv: &[[f64; 2]], cfg: &SurfaceFitConfig) -> Result<Surface> {
+    check_net(cfg)?;
+    let (p, q) = cfg.degree;
+    let (nu, nv) = cfg.ctrl;
+    let ku = if cfg.periodic_u {
+        KnotVector::uniform_periodic(p, nu)?
+    } else {
+        match cfg.knots {
+            KnotPlacement::Uniform => KnotVector::uniform_clamped(p, nu)?,
+            KnotPlacement::Distribution => distribution_knots(uv.iter().map(|t| t[0]), p, nu)?,
+        }
+    };
+    let kv = match cfg.knots {
+        KnotPlacement::Uniform => KnotVector::uniform_clamped(q, nv)?,
+        KnotPlacement::Distribution => distribution_knots(uv.iter().map(|t| t[1]), q, nv)?,
+    };
+    let opts = SurfaceLsqOptions {
+        smoothing: cfg.smoothing,
+        weights: cfg.weights.as_deref(),
+        periodic_u: cfg.periodic_u,
+    };
+    least_squares_surface_with(points, uv, ku, kv, opts)
+}
+
+/// The degrees and net of `cfg` are usable: degrees 1 to 10, at least
+/// `p + 1` (periodic: `2p + 1`) by `q + 1` control points, at most
+/// [`MAX_SURFACE_CONTROL_POINTS`].
+fn check_net(cfg: &SurfaceFitConfig) -> Result<()> {
     let (p, q) = cfg.degree;
     let (nu, nv) = cfg.ctrl;
     if p == 0 || q == 0 {
@@ -103,24 +130,48 @@ pub fn fit_surface(points: &[Point3], uv: &[[f64; 2]], cfg: &SurfaceFitConfig) -
             "a {nu} x {nv} control net of degrees {p} x {q} is beyond the limits ({MAX_SURFACE_CONTROL_POINTS} control points, degree 10); choose a smaller net"
         )));
     }
-    let ku = if cfg.periodic_u {
-        KnotVector::uniform_periodic(p, nu)?
-    } else {
-        match cfg.knots {
-            KnotPlacement::Uniform => KnotVector::uniform_clamped(p, nu)?,
-            KnotPlacement::Distribution => distribution_knots(uv.iter().map(|t| t[0]), p, nu)?,
+    Ok(())
+}
+
+impl SurfaceFitConfig {
+    /// Empty normal equations for this configuration with uniform knots
+    /// (the knots of [`fit_surface`] with [`KnotPlacement::Uniform`]), for
+    /// points that arrive in chunks. Errors for the distribution knots
+    /// (NURBS Book eq. 9.69 needs all parameters sorted at once) and for
+    /// weights (give them per chunk to [`NormalEquations::add`]).
+    ///
+    /// ```
+    /// use scanfit::fit::surface::{KnotPlacement, SurfaceFitConfig};
+    /// let cfg = SurfaceFitConfig { knots: KnotPlacement::Uniform, ctrl: (10, 8), ..Default::default() };
+    /// let eq = cfg.uniform_equations()?;
+    /// assert_eq!(eq.points(), 0);
+    /// assert!(SurfaceFitConfig::default().uniform_equations().is_err());
+    /// # Ok::<(), scanfit::Error>(())
+    /// ```
+    pub fn uniform_equations(&self) -> Result<NormalEquations> {
+        check_net(self)?;
+        if self.knots != KnotPlacement::Uniform {
+            return Err(Error::InvalidSetting {
+                setting: "knots",
+                value: "distribution".into(),
+                hint: "knots from the parameter distribution (NURBS Book eq. 9.69) need all parameters sorted at once; use uniform knots for points read in chunks".into(),
+            });
         }
-    };
-    let kv = match cfg.knots {
-        KnotPlacement::Uniform => KnotVector::uniform_clamped(q, nv)?,
-        KnotPlacement::Distribution => distribution_knots(uv.iter().map(|t| t[1]), q, nv)?,
-    };
-    let opts = SurfaceLsqOptions {
-        smoothing: cfg.smoothing,
-        weights: cfg.weights.as_deref(),
-        periodic_u: cfg.periodic_u,
-    };
-    least_squares_surface_with(points, uv, ku, kv, opts)
+        if self.weights.is_some() {
+            return Err(Error::InvalidSetting {
+                setting: "weights",
+                value: "given".into(),
+                hint: "give the weights of points read in chunks with each chunk (NormalEquations::add)".into(),
+            });
+        }
+        let ((p, q), (nu, nv)) = (self.degree, self.ctrl);
+        let ku = if self.periodic_u {
+            KnotVector::uniform_periodic(p, nu)?
+        } else {
+            KnotVector::uniform_clamped(p, nu)?
+        };
+        NormalEquations::new(ku, KnotVector::uniform_clamped(q, nv)?, self.periodic_u)
+    }
 }
 
 /// Clamped knots on `[0, 1]` whose interior knots follow the distribution of the

@@ -321,18 +321,7 @@ fn finish(
     let orthogonal = ErrorStats::of(&dist);
     let unconverged = inversions.iter().filter(|r| !r.converged).count();
     let cloud = PointCloud::new(points.to_vec())?;
-    // eq. 17 at the knot lines (u_i = s_{i+3} in the MBA paper)
-    let knots: Vec<Point3> = {
-        let (us, vs) = (
-            surface.knots_u().breakpoints(),
-            surface.knots_v().breakpoints(),
-        );
-        us.iter()
-            .flat_map(|&u| vs.iter().map(move |&v| (u, v)))
-            .map(|(u, v)| surface.point(u, v))
-            .collect()
-    };
-    let grid_rmse = crate::metrics::rmse_to_cloud(&cloud, &knots)?;
+    let grid_rmse = crate::metrics::rmse_to_cloud(&cloud, &knot_line_points(surface))?;
     let (samples_to_points, samples) = sample_distances(surface, &cloud, config)?;
     let extent = extent(surface, &cloud, &samples, samples_to_points.spacing, config);
     let parameterization = if config.parameterization {
@@ -376,9 +365,22 @@ fn extent(
     spacing: f64,
     config: &AssessConfig,
 ) -> Extent {
-    let Some((lo, hi)) = cloud.bounding_box() else {
-        return Extent::default();
-    };
+    match cloud.bounding_box() {
+        Some(b) => extent_in_box(surface, b, samples, spacing, config),
+        None => Extent::default(),
+    }
+}
+
+/// The [`Extent`] of `surface` (its `samples`) against the points' bounding
+/// box `(lo, hi)` (also used by the streamed assessment, which gathers the
+/// box chunk by chunk).
+pub(crate) fn extent_in_box(
+    surface: &Surface,
+    (lo, hi): (Point3, Point3),
+    samples: &[Point3],
+    spacing: f64,
+    config: &AssessConfig,
+) -> Extent {
     let far = |pts: &[Point3]| {
         pts.iter()
             .map(|p| outside_box(p, &lo, &hi))
@@ -405,15 +407,26 @@ fn extent(
     }
 }
 
-/// The surface-to-points distances over the sample grid of `config`, and
-/// the samples.
-fn sample_distances(
+/// The surface points at the knot lines (every pair of breakpoints), where
+/// [MBA18] eq. 17 is measured (`u_i = s_{i+3}` in the MBA paper).
+pub(crate) fn knot_line_points(surface: &Surface) -> Vec<Point3> {
+    let (us, vs) = (
+        surface.knots_u().breakpoints(),
+        surface.knots_v().breakpoints(),
+    );
+    us.iter()
+        .flat_map(|&u| vs.iter().map(move |&v| (u, v)))
+        .map(|(u, v)| surface.point(u, v))
+        .collect()
+}
+
+/// The sample grid of `config` (intervals `(nu, nv)`) and its surface points.
+pub(crate) fn sample_grid(
     surface: &Surface,
-    cloud: &PointCloud,
     config: &AssessConfig,
-) -> Result<(SampleDistances, Vec<Point3>)> {
+) -> Result<((usize, usize), Vec<Point3>)> {
+    check(config)?;
     let (cu, cv) = surface.counts();
-    // checked by `check`
     let (nu, nv) = config
         .samples
         .unwrap_or(((cu * 4).clamp(32, 200), (cv * 4).clamp(32, 200)));
@@ -427,6 +440,16 @@ fn sample_distances(
             )
         })
         .collect();
+    Ok(((nu, nv), samples))
+}
+
+/// The surface-to-points distances over the sample grid of `config`.
+fn sample_distances(
+    surface: &Surface,
+    cloud: &PointCloud,
+    config: &AssessConfig,
+) -> Result<(SampleDistances, Vec<Point3>)> {
+    let ((nu, nv), samples) = sample_grid(surface, config)?;
     let d: Vec<f64> = cloud
         .nearest_batch(&samples)?
         .into_iter()

@@ -204,8 +204,12 @@ pub struct PdeOutcome {
     pub fit: PdeFit,
     /// The export tolerance used (data units).
     pub export_tolerance: f64,
-    /// Largest deviation of the exported B-spline from the PDE surface.
+    /// Largest deviation of the exported B-spline from the PDE surface: the
+    /// tolerance reached (above `export_tolerance` when `export_capped`).
     pub export_deviation: f64,
+    /// The export stopped at the control-point cap (never more control
+    /// points than input points) before it met `export_tolerance`.
+    pub export_capped: bool,
 }
 
 /// Everything [`run`] produced.
@@ -348,13 +352,17 @@ fn run_centred(
                 });
             }
             progress.stage(STAGES[3], None);
-            let b = f.surface.to_bspline(&BsplineConversionConfig::new(tol))?;
+            let b = f.surface.to_bspline(&BsplineConversionConfig {
+                max_control_points: Some(pts.len()),
+                ..BsplineConversionConfig::new(tol)
+            })?;
             (
                 b.surface,
                 Some(PdeOutcome {
                     fit: f,
                     export_tolerance: tol,
                     export_deviation: b.max_deviation,
+                    export_capped: b.capped,
                 }),
             )
         }
@@ -415,8 +423,11 @@ mod tests {
     #[test]
     fn bspline_route_fits_the_panel_on_grid_parameters() {
         let cloud = panel();
+        // the paper's fit: the given net, no smoothing
         let cfg = CoonsConfig {
             route: CoonsRoute::bspline((3, 3), (12, 10)),
+            ctrl_from_density: false,
+            relative_smoothing: None,
             ..Default::default()
         };
         let r = run(&cloud, &cfg, &crate::progress::NoProgress).unwrap();

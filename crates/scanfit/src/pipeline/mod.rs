@@ -36,6 +36,9 @@
 //!   with the MBA paper's projection adjustment, with its per-level table.
 //! * [`measure`]: what `scanfit report` measures for a surface and points
 //!   (the assessment of their projections, percentiles, histogram).
+//! * [`measure_model`]: what `scanfit report` measures for a multi-patch
+//!   model and points (per patch eq. 15 and orthogonal errors, per edge gap
+//!   and normal angle, totals).
 //! * [`reconstruct`]: a segmented cloud to a whole object, patches that
 //!   share their edge curves (`scanfit reconstruct`, PDE paper section 4).
 //! * [`regularize`]: the safe defaults of the least-squares fits (net from
@@ -51,8 +54,11 @@ pub mod coons;
 pub mod curve;
 pub mod mba;
 pub mod measure;
+pub mod measure_model;
 pub mod reconstruct;
 pub mod regularize;
+pub mod segment;
+pub mod stream;
 pub mod surface_fit;
 pub mod turntable;
 

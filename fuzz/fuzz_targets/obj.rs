@@ -1,0 +1,6 @@
+//! Fuzz target: the obj reader (`scanfit_io::fuzz::point_file` with a `.obj` name).
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    scanfit_io::fuzz::point_file("f.obj", data);
+});
