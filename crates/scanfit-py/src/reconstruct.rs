@@ -181,6 +181,7 @@ pub fn reconstruct<'py>(
             inner: r.complex.clone(),
         },
     )?;
+    d.set_item("model_error", py.None())?;
     let patches = PyList::empty(py);
     for (p, f) in r.patches.iter().zip(&r.faces) {
         let e = PyDict::new(py);

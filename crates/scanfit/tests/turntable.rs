@@ -117,8 +117,10 @@ fn tube_along_a_tilted_axis() {
         t.end_shapes
     );
     assert!(t.on_v_boundary < 20, "{}", t.on_v_boundary);
-    let mut margins = TurntableConfig::default();
-    margins.detect_open_ends = false;
+    let margins = TurntableConfig {
+        detect_open_ends: false,
+        ..Default::default()
+    };
     let (_, m) = run(
         tube(12_000, Point3::new(100.0, -50.0, 20.0), axis),
         &margins,
