@@ -207,9 +207,12 @@ fn chain_params(side: &Curve, junctions: &[f64]) -> Vec<(f64, f64)> {
     cuts.windows(2).map(|w| (w[0], w[1])).collect()
 }
 
-/// Every non-degenerate side of every face: its curve and the parameter
-/// range of each edge of its chain.
-type SidePieces = Vec<[Option<(Curve, Vec<(f64, f64)>)>; 4]>;
+/// A non-degenerate side: its curve and the parameter range of each edge of
+/// its chain (`None` for a degenerate side).
+type SidePiece = Option<(Curve, Vec<(f64, f64)>)>;
+
+/// The four [`SidePiece`]s of every face.
+type SidePieces = Vec<[SidePiece; 4]>;
 
 impl PatchComplex {
     /// The fractions `[s0, s1]` of side `k` of face `fi` (0 at the side's
@@ -244,7 +247,7 @@ impl PatchComplex {
             .iter()
             .enumerate()
             .map(|(fi, f)| {
-                let mut out: [Option<(Curve, Vec<(f64, f64)>)>; 4] = Default::default();
+                let mut out: [SidePiece; 4] = Default::default();
                 for (k, chain) in f.sides.iter().enumerate() {
                     if chain.is_empty() {
                         continue;
