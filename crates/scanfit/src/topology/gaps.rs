@@ -244,6 +244,7 @@ impl PatchComplex {
             .iter()
             .enumerate()
             .map(|(fi, f)| {
+                #[allow(clippy::type_complexity)]
                 let mut out: [Option<(Curve, Vec<(f64, f64)>)>; 4] = Default::default();
                 for (k, chain) in f.sides.iter().enumerate() {
                     if chain.is_empty() {
