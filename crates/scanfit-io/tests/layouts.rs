@@ -146,7 +146,7 @@ fn blob_as_a_cube_is_a_closed_solid_of_the_true_volume() {
     let dir = std::env::temp_dir().join(format!("scanfit-layout-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let (jp, sp) = (dir.join("blob.json"), dir.join("blob.stp"));
-    std::fs::write(&jp, ModelDoc::new(model).to_json()).unwrap();
+    std::fs::write(&jp, ModelDoc::new(model).to_json().unwrap()).unwrap();
     std::fs::write(&sp, &step.text).unwrap();
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/occ/check_model.py");
     let o = Command::new("python3")
