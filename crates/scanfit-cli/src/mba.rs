@@ -174,8 +174,11 @@ struct Row {
     vertical_max: f64,
     vertical_rmse: f64,
     grid_rmse: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
     adjusted_vertical_rmse: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     adjusted_grid_rmse: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     adjust_steps: Option<usize>,
     seconds: f64,
 }
@@ -220,9 +223,13 @@ pub fn run(a: MbaArgs) -> Result<()> {
     ];
     let r = mba(&cloud, &a.config(), &progress)
         .map_err(|e| anyhow::anyhow!("{}: {e}{}", input.display(), option_note(&e, &options)))?;
+    let q = &r.assessment.quality;
+    a.out.guard(
+        q,
+        "remove stray points or use fewer levels (--levels) or a tolerance (--tolerance)",
+    )?;
     progress.stage("writing");
     let pts = cloud.points();
-    let q = &r.assessment.quality;
     let operation = if a.adjust {
         "mba (multilevel B-spline approximation + projection adjustment)"
     } else {
@@ -264,7 +271,10 @@ pub fn run(a: MbaArgs) -> Result<()> {
             "seconds": r.seconds,
             "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
         });
-        outln!("{}", serde_json::to_string_pretty(&report)?);
+        out!(
+            "{}",
+            scanfit_io::json::finite_json(&report, "the JSON report")?
+        );
         return Ok(());
     }
     print_report(&a, &r)?;

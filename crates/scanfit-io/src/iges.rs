@@ -4,15 +4,27 @@
 //!
 //! Entity 128 lists weights and control points with the `u` index varying
 //! fastest (`W(0,0), W(1,0), ..., W(K1,0), W(0,1), ...`), the transpose of
-//! scanfit's row-major net. Units are declared as millimetres. A multi-patch
-//! model ([`iges_model_file`]) is written as its patches and its shared edge
-//! curves.
+//! scanfit's row-major net. Units are declared as millimetres unless
+//! [`CadOptions::units`] says otherwise (global parameters 14 and 15; the
+//! values are never scaled). A multi-patch model ([`iges_model_file`]) is
+//! written as its patches and its shared edge curves.
+//!
+//! A trimmed surface ([`CadItem::Trimmed`]) is an entity 144 (trimmed
+//! parametric surface) on its entity 128, with one entity 142 (curve on a
+//! parametric surface) per trim loop; each 142 points at the loop's 2D
+//! curve in the surface's parameter space (entity 126, planar, entity use
+//! "parametric") and its 3D curve (entity 126), and prefers the former
+//! (`PREF = 1`, `S(B(t))`). A face that keeps its rectangle has `N1 = 0`
+//! (its outer boundary is the domain's). The referenced entities are
+//! flagged physically dependent in their directory entries.
 
 use scanfit::bspline::{Curve, Surface};
 use scanfit::topology::PatchComplex;
 
 use crate::step::CadItem;
+use crate::units::CadOptions;
 use crate::{Error, Result};
+use scanfit::trim::TrimmedSurface;
 
 /// IGES reals use the same form as STEP's (shortest round trip, a decimal point).
 use crate::step::real;
@@ -21,8 +33,9 @@ fn hollerith(s: &str) -> String {
     format!("{}H{s}", s.len())
 }
 
-/// Parameters of entity 126 for `c` (clamped or not; periodic flagged).
-fn curve_params(c: &Curve) -> Vec<String> {
+/// Parameters of entity 126 for `c` (clamped or not; periodic flagged);
+/// `planar` flags a parameter-space curve (in the plane `z = 0`).
+fn curve_params(c: &Curve, planar: bool) -> Vec<String> {
     let k = c.control_points().len() - 1;
     let m = c.degree();
     let w: Vec<f64> = c
@@ -35,7 +48,7 @@ fn curve_params(c: &Curve) -> Vec<String> {
         "126".into(),
         k.to_string(),
         m.to_string(),
-        "0".into(),
+        (planar as u8).to_string(),
         (c.is_closed() as u8).to_string(),
         (polynomial as u8).to_string(),
         (c.is_periodic() as u8).to_string(),
@@ -95,8 +108,116 @@ fn record(text: &str, section: char, seq: usize) -> String {
     format!("{text:<72}{section}{seq:>7}\n")
 }
 
-/// An IGES file with `items` (curves as entity 126, surfaces as 128).
+/// One entity to write: its type, parameters (the type first), label and
+/// directory status (blank, subordinate, use, hierarchy).
+struct Entity {
+    etype: u32,
+    params: Vec<String>,
+    label: &'static str,
+    status: &'static str,
+}
+
+/// Independent entities.
+const INDEPENDENT: &str = "00000000";
+/// Physically dependent on a referencing entity.
+const DEPENDENT: &str = "00010000";
+/// Physically dependent, used as a curve in a parameter space.
+const PARAMETRIC: &str = "00010500";
+
+/// An IGES file with `items` (curves as entity 126, surfaces as 128,
+/// trimmed surfaces as 144), lengths in millimetres.
 pub fn iges_file(items: &[CadItem], name: &str) -> Result<String> {
+    iges_file_with(items, name, &CadOptions::default())
+}
+
+/// The directory entry number (odd, 1-based) of the entity pushed next.
+fn next_de(entities: &[Entity]) -> usize {
+    2 * entities.len() + 1
+}
+
+/// Pushes the entities of a trimmed surface: 128, per loop 126 (2D), 126
+/// (3D) and 142, then 144.
+fn push_trimmed(entities: &mut Vec<Entity>, t: &TrimmedSurface) -> scanfit::Result<()> {
+    let surf = next_de(entities);
+    entities.push(Entity {
+        etype: 128,
+        params: surface_params(&t.surface.to_clamped()?),
+        label: "BSPLSRF",
+        status: DEPENDENT,
+    });
+    let mut on_surface = Vec::new();
+    for c in t.curves() {
+        let b = next_de(entities);
+        entities.push(Entity {
+            etype: 126,
+            params: curve_params(&c.uv.to_clamped()?, true),
+            label: "PCURVE",
+            status: PARAMETRIC,
+        });
+        let cc = next_de(entities);
+        entities.push(Entity {
+            etype: 126,
+            params: curve_params(&c.space.to_clamped()?, false),
+            label: "BSPLCRV",
+            status: DEPENDENT,
+        });
+        on_surface.push(next_de(entities));
+        entities.push(Entity {
+            etype: 142,
+            params: [
+                "142",
+                "1",
+                &surf.to_string(),
+                &b.to_string(),
+                &cc.to_string(),
+                "1",
+            ]
+            .map(String::from)
+            .to_vec(),
+            label: "CRVONSRF",
+            status: DEPENDENT,
+        });
+    }
+    let outer = t.outer.is_some();
+    let (pto, holes) = if outer {
+        (on_surface[0], &on_surface[1..])
+    } else {
+        (0, &on_surface[..])
+    };
+    let mut params = vec![
+        "144".to_string(),
+        surf.to_string(),
+        (outer as u8).to_string(),
+        holes.len().to_string(),
+        pto.to_string(),
+    ];
+    params.extend(holes.iter().map(|h| h.to_string()));
+    entities.push(Entity {
+        etype: 144,
+        params,
+        label: "TRIMSRF",
+        status: INDEPENDENT,
+    });
+    Ok(())
+}
+
+/// An IGES file with `items`, written with `options` (the declared length
+/// unit in the global section).
+///
+/// ```
+/// use scanfit::bspline::{KnotVector, Surface};
+/// use scanfit::Point3;
+/// use scanfit_io::iges::iges_file_with;
+/// use scanfit_io::step::CadItem;
+/// use scanfit_io::units::{CadOptions, LengthUnit};
+/// let k = KnotVector::uniform_clamped(1, 2).unwrap();
+/// let p = |x: f64, y: f64| Point3::new(x, y, 0.0);
+/// let s = Surface::new(k.clone(), k, vec![p(0., 0.), p(0., 1.), p(1., 0.), p(1., 1.)]).unwrap();
+/// let text = iges_file_with(&[CadItem::Surface(&s)], "square",
+///     &CadOptions::with_units(LengthUnit::Metre)).unwrap();
+/// assert!(text.contains(",6,1HM,"));
+/// ```
+pub fn iges_file_with(items: &[CadItem], name: &str, options: &CadOptions) -> Result<String> {
     if items.is_empty() {
         return Err(Error::Invalid {
             path: name.into(),
@@ -117,8 +238,10 @@ pub fn iges_file(items: &[CadItem], name: &str) -> Result<String> {
         .flat_map(|it| match it {
             CadItem::Curve(c) => c.control_points().to_vec(),
             CadItem::Surface(s) => s.control_points().to_vec(),
+            CadItem::Trimmed(t) => t.surface.control_points().to_vec(),
         })
         .fold(0.0f64, |m, p| m.max(p.coords.amax()));
+    let units = options.units;
     let global = [
         "1H,".to_string(),
         "1H;".into(),
@@ -133,8 +256,8 @@ pub fn iges_file(items: &[CadItem], name: &str) -> Result<String> {
         "15".into(),
         hollerith("scanfit"),
         "1.0".into(),
-        "2".into(),
-        hollerith("MM"),
+        units.iges_flag().to_string(),
+        hollerith(units.iges_name()),
         "1".into(),
         "1.0".into(),
         hollerith(stamp),
@@ -150,26 +273,38 @@ pub fn iges_file(items: &[CadItem], name: &str) -> Result<String> {
     for (k, l) in glines.iter().enumerate() {
         out.push_str(&record(l, 'G', k + 1));
     }
-    // Directory entries and parameter data
-    let mut d = String::new();
-    let mut pdata = String::new();
-    let mut pseq = 1usize;
+    // the entities, referenced ones before those that reference them;
+    // periodic or unclamped geometry goes out in the clamped form of the same shape
+    let mut entities = Vec::new();
     for (k, item) in items.iter().enumerate() {
-        // periodic or unclamped geometry goes out in the clamped form of the same shape
         let bad = |e: scanfit::Error| Error::Invalid {
             path: name.into(),
             message: format!("item {k}: {e}"),
         };
-        let (etype, params, label) = match item {
-            CadItem::Curve(c) => (126, curve_params(&c.to_clamped().map_err(bad)?), "BSPLCRV"),
-            CadItem::Surface(s) => (
-                128,
-                surface_params(&s.to_clamped().map_err(bad)?),
-                "BSPLSRF",
-            ),
-        };
+        match item {
+            CadItem::Curve(c) => entities.push(Entity {
+                etype: 126,
+                params: curve_params(&c.to_clamped().map_err(bad)?, false),
+                label: "BSPLCRV",
+                status: INDEPENDENT,
+            }),
+            CadItem::Surface(s) => entities.push(Entity {
+                etype: 128,
+                params: surface_params(&s.to_clamped().map_err(bad)?),
+                label: "BSPLSRF",
+                status: INDEPENDENT,
+            }),
+            CadItem::Trimmed(t) => push_trimmed(&mut entities, t).map_err(bad)?,
+        }
+    }
+    // Directory entries and parameter data
+    let mut d = String::new();
+    let mut pdata = String::new();
+    let mut pseq = 1usize;
+    for (k, e) in entities.iter().enumerate() {
+        let etype = e.etype;
         let de = 2 * k + 1; // sequence number of this entity's first DE line
-        let lines = pack(&params, 64);
+        let lines = pack(&e.params, 64);
         let first = pseq;
         for l in &lines {
             pdata.push_str(&format!("{l:<64} {de:>7}P{pseq:>7}\n"));
@@ -178,20 +313,21 @@ pub fn iges_file(items: &[CadItem], name: &str) -> Result<String> {
         d.push_str(&record(
             &format!(
                 "{etype:>8}{first:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}",
-                0, 0, 0, 0, 0, 0, "00000000"
+                0, 0, 0, 0, 0, 0, e.status
             ),
             'D',
             de,
         ));
         d.push_str(&record(
             &format!(
-                "{etype:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{label:>8}{:>8}",
+                "{etype:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}",
                 0,
                 0,
                 lines.len(),
                 0,
                 "",
                 "",
+                e.label,
                 k + 1
             ),
             'D',
@@ -204,7 +340,7 @@ pub fn iges_file(items: &[CadItem], name: &str) -> Result<String> {
         "S{:>7}G{:>7}D{:>7}P{:>7}",
         1,
         glines.len(),
-        2 * items.len(),
+        2 * entities.len(),
         pseq - 1
     );
     out.push_str(&record(&term, 'T', 1));
@@ -234,13 +370,22 @@ pub fn iges_file(items: &[CadItem], name: &str) -> Result<String> {
 /// assert!(de[0].starts_with("     128") && de[2].starts_with("     126"));
 /// ```
 pub fn iges_model_file(model: &PatchComplex, name: &str) -> Result<String> {
+    iges_model_file_with(model, name, &CadOptions::default())
+}
+
+/// [`iges_model_file`] written with `options` (the declared length unit).
+pub fn iges_model_file_with(
+    model: &PatchComplex,
+    name: &str,
+    options: &CadOptions,
+) -> Result<String> {
     let mut items: Vec<CadItem> = model
         .faces
         .iter()
         .map(|f| CadItem::Surface(&f.surface))
         .collect();
     items.extend(model.edges.iter().map(|e| CadItem::Curve(&e.curve)));
-    iges_file(&items, name)
+    iges_file_with(&items, name, options)
 }
 
 /// Joins parameters with ',' and a final ';' into lines of at most `width`

@@ -26,6 +26,7 @@ pub mod step;
 pub mod step_shell;
 pub mod svg;
 pub mod table;
+pub mod units;
 pub mod xyz;
 
 pub use atomic::{check_paths, recover, write_all_atomic, write_atomic};

@@ -11,13 +11,27 @@
 //! `GEOMETRICALLY_BOUNDED_WIREFRAME_SHAPE_REPRESENTATION`. Several surfaces and
 //! curves share one file and one product. Rational curves and surfaces use the
 //! complex-entity forms (`RATIONAL_B_SPLINE_*`). Lengths are declared in
-//! millimetres (the data's own units are kept unscaled).
+//! millimetres unless [`CadOptions::units`] says otherwise (the data's own
+//! values are kept unscaled; see [`crate::units`]).
+//!
+//! A trimmed surface ([`CadItem::Trimmed`]) becomes an `ADVANCED_FACE`
+//! bounded by a `FACE_OUTER_BOUND` (its outer trim curve, or the four
+//! boundary curves when it keeps its rectangle) and one `FACE_BOUND` per
+//! hole; each trim loop is an `EDGE_LOOP` of one closed `EDGE_CURVE` whose
+//! geometry is a `SURFACE_CURVE`: the 3D B-spline curve and a `PCURVE` on
+//! the face's surface holding the 2D B-spline curve in the surface's
+//! parameter space (a `DEFINITIONAL_REPRESENTATION` in a 2D
+//! `PARAMETRIC_REPRESENTATION_CONTEXT`), as CAD systems expect of a trimmed
+//! face. The file's uncertainty is then the larger of `1e-7` and twice the
+//! largest deviation between a 3D trim curve and its pcurve's image.
 
 use std::fmt::Write as _;
 
 use scanfit::bspline::{Curve, KnotVector, Surface};
+use scanfit::trim::{TrimCurve, TrimmedSurface};
 use scanfit::Point3;
 
+use crate::units::{CadOptions, LengthUnit};
 use crate::{Error, Result};
 
 /// Something to export.
@@ -27,6 +41,8 @@ pub enum CadItem<'a> {
     Curve(&'a Curve),
     /// A B-spline or NURBS surface.
     Surface(&'a Surface),
+    /// A surface bounded by trim curves ([`scanfit::trim::trim_surface`]).
+    Trimmed(&'a TrimmedSurface),
 }
 
 /// Entity text being written, with the next free entity id.
@@ -97,8 +113,31 @@ pub(crate) fn list<T>(items: &[T], f: impl Fn(&T) -> String) -> String {
 /// Writes `curve` (clamped or not) and returns its entity id.
 pub(crate) fn curve_entity(w: &mut Writer, c: &Curve) -> usize {
     let ids: Vec<usize> = c.control_points().iter().map(|p| w.point(p)).collect();
+    curve_on_points(w, c, &ids)
+}
+
+/// Writes a parameter-space curve (its points' `(x, y)` as 2D
+/// `CARTESIAN_POINT`s) and returns its entity id.
+fn curve_2d_entity(w: &mut Writer, c: &Curve) -> usize {
+    let ids: Vec<usize> = c
+        .control_points()
+        .iter()
+        .map(|p| {
+            w.add(&format!(
+                "CARTESIAN_POINT('',({},{}))",
+                real(p.x),
+                real(p.y)
+            ))
+        })
+        .collect();
+    curve_on_points(w, c, &ids)
+}
+
+/// The `B_SPLINE_CURVE_WITH_KNOTS` (or rational complex entity) of `c` on
+/// the already written control points `ids`.
+fn curve_on_points(w: &mut Writer, c: &Curve, ids: &[usize]) -> usize {
     let (k, m) = knots_mults(c.knots());
-    let pts = list(&ids, |i| format!("#{i}"));
+    let pts = list(ids, |i| format!("#{i}"));
     let closed = if c.is_closed() { ".T." } else { ".F." };
     let mults = list(&m, |x| x.to_string());
     let knots = list(&k, |x| real(*x));
@@ -196,9 +235,10 @@ pub(crate) struct Preamble {
     pub esc: String,
 }
 
-/// Starts a file: application context, product, units (millimetres) and a
-/// representation context whose uncertainty is `uncertainty` (length units).
-pub(crate) fn begin(name: &str, uncertainty: f64) -> (Writer, Preamble) {
+/// Starts a file: application context, product, units (`units` for
+/// lengths) and a representation context whose uncertainty is
+/// `uncertainty` (length units).
+pub(crate) fn begin(name: &str, uncertainty: f64, units: LengthUnit) -> (Writer, Preamble) {
     let mut w = Writer {
         data: String::new(),
         next: 1,
@@ -216,7 +256,7 @@ pub(crate) fn begin(name: &str, uncertainty: f64) -> (Writer, Preamble) {
     let pdf = w.add(&format!("PRODUCT_DEFINITION_FORMATION('','',#{prod})"));
     let pd = w.add(&format!("PRODUCT_DEFINITION('design','',#{pdf},#{pdc})"));
     let pds = w.add(&format!("PRODUCT_DEFINITION_SHAPE('','',#{pd})"));
-    let len = w.add("(LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.))");
+    let len = units.step_entities(|e| w.add(e));
     let ang = w.add("(NAMED_UNIT(*) PLANE_ANGLE_UNIT() SI_UNIT($,.RADIAN.))");
     let sol = w.add("(NAMED_UNIT(*) SI_UNIT($,.STERADIAN.) SOLID_ANGLE_UNIT())");
     let unc = w.add(&format!(
@@ -270,17 +310,44 @@ pub(crate) fn finish(mut w: Writer, pre: &Preamble, rep: usize, description: &st
     out
 }
 
-/// A STEP file with `items`; `name` names the product.
+/// A STEP file with `items`; `name` names the product. Lengths in millimetres.
 pub fn step_file(items: &[CadItem], name: &str) -> Result<String> {
+    step_file_with(items, name, &CadOptions::default())
+}
+
+/// A STEP file with `items`, `name` naming the product, written with `options`
+/// (the declared length unit).
+///
+/// ```
+/// use scanfit::bspline::{KnotVector, Surface};
+/// use scanfit::Point3;
+/// use scanfit_io::step::{step_file_with, CadItem};
+/// use scanfit_io::units::{CadOptions, LengthUnit};
+/// let k = KnotVector::uniform_clamped(1, 2).unwrap();
+/// let p = |x: f64, y: f64| Point3::new(x, y, 0.0);
+/// let s = Surface::new(k.clone(), k, vec![p(0., 0.), p(0., 1.), p(1., 0.), p(1., 1.)]).unwrap();
+/// let text = step_file_with(&[CadItem::Surface(&s)], "square",
+///     &CadOptions::with_units(LengthUnit::Inch)).unwrap();
+/// assert!(text.contains("CONVERSION_BASED_UNIT('INCH'"));
+/// ```
+pub fn step_file_with(items: &[CadItem], name: &str, options: &CadOptions) -> Result<String> {
     let bad = |m: String| Error::Invalid {
         path: name.into(),
         message: m,
     };
-    let (mut w, pre) = begin(name, 1e-7);
+    let deviation = items
+        .iter()
+        .filter_map(|it| match it {
+            CadItem::Trimmed(t) => Some(t.curves().map(|c| c.deviation).fold(0.0, f64::max)),
+            _ => None,
+        })
+        .fold(0.0, f64::max);
+    let (mut w, pre) = begin(name, (2.0 * deviation).max(1e-7), options.units);
     let (ctx, axis) = (pre.ctx, pre.axis);
     let esc = pre.esc.clone();
     let mut faces = Vec::new();
     let mut curves = Vec::new();
+    let mut ctx2d = None;
     for (k, item) in items.iter().enumerate() {
         match item {
             CadItem::Surface(s) => {
@@ -288,40 +355,18 @@ pub fn step_file(items: &[CadItem], name: &str) -> Result<String> {
                 let clamped = s
                     .to_clamped()
                     .map_err(|e| bad(format!("surface {k}: {e}")))?;
-                let s = &clamped;
-                let surf = surface_entity(&mut w, s);
-                let b = boundary_curves(s).map_err(|e| bad(format!("surface {k}: {e}")))?;
-                let ((u0, u1), (v0, v1)) = s.domain();
-                let corners = [
-                    s.point(u0, v0),
-                    s.point(u1, v0),
-                    s.point(u1, v1),
-                    s.point(u0, v1),
-                ];
-                let vp: Vec<usize> = corners
-                    .iter()
-                    .map(|c| {
-                        let pt = w.point(c);
-                        w.add(&format!("VERTEX_POINT('',#{pt})"))
-                    })
-                    .collect();
-                // edges: v = v0 (corner 0 -> 1), u = u1 (1 -> 2), v = v1 (3 -> 2), u = u0 (0 -> 3)
-                let ends = [(0, 1), (1, 2), (3, 2), (0, 3)];
-                let order = [0usize, 1, 2, 3];
-                let mut oes = Vec::new();
-                for (e, &(a, bb)) in order.iter().zip(&ends) {
-                    let cid = curve_entity(&mut w, &b[*e]);
-                    let ec = w.add(&format!("EDGE_CURVE('',#{},#{},#{cid},.T.)", vp[a], vp[bb]));
-                    // the loop runs 0 -> 1 -> 2 -> 3 -> 0: the last two edges backwards
-                    let sense = if *e < 2 { ".T." } else { ".F." };
-                    oes.push(w.add(&format!("ORIENTED_EDGE('',*,*,#{ec},{sense})")));
-                }
-                let lp = w.add(&format!(
-                    "EDGE_LOOP('',{})",
-                    list(&oes, |i| format!("#{i}"))
-                ));
-                let fb = w.add(&format!("FACE_OUTER_BOUND('',#{lp},.T.)"));
+                let surf = surface_entity(&mut w, &clamped);
+                let fb = rectangle_bound(&mut w, &clamped)
+                    .map_err(|e| bad(format!("surface {k}: {e}")))?;
                 faces.push(w.add(&format!("ADVANCED_FACE('',(#{fb}),#{surf},.T.)")));
+            }
+            CadItem::Trimmed(t) => {
+                let c2 = *ctx2d.get_or_insert_with(|| {
+                    w.add("(GEOMETRIC_REPRESENTATION_CONTEXT(2) PARAMETRIC_REPRESENTATION_CONTEXT() REPRESENTATION_CONTEXT('2D SPACE',''))")
+                });
+                faces.push(
+                    trimmed_face(&mut w, t, c2).map_err(|e| bad(format!("surface {k}: {e}")))?,
+                );
             }
             CadItem::Curve(c) => {
                 let clamped = c.to_clamped().map_err(|e| bad(format!("curve {k}: {e}")))?;
@@ -359,6 +404,81 @@ pub fn step_file(items: &[CadItem], name: &str) -> Result<String> {
         (None, None) => return Err(bad("nothing to export".into())),
     };
     Ok(finish(w, &pre, rep, "scanfit B-spline geometry"))
+}
+
+/// The `FACE_OUTER_BOUND` of a clamped surface's own rectangle: its four
+/// boundary curves (exact: the boundary rows and columns of the net).
+fn rectangle_bound(w: &mut Writer, s: &Surface) -> scanfit::Result<usize> {
+    let b = boundary_curves(s)?;
+    let ((u0, u1), (v0, v1)) = s.domain();
+    let corners = [
+        s.point(u0, v0),
+        s.point(u1, v0),
+        s.point(u1, v1),
+        s.point(u0, v1),
+    ];
+    let vp: Vec<usize> = corners
+        .iter()
+        .map(|c| {
+            let pt = w.point(c);
+            w.add(&format!("VERTEX_POINT('',#{pt})"))
+        })
+        .collect();
+    // edges: v = v0 (corner 0 -> 1), u = u1 (1 -> 2), v = v1 (3 -> 2), u = u0 (0 -> 3)
+    let ends = [(0, 1), (1, 2), (3, 2), (0, 3)];
+    let mut oes = Vec::new();
+    for (e, &(a, bb)) in ends.iter().enumerate() {
+        let cid = curve_entity(w, &b[e]);
+        let ec = w.add(&format!("EDGE_CURVE('',#{},#{},#{cid},.T.)", vp[a], vp[bb]));
+        // the loop runs 0 -> 1 -> 2 -> 3 -> 0: the last two edges backwards
+        let sense = if e < 2 { ".T." } else { ".F." };
+        oes.push(w.add(&format!("ORIENTED_EDGE('',*,*,#{ec},{sense})")));
+    }
+    let lp = w.add(&format!(
+        "EDGE_LOOP('',{})",
+        list(&oes, |i| format!("#{i}"))
+    ));
+    Ok(w.add(&format!("FACE_OUTER_BOUND('',#{lp},.T.)")))
+}
+
+/// One trim loop on the surface entity `surf`: a closed `EDGE_CURVE` on a
+/// `SURFACE_CURVE` (3D curve + `PCURVE` in the 2D context `ctx2d`) in an
+/// `EDGE_LOOP`; returns the loop's id.
+fn trim_loop(w: &mut Writer, c: &TrimCurve, surf: usize, ctx2d: usize) -> scanfit::Result<usize> {
+    let space = c.space.to_clamped()?;
+    let uv = c.uv.to_clamped()?;
+    let c3 = curve_entity(w, &space);
+    let c2 = curve_2d_entity(w, &uv);
+    let dr = w.add(&format!("DEFINITIONAL_REPRESENTATION('',(#{c2}),#{ctx2d})"));
+    let pc = w.add(&format!("PCURVE('',#{surf},#{dr})"));
+    let sc = w.add(&format!("SURFACE_CURVE('',#{c3},(#{pc}),.PCURVE_S1.)"));
+    let start = space.point(space.domain().0);
+    let pt = w.point(&start);
+    let vp = w.add(&format!("VERTEX_POINT('',#{pt})"));
+    let ec = w.add(&format!("EDGE_CURVE('',#{vp},#{vp},#{sc},.T.)"));
+    let oe = w.add(&format!("ORIENTED_EDGE('',*,*,#{ec},.T.)"));
+    Ok(w.add(&format!("EDGE_LOOP('',(#{oe}))")))
+}
+
+/// The `ADVANCED_FACE` of a trimmed surface; returns its id.
+fn trimmed_face(w: &mut Writer, t: &TrimmedSurface, ctx2d: usize) -> scanfit::Result<usize> {
+    let s = t.surface.to_clamped()?;
+    let surf = surface_entity(w, &s);
+    let mut bounds = vec![match &t.outer {
+        Some(o) => {
+            let lp = trim_loop(w, o, surf, ctx2d)?;
+            w.add(&format!("FACE_OUTER_BOUND('',#{lp},.T.)"))
+        }
+        None => rectangle_bound(w, &s)?,
+    }];
+    for h in &t.holes {
+        let lp = trim_loop(w, h, surf, ctx2d)?;
+        bounds.push(w.add(&format!("FACE_BOUND('',#{lp},.T.)")));
+    }
+    Ok(w.add(&format!(
+        "ADVANCED_FACE('',{},#{surf},.T.)",
+        list(&bounds, |i| format!("#{i}"))
+    )))
 }
 
 #[cfg(test)]

@@ -30,6 +30,7 @@
 use scanfit::topology::PatchComplex;
 
 use crate::step::{begin, curve_entity, finish, list, surface_entity};
+use crate::units::CadOptions;
 use crate::{Error, Result};
 
 /// Largest gap, relative to the model's size, that [`step_shell_file`]
@@ -84,6 +85,15 @@ pub struct StepShell {
 /// assert_eq!(step.text.matches("ADVANCED_FACE(").count(), 2);
 /// ```
 pub fn step_shell_file(model: &PatchComplex, name: &str) -> Result<StepShell> {
+    step_shell_file_with(model, name, &CadOptions::default())
+}
+
+/// [`step_shell_file`] written with `options` (the declared length unit).
+pub fn step_shell_file_with(
+    model: &PatchComplex,
+    name: &str,
+    options: &CadOptions,
+) -> Result<StepShell> {
     let bad = |m: String| Error::Invalid {
         path: name.into(),
         message: m,
@@ -103,7 +113,7 @@ pub fn step_shell_file(model: &PatchComplex, name: &str) -> Result<StepShell> {
         )));
     }
     let uncertainty = (2.0 * max_gap).max(1e-7);
-    let (mut w, pre) = begin(name, uncertainty);
+    let (mut w, pre) = begin(name, uncertainty, options.units);
     let (ctx, axis) = (pre.ctx, pre.axis);
     let esc = pre.esc.clone();
     let vps: Vec<usize> = model

@@ -42,6 +42,7 @@
 
 pub mod base;
 pub mod bspline;
+pub mod centring;
 pub mod cloud;
 mod error;
 pub mod fit;
@@ -60,6 +61,7 @@ pub mod spatial;
 pub mod surface;
 pub mod testdata;
 pub mod topology;
+pub mod trim;
 
 pub use cloud::PointCloud;
 pub use error::{Error, Result};

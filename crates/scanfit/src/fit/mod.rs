@@ -19,6 +19,7 @@ pub mod surface;
 pub use interpolate::{
     interpolate, interpolate_closed_with, interpolate_with, InterpolationConfig,
 };
+pub(crate) use least_squares::lsq_values;
 pub use least_squares::{
     approximate, least_squares_closed_with, least_squares_with, ApproximationConfig,
     LeastSquaresOptions,

@@ -29,11 +29,12 @@
 use std::time::Instant;
 
 use crate::bspline::Surface;
+use crate::centring::Centring;
 use crate::mba::{
     lattice_surface, sums::residual, FrameSums, Lattice, MbaConfig, MbaLevels, ResidualSums,
 };
 use crate::metrics::ParamQuality;
-use crate::pipeline::assess::{AssessConfig, SampleDistances, SurfaceQuality};
+use crate::pipeline::assess::{AssessConfig, Extent, SampleDistances, SurfaceQuality};
 use crate::pipeline::mba::LevelRow;
 use crate::pipeline::surface_fit::{FitConfig, ParameterSource};
 use crate::progress::Progress;
@@ -83,6 +84,44 @@ impl PointSource for SliceSource<'_> {
     }
 }
 
+/// A pass for the bounding box: the data's [`Centring`] (the in-memory
+/// pipelines compute relative to it) and the point count.
+fn centring_pass(source: &mut dyn PointSource) -> Result<(Centring, usize)> {
+    let (mut lo, mut hi, mut n) = (None::<Point3>, None::<Point3>, 0usize);
+    source.pass(&mut |c| {
+        for p in c.points {
+            lo = Some(lo.map_or(*p, |l| Point3::from(l.coords.inf(&p.coords))));
+            hi = Some(hi.map_or(*p, |h| Point3::from(h.coords.sup(&p.coords))));
+        }
+        n += c.points.len();
+        Ok(())
+    })?;
+    let corners: Vec<Point3> = lo.into_iter().chain(hi).collect();
+    Ok((Centring::of(&corners), n))
+}
+
+/// `source` with every chunk moved by `-centre`.
+struct Centred<'a> {
+    source: &'a mut dyn PointSource,
+    centring: Centring,
+}
+
+impl PointSource for Centred<'_> {
+    fn pass(&mut self, f: &mut dyn FnMut(Chunk<'_>) -> Result<()>) -> Result<()> {
+        let centring = self.centring;
+        self.source.pass(&mut |c| {
+            let moved;
+            let points = if centring.is_identity() {
+                c.points
+            } else {
+                moved = centring.points(c.points);
+                &moved
+            };
+            f(Chunk { points, uv: c.uv })
+        })
+    }
+}
+
 /// What [`mba`] returns.
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
@@ -126,7 +165,7 @@ pub struct StreamedMba {
 /// let r = mba(&mut source, &config, &AssessConfig::default(), &NoProgress)?;
 /// let once = mba_in_memory(&p, &config)?;
 /// assert_eq!(r.surface, lattice_surface(&once.frame, &once.lattice)?);
-/// assert_eq!(r.passes, 6); // frame, 4 levels, measures
+/// assert_eq!(r.passes, 7); // bounding box, frame, 4 levels, measures
 /// # Ok::<(), scanfit::Error>(())
 /// ```
 pub fn mba(
@@ -137,11 +176,13 @@ pub fn mba(
 ) -> Result<StreamedMba> {
     let t0 = Instant::now();
     progress.stage("pass 1: the bounding box", None);
+    let (centring, _) = centring_pass(source)?;
+    let source = &mut Centred { source, centring };
     let mut frame_sums = FrameSums::default();
     source.pass(&mut |c| frame_sums.add(c.points))?;
     let frame = frame_sums.finish()?;
     let mut run = MbaLevels::new(frame, config)?;
-    let mut passes = 1;
+    let mut passes = 2;
     let mut grid_rmse = Vec::new();
     // the residual statistics of a level come from the pass after it
     let mut recorded = true;
@@ -221,7 +262,7 @@ pub fn mba(
         })
         .collect();
     Ok(StreamedMba {
-        surface,
+        surface: centring.restore(surface),
         cells: (result.lattice.m, result.lattice.n),
         levels,
         passes,
@@ -258,6 +299,8 @@ pub struct StreamedFit {
     pub surface: Surface,
     /// Passes made over the points.
     pub passes: usize,
+    /// The thin-plate weight used (after the pipeline's scaling rule).
+    pub smoothing: f64,
     /// The streamed measures (see the module documentation).
     pub quality: SurfaceQuality,
 }
@@ -279,10 +322,9 @@ pub struct StreamedFit {
 ///     p.push(Point3::new(u, v, (2.0 * u).sin() * v));
 ///     uv.push([u, v]);
 /// }
-/// let mut cfg = FitConfig::default();
+/// let mut cfg = FitConfig::bare((8, 8));
 /// cfg.params = ParameterSource::uv_attributes();
 /// cfg.fit.knots = KnotPlacement::Uniform;
-/// cfg.fit.ctrl = (8, 8);
 /// let mut source = SliceSource { points: &p, uv: Some(&uv), chunk: 1000 };
 /// let r = fit(&mut source, &cfg, &NoProgress)?;
 /// let once = scanfit::fit::surface::fit_surface(&p, &uv, &cfg.fit)?;
@@ -314,8 +356,11 @@ pub fn fit(
             "parameter correction re-projects every point in each round and keeps their parameters; leave it out",
         ));
     }
-    let mut eq = config.fit.uniform_equations()?;
-    let (cu, cv) = config.fit.ctrl;
+    let (centring, count) = centring_pass(source)?;
+    let source = &mut Centred { source, centring };
+    let fit_config = config.resolved_fit(count);
+    let mut eq = fit_config.uniform_equations()?;
+    let (cu, cv) = fit_config.ctrl;
     progress.stage(
         &format!("pass 1: normal equations of {cu} x {cv} control points"),
         None,
@@ -324,14 +369,15 @@ pub fn fit(
         let uv = chunk_uv(&c)?;
         eq.add(c.points, uv, None)
     })?;
-    let surface = eq.finish(config.fit.smoothing)?;
+    let surface = eq.finish(fit_config.smoothing)?;
     progress.stage("pass 2: measuring", None);
     let mut assessor = StreamAssessor::new(&surface, &config.assess)?;
     source.pass(&mut |c| assessor.add(c.points, chunk_uv(&c)?))?;
     Ok(StreamedFit {
         quality: assessor.finish(),
-        surface,
-        passes: 2,
+        surface: centring.restore(surface),
+        passes: 3,
+        smoothing: fit_config.smoothing,
     })
 }
 
@@ -369,6 +415,11 @@ impl NearestSums {
         Ok(())
     }
 
+    /// The query points.
+    pub fn queries(&self) -> &[Point3] {
+        &self.queries
+    }
+
     /// The distances so far.
     pub fn distances(&self) -> &[f64] {
         &self.best
@@ -394,6 +445,8 @@ pub struct StreamAssessor<'s> {
     grid: (usize, usize),
     far_spacings: f64,
     spacing: Option<f64>,
+    config: AssessConfig,
+    bounds: Option<(Point3, Point3)>,
 }
 
 impl<'s> StreamAssessor<'s> {
@@ -411,6 +464,8 @@ impl<'s> StreamAssessor<'s> {
             grid,
             far_spacings: config.far_spacings,
             spacing: None,
+            config: *config,
+            bounds: None,
         })
     }
 
@@ -433,6 +488,11 @@ impl<'s> StreamAssessor<'s> {
         }
         self.knots.add(points)?;
         self.samples.add(points)?;
+        for p in points {
+            let (lo, hi) = self.bounds.get_or_insert((*p, *p));
+            *lo = lo.inf(p);
+            *hi = hi.sup(p);
+        }
         if self.spacing.is_none() && points.len() >= 2 {
             self.spacing = Some(PointCloud::new(points.to_vec())?.spacing()?.median);
         }
@@ -445,6 +505,16 @@ impl<'s> StreamAssessor<'s> {
         let d = self.samples.distances();
         let limit = self.far_spacings * spacing;
         let far = d.iter().filter(|&&x| x > limit).count();
+        let extent = match self.bounds {
+            Some(b) => crate::pipeline::assess::extent_in_box(
+                self.surface,
+                b,
+                self.samples.queries(),
+                spacing,
+                &self.config,
+            ),
+            None => Extent::default(),
+        };
         SurfaceQuality {
             points: usize::try_from(self.at_parameters.count).unwrap_or(usize::MAX),
             at_parameters: self.at_parameters.stats(),
@@ -459,6 +529,7 @@ impl<'s> StreamAssessor<'s> {
                 far_share: far as f64 / d.len().max(1) as f64,
             },
             parameterization: ParamQuality::default(),
+            extent,
         }
     }
 }
@@ -499,7 +570,7 @@ mod tests {
             };
             let r = mba(&mut s, &cfg.mba, &cfg.assess, &NoProgress).unwrap();
             assert_eq!(r.surface, once.surface, "chunk {chunk}");
-            assert_eq!(r.passes, 7);
+            assert_eq!(r.passes, 8);
             let (a, b) = (r.quality, once.assessment.quality);
             let close = |x: f64, y: f64| (x - y).abs() <= 1e-12 * y.abs().max(1e-300);
             assert!(
