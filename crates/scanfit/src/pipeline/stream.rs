@@ -603,8 +603,10 @@ mod tests {
             .unwrap()
             .with_attribute("v", uv.iter().map(|t| t[1]).collect())
             .unwrap();
-        let mut cfg = FitConfig::default();
-        cfg.params = ParameterSource::uv_attributes();
+        let mut cfg = FitConfig {
+            params: ParameterSource::uv_attributes(),
+            ..Default::default()
+        };
         cfg.fit.knots = KnotPlacement::Uniform;
         cfg.fit.ctrl = (20, 14);
         cfg.fit.smoothing = 1e-9;
