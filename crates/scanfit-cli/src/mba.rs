@@ -217,6 +217,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
     let progress = Progress::spinner(a.quiet || a.json);
     progress.stage(format!("reading {}", a.input.input.display()));
     let cloud = a.outliers.apply(a.input.load(a.json)?, a.json)?;
+    note_lattice(&a, cloud.points());
     let input = &a.input.input;
     let options = [
         ("base", "--base"),
@@ -287,6 +288,29 @@ pub fn run(a: MbaArgs) -> Result<()> {
     crate::cad::print_trim(trimmed.as_ref())?;
     print_written(&files, a.out.png.as_deref(), exaggeration)?;
     Ok(())
+}
+
+/// Tells on stderr, before any work, when the last level's lattice has more
+/// control values than there are points (most of them then see no data),
+/// with the memory it takes.
+fn note_lattice(a: &MbaArgs, points: &[scanfit::Point3]) {
+    let base = a.base.or_else(|| {
+        scanfit::mba::Frame::of(points)
+            .ok()
+            .map(|f| f.default_base())
+    });
+    let Some(values) = base.and_then(|b| scanfit::mba::last_lattice_values(b, a.levels)) else {
+        return;
+    };
+    if values > 4 * points.len() && !a.quiet && !a.json {
+        // BA sums (2), the level, the combined lattice and its refinement
+        let mib = (values * 8 * 5) as f64 / (1 << 20) as f64;
+        crate::print_stderr(format_args!(
+            "note: --levels {} ends on a lattice of {values} control values (about {mib:.0} MiB and a pass over all of them per level) for {} points; most control values see no data; fewer levels give the same fit near the points",
+            a.levels,
+            points.len()
+        ));
+    }
 }
 
 fn print_report(a: &MbaArgs, r: &MbaReport) -> Result<()> {

@@ -158,7 +158,7 @@ pub fn fit(a: &FitArgs, chunk: usize) -> Result<()> {
         Some(name.into()),
         &a.input.input,
         q.points,
-        a.settings(&r.surface, r.smoothing),
+        a.settings(r.surface.counts(), r.smoothing),
     ));
     doc.quality = Some(quality_doc(q, Vec::new()));
     let deviation = Deviation {

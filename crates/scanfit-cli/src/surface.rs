@@ -134,11 +134,11 @@ impl FitArgs {
         c
     }
 
-    /// The settings recorded in the surface document (the net and weight
-    /// the fit used).
+    /// The settings recorded in the surface document (the net `(cu, cv)`
+    /// and thin-plate weight the fit used).
     pub(crate) fn settings(
         &self,
-        surface: &scanfit::bspline::Surface,
+        (cu, cv): (usize, usize),
         smoothing: f64,
     ) -> BTreeMap<String, serde_json::Value> {
         let mut s = BTreeMap::new();
@@ -146,7 +146,6 @@ impl FitArgs {
             "degree".into(),
             serde_json::json!([self.degree.0, self.degree.1]),
         );
-        let (cu, cv) = surface.counts();
         s.insert("ctrl".into(), serde_json::json!([cu, cv]));
         s.insert("knots".into(), name(&self.knots).into());
         s.insert("smoothing".into(), smoothing.into());
@@ -218,7 +217,7 @@ pub fn run(a: FitArgs) -> Result<()> {
         Some(name(&a.params)),
         &a.input.input,
         pts.len(),
-        a.settings(&r.surface, r.smoothing),
+        a.settings(r.surface.counts(), r.smoothing),
     ));
     doc.quality = Some(quality.clone());
     let dist = r.assessment.distances();

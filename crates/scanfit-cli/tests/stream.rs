@@ -52,7 +52,7 @@ fn streamed_mba_writes_the_in_memory_surface() {
         ok(&out);
         assert_eq!(surface(&a), surface(&b), "chunk {chunk}");
         let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-        assert_eq!(report["streamed"]["passes"], 7);
+        assert_eq!(report["streamed"]["passes"], 8);
         assert_eq!(report["point_count"], 50_000);
     }
     let e = scanfit(&["mba", sample, "--adjust", "--chunk-points", "1000"]);

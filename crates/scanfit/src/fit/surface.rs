@@ -130,7 +130,54 @@ fn check_net(cfg: &SurfaceFitConfig) -> Result<()> {
             "a {nu} x {nv} control net of degrees {p} x {q} is beyond the limits ({MAX_SURFACE_CONTROL_POINTS} control points, degree 10); choose a smaller net"
         )));
     }
+    let bytes = memory_estimate(cfg);
+    if bytes > MAX_FIT_BYTES {
+        // the largest square net of these degrees under the limit
+        let per = |k: usize| {
+            memory_estimate(&SurfaceFitConfig {
+                ctrl: (k, k),
+                ..cfg.clone()
+            })
+        };
+        let side = (p.max(q) + 1..=2048)
+            .take_while(|&k| per(k) <= MAX_FIT_BYTES)
+            .last();
+        return Err(Error::InvalidSetting {
+            setting: "ctrl",
+            value: format!("{nu} x {nv}"),
+            hint: format!(
+                "a {nu} x {nv} net of degrees {p} x {q} needs about {:.1} GiB for its normal equations and their Cholesky factor (limit {} GiB); use at most {} control points",
+                bytes as f64 / (1u64 << 30) as f64,
+                MAX_FIT_BYTES >> 30,
+                side.map_or("fewer".into(), |k| format!("{k} x {k}"))
+            ),
+        });
+    }
     Ok(())
+}
+
+/// Most bytes a least-squares surface fit may plan for (4 GiB).
+pub const MAX_FIT_BYTES: usize = 4 << 30;
+
+/// Bytes a least-squares fit of `cfg`'s net takes, about: the band-block
+/// normal equations and one partial sum (`nu nv ((2p+1)(2q+1) + 3)` values
+/// each) plus a Cholesky factor of about `nu nv min(nu, nv) (p + 1)` values
+/// (the fill of a banded ordering), whatever the number of points.
+///
+/// ```
+/// use scanfit::fit::surface::{memory_estimate, SurfaceFitConfig};
+/// let small = memory_estimate(&SurfaceFitConfig { ctrl: (100, 100), ..Default::default() });
+/// let big = memory_estimate(&SurfaceFitConfig { ctrl: (1000, 1000), ..Default::default() });
+/// assert!(small < 100 << 20 && big > 16 << 30);
+/// ```
+pub fn memory_estimate(cfg: &SurfaceFitConfig) -> usize {
+    let ((p, q), (nu, nv)) = (cfg.degree, cfg.ctrl);
+    let n = nu.saturating_mul(nv);
+    let band = n.saturating_mul((2 * p + 1) * (2 * q + 1) + 3);
+    let factor = n.saturating_mul(nu.min(nv)).saturating_mul(p.min(q) + 1);
+    band.saturating_mul(2)
+        .saturating_add(factor)
+        .saturating_mul(8)
 }
 
 impl SurfaceFitConfig {
@@ -398,7 +445,7 @@ impl NormalEquations {
                 ),
             });
         }
-        let sol = solve(acc, rhs, &l)?;
+        let sol = solve(acc, rhs, &l, smoothing)?;
         // unfold into the control net (repeating the first p rows when periodic)
         let nu_total = ku.basis_count();
         let mut ctrl = Vec::with_capacity(nu_total * nv);
@@ -678,7 +725,12 @@ fn add_thin_plate(acc: &mut [f64], ku: &KnotVector, kv: &KnotVector, lambda: f64
 }
 
 /// Sparse Cholesky of the lower triangle, three right-hand sides.
-fn solve(acc: Vec<f64>, rhs: Vec<f64>, l: &Layout) -> Result<Mat<f64>> {
+fn solve(acc: Vec<f64>, rhs: Vec<f64>, l: &Layout, smoothing: f64) -> Result<Mat<f64>> {
+    let remedy = if smoothing > 0.0 {
+        "use fewer control points or a larger smoothing weight"
+    } else {
+        "add smoothing or use fewer control points"
+    };
     let n = l.nu * l.nv;
     let s = l.slots();
     let mut trip = Vec::with_capacity(n * (s / 2 + 1));
@@ -703,14 +755,14 @@ fn solve(acc: Vec<f64>, rhs: Vec<f64>, l: &Layout) -> Result<Mat<f64>> {
     let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &trip)
         .map_err(|e| singular(format!("could not build the sparse matrix: {e:?}")))?;
     let llt = a.sp_cholesky(Side::Lower).map_err(|_| {
-        singular(
-            "the normal equations are not positive definite: the parameters do not spread over the control net (e.g. too few distinct u or v values); add smoothing or use fewer control points".into(),
-        )
+        singular(format!(
+            "the normal equations are not positive definite: the parameters do not spread over the control net (e.g. too few distinct u or v values); {remedy}"
+        ))
     })?;
     let mut x = Mat::<f64>::from_fn(n, 3, |i, c| rhs[i * 3 + c]);
     llt.solve_in_place(&mut x);
     if x.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
-        return Err(singular("the solution is not finite; add smoothing".into()));
+        return Err(singular(format!("the solution is not finite; {remedy}")));
     }
     Ok(x)
 }

@@ -29,6 +29,7 @@
 use std::time::Instant;
 
 use crate::bspline::Surface;
+use crate::centring::Centring;
 use crate::mba::{
     lattice_surface, sums::residual, FrameSums, Lattice, MbaConfig, MbaLevels, ResidualSums,
 };
@@ -83,6 +84,44 @@ impl PointSource for SliceSource<'_> {
     }
 }
 
+/// A pass for the bounding box: the data's [`Centring`] (the in-memory
+/// pipelines compute relative to it) and the point count.
+fn centring_pass(source: &mut dyn PointSource) -> Result<(Centring, usize)> {
+    let (mut lo, mut hi, mut n) = (None::<Point3>, None::<Point3>, 0usize);
+    source.pass(&mut |c| {
+        for p in c.points {
+            lo = Some(lo.map_or(*p, |l| Point3::from(l.coords.inf(&p.coords))));
+            hi = Some(hi.map_or(*p, |h| Point3::from(h.coords.sup(&p.coords))));
+        }
+        n += c.points.len();
+        Ok(())
+    })?;
+    let corners: Vec<Point3> = lo.into_iter().chain(hi).collect();
+    Ok((Centring::of(&corners), n))
+}
+
+/// `source` with every chunk moved by `-centre`.
+struct Centred<'a> {
+    source: &'a mut dyn PointSource,
+    centring: Centring,
+}
+
+impl PointSource for Centred<'_> {
+    fn pass(&mut self, f: &mut dyn FnMut(Chunk<'_>) -> Result<()>) -> Result<()> {
+        let centring = self.centring;
+        self.source.pass(&mut |c| {
+            let moved;
+            let points = if centring.is_identity() {
+                c.points
+            } else {
+                moved = centring.points(c.points);
+                &moved
+            };
+            f(Chunk { points, uv: c.uv })
+        })
+    }
+}
+
 /// What [`mba`] returns.
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
@@ -126,7 +165,7 @@ pub struct StreamedMba {
 /// let r = mba(&mut source, &config, &AssessConfig::default(), &NoProgress)?;
 /// let once = mba_in_memory(&p, &config)?;
 /// assert_eq!(r.surface, lattice_surface(&once.frame, &once.lattice)?);
-/// assert_eq!(r.passes, 6); // frame, 4 levels, measures
+/// assert_eq!(r.passes, 7); // bounding box, frame, 4 levels, measures
 /// # Ok::<(), scanfit::Error>(())
 /// ```
 pub fn mba(
@@ -137,11 +176,13 @@ pub fn mba(
 ) -> Result<StreamedMba> {
     let t0 = Instant::now();
     progress.stage("pass 1: the bounding box", None);
+    let (centring, _) = centring_pass(source)?;
+    let source = &mut Centred { source, centring };
     let mut frame_sums = FrameSums::default();
     source.pass(&mut |c| frame_sums.add(c.points))?;
     let frame = frame_sums.finish()?;
     let mut run = MbaLevels::new(frame, config)?;
-    let mut passes = 1;
+    let mut passes = 2;
     let mut grid_rmse = Vec::new();
     // the residual statistics of a level come from the pass after it
     let mut recorded = true;
@@ -221,7 +262,7 @@ pub fn mba(
         })
         .collect();
     Ok(StreamedMba {
-        surface,
+        surface: centring.restore(surface),
         cells: (result.lattice.m, result.lattice.n),
         levels,
         passes,
@@ -258,11 +299,10 @@ pub struct StreamedFit {
     pub surface: Surface,
     /// Passes made over the points.
     pub passes: usize,
+    /// The thin-plate weight used (after the pipeline's scaling rule).
+    pub smoothing: f64,
     /// The streamed measures (see the module documentation).
     pub quality: SurfaceQuality,
-    /// The thin-plate weight used (scaled to the point count unless
-    /// [`FitConfig::relative_smoothing`] is `None`).
-    pub smoothing: f64,
 }
 
 /// The least-squares surface of the points of `source` (parameters from
@@ -282,12 +322,9 @@ pub struct StreamedFit {
 ///     p.push(Point3::new(u, v, (2.0 * u).sin() * v));
 ///     uv.push([u, v]);
 /// }
-/// let mut cfg = FitConfig::default();
+/// let mut cfg = FitConfig::bare((8, 8));
 /// cfg.params = ParameterSource::uv_attributes();
 /// cfg.fit.knots = KnotPlacement::Uniform;
-/// cfg.fit.ctrl = (8, 8);
-/// cfg.ctrl_from_density = false;
-/// cfg.relative_smoothing = None;
 /// let mut source = SliceSource { points: &p, uv: Some(&uv), chunk: 1000 };
 /// let r = fit(&mut source, &cfg, &NoProgress)?;
 /// let once = scanfit::fit::surface::fit_surface(&p, &uv, &cfg.fit)?;
@@ -319,43 +356,28 @@ pub fn fit(
             "parameter correction re-projects every point in each round and keeps their parameters; leave it out",
         ));
     }
-    // the net from the point density needs the count first: one more pass
-    let mut passes = 2;
-    let fit = if config.ctrl_from_density {
-        progress.stage("pass 0: counting the points", None);
-        let mut n = 0usize;
-        source.pass(&mut |c| {
-            n += c.points.len();
-            Ok(())
-        })?;
-        passes += 1;
-        config.resolved_fit(n)
-    } else {
-        config.fit.clone()
-    };
-    let mut eq = fit.uniform_equations()?;
-    let (cu, cv) = fit.ctrl;
+    let (centring, count) = centring_pass(source)?;
+    let source = &mut Centred { source, centring };
+    let fit_config = config.resolved_fit(count);
+    let mut eq = fit_config.uniform_equations()?;
+    let (cu, cv) = fit_config.ctrl;
     progress.stage(
         &format!("pass 1: normal equations of {cu} x {cv} control points"),
         None,
     );
-    let mut n = 0usize;
     source.pass(&mut |c| {
         let uv = chunk_uv(&c)?;
-        n += c.points.len();
         eq.add(c.points, uv, None)
     })?;
-    // the thin-plate weight scaled to the count, as the in-memory pipeline
-    let smoothing = config.resolved_fit(n).smoothing;
-    let surface = eq.finish(smoothing)?;
+    let surface = eq.finish(fit_config.smoothing)?;
     progress.stage("pass 2: measuring", None);
     let mut assessor = StreamAssessor::new(&surface, &config.assess)?;
     source.pass(&mut |c| assessor.add(c.points, chunk_uv(&c)?))?;
     Ok(StreamedFit {
         quality: assessor.finish(),
-        surface,
-        passes,
-        smoothing,
+        surface: centring.restore(surface),
+        passes: 3,
+        smoothing: fit_config.smoothing,
     })
 }
 
@@ -548,7 +570,7 @@ mod tests {
             };
             let r = mba(&mut s, &cfg.mba, &cfg.assess, &NoProgress).unwrap();
             assert_eq!(r.surface, once.surface, "chunk {chunk}");
-            assert_eq!(r.passes, 7);
+            assert_eq!(r.passes, 8);
             let (a, b) = (r.quality, once.assessment.quality);
             let close = |x: f64, y: f64| (x - y).abs() <= 1e-12 * y.abs().max(1e-300);
             assert!(
@@ -587,8 +609,6 @@ mod tests {
         };
         cfg.fit.knots = KnotPlacement::Uniform;
         cfg.fit.ctrl = (20, 14);
-        cfg.ctrl_from_density = false;
-        cfg.relative_smoothing = None;
         cfg.fit.smoothing = 1e-9;
         let once = surface_fit::run(&cloud, &cfg, &NoProgress).unwrap();
         let mut s = SliceSource {
@@ -598,16 +618,6 @@ mod tests {
         };
         let r = fit(&mut s, &cfg, &NoProgress).unwrap();
         assert_eq!(r.surface, once.surface);
-        // the safe defaults (net from the density, weight scaled to the
-        // count) give the in-memory surface too, after a counting pass
-        let mut dflt = FitConfig::default();
-        dflt.params = ParameterSource::uv_attributes();
-        dflt.fit.knots = KnotPlacement::Uniform;
-        let once_default = surface_fit::run(&cloud, &dflt, &NoProgress).unwrap();
-        let streamed_default = fit(&mut s, &dflt, &NoProgress).unwrap();
-        assert_eq!(streamed_default.passes, 3);
-        assert_eq!(streamed_default.surface, once_default.surface);
-        assert!(streamed_default.smoothing > 0.0);
         let (a, b) = (r.quality, once.assessment.quality);
         assert!(
             (a.at_parameters.rmse - b.at_parameters.rmse).abs() <= 1e-12 * b.at_parameters.rmse
