@@ -652,7 +652,7 @@ mod tests {
             .sides
             .iter()
             .all(|s| matches!(s, Some(SideChain::One(_)))));
-        let text = doc.to_json();
+        let text = doc.to_json().unwrap();
         let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
         // the same side as a one-edge list reads to the same model
         let side = v["patches"][0]["sides"][1].clone();
@@ -664,10 +664,10 @@ mod tests {
         chained.faces[0].sides[1] = vec![m.faces[0].sides[1][0]; 2];
         let d = ModelDoc::new(&chained);
         assert!(matches!(&d.patches[0].sides[1], Some(SideChain::Chain(c)) if c.len() == 2));
-        let back: ModelDoc = serde_json::from_str(&d.to_json()).unwrap();
+        let back: ModelDoc = serde_json::from_str(&d.to_json().unwrap()).unwrap();
         assert_eq!(back.patches[0].sides, d.patches[0].sides);
         // which the topology check then refuses (not a cycle), naming the patch
-        let e = parse_model(Path::new("m.json"), &d.to_json())
+        let e = parse_model(Path::new("m.json"), &d.to_json().unwrap())
             .unwrap_err()
             .to_string();
         assert!(e.contains("closed cycle"), "{e}");
