@@ -330,17 +330,23 @@ impl InputArgs {
     /// Reads the file with this group's options; the reader's warnings (a
     /// header count that disagrees with the data, ...) go to stderr.
     fn read(&self) -> Result<PointTable> {
-        let options = ReadOptions {
+        let table = read_cloud(&self.input, &self.options())?;
+        crate::print_warnings(&table.warnings);
+        Ok(table)
+    }
+}
+
+impl InputArgs {
+    /// The reader's options from `--format` and `--drop-non-finite`.
+    pub fn options(&self) -> ReadOptions {
+        ReadOptions {
             format: self.format.map(Format::from),
             non_finite: if self.drop_non_finite {
                 NonFinite::Drop
             } else {
                 NonFinite::Reject
             },
-        };
-        let table = read_cloud(&self.input, &options)?;
-        crate::print_warnings(&table.warnings);
-        Ok(table)
+        }
     }
 }
 

@@ -41,6 +41,8 @@ pub enum CloudCommand {
     Hpr(HprArgs),
     /// Boundary loop of a sheet-like patch (alpha shape), its corners and sides.
     Boundary(BoundaryArgs),
+    /// Regions between sharp edges (normal variation, octree cells) as a `label` property.
+    Segment(crate::segment::SegmentArgs),
 }
 
 /// `--criterion`: the corner measure (`cloud boundary`, `coons`).
@@ -271,6 +273,7 @@ pub fn run(c: CloudCommand) -> Result<()> {
         CloudCommand::Normals(a) => normals(a),
         CloudCommand::Hpr(a) => hpr(a),
         CloudCommand::Boundary(a) => boundary(a),
+        CloudCommand::Segment(a) => crate::segment::run(a),
     }
 }
 
@@ -301,7 +304,7 @@ fn info(a: InfoArgs) -> Result<()> {
     .with_context(|| a.input.input.display().to_string())?;
     if a.json {
         let (lo, hi) = (r.bbox_min, r.bbox_max);
-        let report = serde_json::json!({
+        let mut report = serde_json::json!({
             "file": a.input.input.display().to_string(),
             "points": r.points,
             "dropped_non_finite": dropped,
@@ -309,10 +312,15 @@ fn info(a: InfoArgs) -> Result<()> {
             "bbox_max": [hi.x, hi.y, hi.z],
             "diagonal": r.diagonal,
             "attributes": r.attributes.iter().map(|at| serde_json::json!({"name": at.name, "min": at.min, "max": at.max})).collect::<Vec<_>>(),
-            "spacing": r.spacing.map(|s| serde_json::json!({"min": s.min, "median": s.median, "mean": s.mean, "max": s.max, "duplicates": s.duplicates})),
             "read_seconds": read_s,
         });
-        outln!("{}", serde_json::to_string_pretty(&report)?);
+        if let Some(s) = r.spacing {
+            report["spacing"] = serde_json::json!({"min": s.min, "median": s.median, "mean": s.mean, "max": s.max, "duplicates": s.duplicates, "measured_points": s.measured, "sampled": s.measured < r.points});
+        }
+        out!(
+            "{}",
+            scanfit_io::json::finite_json(&report, "the JSON report")?
+        );
         return Ok(());
     }
     print_info(&a.input.input, &r, read_s)?;
@@ -358,6 +366,13 @@ fn print_info(input: &Path, r: &CloudInfo, read_s: f64) -> Result<()> {
             t.row(vec![n.to_string(), num(v)]);
         }
         out!("{}", t.render());
+        if s.measured < r.points {
+            outln!(
+                "(nearest-neighbour distances of a seeded random sample of {} of the {} points)",
+                s.measured,
+                r.points
+            );
+        }
         if s.duplicates > 0 {
             outln!("{} points coincide with another point", s.duplicates);
         }
@@ -465,7 +480,10 @@ fn print_normals(
             "mean_variation": r.mean_variation,
             "seconds": secs,
         });
-        outln!("{}", serde_json::to_string_pretty(&report)?);
+        out!(
+            "{}",
+            scanfit_io::json::finite_json(&report, "the JSON report")?
+        );
         return Ok(());
     }
     let mut t = Table::new(&["normals", "value"], &[true]);
@@ -584,7 +602,10 @@ fn hpr(a: HprArgs) -> Result<()> {
             "gamma": a.gamma,
             "seconds": secs,
         });
-        outln!("{}", serde_json::to_string_pretty(&report)?);
+        out!(
+            "{}",
+            scanfit_io::json::finite_json(&report, "the JSON report")?
+        );
         return Ok(());
     }
     let mut t = Table::new(&["hidden point removal", "value"], &[true]);
@@ -815,7 +836,7 @@ fn boundary(a: BoundaryArgs) -> Result<()> {
     let mut files: Files = Vec::new();
     if let Some(o) = &a.output {
         let bytes = if extension(o) == "json" {
-            serde_json::to_string_pretty(&doc)?.into_bytes()
+            scanfit_io::json::finite_json(&doc, &o.display().to_string())?.into_bytes()
         } else {
             cloud_file(o, &r.loop_cloud()?)?
         };
@@ -828,7 +849,10 @@ fn boundary(a: BoundaryArgs) -> Result<()> {
     write_all_atomic(&files)?;
     progress.finish();
     if a.json {
-        outln!("{}", serde_json::to_string_pretty(&doc)?);
+        out!(
+            "{}",
+            scanfit_io::json::finite_json(&doc, "the JSON report")?
+        );
         return Ok(());
     }
     print_boundary(&cloud, &r, secs)?;

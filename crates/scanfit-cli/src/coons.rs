@@ -13,6 +13,7 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use scanfit::base::{BoundaryFit, CoonsProjection, Sides};
 use scanfit::cloud::corners::CornerCriterion;
+use scanfit::fit::surface::SurfaceFitConfig;
 use scanfit::pde::PdeConfig;
 use scanfit::pipeline::coons::{run as coons, CoonsConfig, CoonsReport, CoonsRoute};
 use scanfit::project::{GridIterationConfig, InversionConfig};
@@ -156,9 +157,11 @@ pub struct CoonsArgs {
     /// Surface route: `bspline` (Coons paper) or `pde` (PDE paper; implied by --pde).
     #[arg(long, value_name = "ROUTE", value_parser = choice::<RouteArg>())]
     pub fit: Option<RouteArg>,
-    /// Control net of the least-squares surface (bspline route), "NUxNV" or "N".
-    #[arg(long, default_value = "20x20", value_name = "NUxNV", value_parser = NXM)]
-    pub ctrl: (usize, usize),
+    /// Control net of the least-squares surface (bspline route), "NUxNV" or
+    /// "N" [default: from the point density, round(sqrt(points / 16)) per
+    /// direction, 5 to 32].
+    #[arg(long, value_name = "NUxNV", value_parser = NXM)]
+    pub ctrl: Option<(usize, usize)>,
     /// Degrees of the least-squares surface (bspline route), "PxQ" or "P".
     #[arg(long, default_value = "3x3", value_name = "PxQ", value_parser = NXM)]
     pub degree: (usize, usize),
@@ -175,9 +178,19 @@ pub struct CoonsArgs {
     /// Grid step h of --params grid (Coons paper: 0.001).
     #[arg(long, default_value_t = 0.001, value_name = "H")]
     pub h: f64,
-    /// Convergence threshold epsilon of --params grid, data units (Coons paper: 0.01).
-    #[arg(long, default_value_t = 0.01, value_name = "EPS")]
-    pub epsilon: f64,
+    /// Convergence threshold epsilon of --params grid, data units (Coons
+    /// paper: 0.01) [default: 1e-3 x the bounding-box diagonal].
+    #[arg(long, value_name = "EPS")]
+    pub epsilon: Option<f64>,
+    /// Thin-plate smoothing weight λ of --fit bspline (0 = the bare
+    /// least-squares fit) [default: scaled to the data, 0.001 x points /
+    /// (NU x NV)²].
+    #[arg(long, value_name = "L", allow_negative_numbers = true)]
+    pub smooth: Option<f64>,
+    /// Fit on the detected corners even when they are not clearly corners
+    /// (turning by less than 30 degrees, or one side over 60% of the loop).
+    #[arg(long)]
+    pub force_corners: bool,
     /// Largest deviation of the exported B-spline from the PDE surface, data
     /// units [default: 1e-4 x the bounding-box diagonal].
     #[arg(long, value_name = "T")]
@@ -213,7 +226,21 @@ fn config(a: &CoonsArgs) -> Result<CoonsConfig> {
     };
     let mut cfg = CoonsConfig::default();
     cfg.route = match pde_terms {
-        None => CoonsRoute::bspline(a.degree, a.ctrl),
+        None => {
+            let mut f = SurfaceFitConfig {
+                degree: a.degree,
+                ..Default::default()
+            };
+            if let Some(ctrl) = a.ctrl {
+                f.ctrl = ctrl;
+                cfg.ctrl_from_density = false;
+            }
+            if let Some(l) = a.smooth {
+                f.smoothing = l;
+                cfg.relative_smoothing = None;
+            }
+            CoonsRoute::Bspline(f)
+        }
         Some((m, n)) => CoonsRoute::Pde {
             pde: PdeConfig {
                 m,
@@ -230,11 +257,15 @@ fn config(a: &CoonsArgs) -> Result<CoonsConfig> {
     cfg.projection = Some(match params {
         ParamsArg::Grid => CoonsProjection::GridIteration(GridIterationConfig {
             h: a.h,
-            epsilon: a.epsilon,
+            epsilon: a.epsilon.unwrap_or(GridIterationConfig::default().epsilon),
             ..Default::default()
         }),
         ParamsArg::Closest => CoonsProjection::Inversion(InversionConfig::default()),
     });
+    if a.epsilon.is_some() {
+        cfg.relative_epsilon = None;
+    }
+    cfg.base.force_corners = a.force_corners;
     cfg.base.boundary.alpha = a.alpha;
     cfg.base.boundary.alpha_factor = a.alpha_factor;
     cfg.base.corners.criterion = CornerCriterion::from(a.criterion);
@@ -272,11 +303,24 @@ pub fn run(a: CoonsArgs) -> Result<()> {
     let cloud = a.input.load(a.json)?;
     let r = coons(&cloud, &cfg, &progress)
         .map_err(|e| {
-            let note = option_note(&e, &[("export_tolerance", "--export-tolerance")]);
+            let note = option_note(
+                &e,
+                &[
+                    ("export_tolerance", "--export-tolerance"),
+                    (
+                        "corners",
+                        "--corners I,J,K,L with loop positions from `scanfit cloud boundary`, or --force-corners",
+                    ),
+                ],
+            );
             anyhow::anyhow!("{e}{note}")
         })
         .with_context(|| format!("Coons patch of {input} ({} sides)", a.sides.count()))?;
     let secs = t0.elapsed().as_secs_f64();
+    a.out.guard(
+        &r.assessment.quality,
+        "check the corners (--corners), use fewer control points (--ctrl) or fewer PDE terms (--pde)",
+    )?;
     progress.stage("writing");
     let pts = cloud.points();
     let boundary = Some(&r.base.boundary);
@@ -314,7 +358,8 @@ fn document(a: &CoonsArgs, points: usize, r: &CoonsReport) -> SurfaceDoc {
             settings.insert("export_deviation".into(), p.export_deviation.into());
         }
         None => {
-            settings.insert("ctrl".into(), serde_json::json!([a.ctrl.0, a.ctrl.1]));
+            let (cu, cv) = r.surface.counts();
+            settings.insert("ctrl".into(), serde_json::json!([cu, cv]));
             settings.insert("degree".into(), serde_json::json!([a.degree.0, a.degree.1]));
         }
     }
@@ -439,7 +484,7 @@ fn print_json(
     let (dp, dq) = r.surface.degrees();
     let q = &r.assessment.quality;
     let par = &r.parameters;
-    let report = serde_json::json!({
+    let mut report = serde_json::json!({
         "input": a.input.input.display().to_string(),
         "point_count": points.len(),
         "sides": a.sides.count(),
@@ -454,6 +499,7 @@ fn print_json(
                 "index": outer[k],
                 "point": [p.x, p.y, p.z],
                 "angle_degrees": ang.to_degrees(),
+                "turning_degrees": 180.0 - ang.to_degrees(),
             })
         }).collect::<Vec<_>>(),
         "curves": r.base.curves.iter().zip(&r.base.side_points).map(|(c, s)| serde_json::json!({
@@ -474,12 +520,18 @@ fn print_json(
         "fit_error": stats_json(&q.at_parameters),
         "orthogonal": stats_json(&q.orthogonal),
         "surface_to_points": samples_json(q),
-        "export_deviation": r.pde.as_ref().map(|p| p.export_deviation),
         "surface": {"degree": [dp, dq], "control_points": [cu, cv]},
         "seconds": secs,
         "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
     });
-    outln!("{}", serde_json::to_string_pretty(&report)?);
+    if let Some(p) = &r.pde {
+        report["export_deviation"] = p.export_deviation.into();
+        report["export_capped"] = p.export_capped.into();
+    }
+    out!(
+        "{}",
+        scanfit_io::json::finite_json(&report, "the JSON report")?
+    );
     Ok(())
 }
 
@@ -499,7 +551,7 @@ fn steps_table(a: &CoonsArgs, points: usize, r: &CoonsReport, secs: f64) -> Tabl
         ),
     ]);
     t.row(vec![
-        "corners (loop position: angle)".into(),
+        "corners (loop position: angle, turn)".into(),
         join(
             r.base
                 .corners
@@ -507,7 +559,13 @@ fn steps_table(a: &CoonsArgs, points: usize, r: &CoonsReport, secs: f64) -> Tabl
                 .iter()
                 .zip(&r.base.corner_angles)
                 .enumerate()
-                .map(|(k, (q, ang))| format!("C{k} {q}: {:.0} deg", ang.to_degrees()))
+                .map(|(k, (q, ang))| {
+                    format!(
+                        "C{k} {q}: {:.0} deg, turns {:.0} deg",
+                        ang.to_degrees(),
+                        180.0 - ang.to_degrees()
+                    )
+                })
                 .collect(),
             ", ",
         ),
@@ -539,9 +597,14 @@ fn steps_table(a: &CoonsArgs, points: usize, r: &CoonsReport, secs: f64) -> Tabl
     ]);
     let export = r.pde.as_ref().map(|p| {
         format!(
-            " (B-spline form within {} of S; tolerance {})",
+            " (B-spline form within {} of S; tolerance {}{})",
             num(p.export_deviation),
-            num(p.export_tolerance)
+            num(p.export_tolerance),
+            if p.export_capped {
+                ", not reached: capped at the number of input points"
+            } else {
+                ""
+            }
         )
     });
     t.row(vec![

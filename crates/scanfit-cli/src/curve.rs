@@ -178,6 +178,7 @@ struct FitReport<'a> {
     closed: bool,
     condition: f64,
     quality: QualityDoc,
+    #[serde(skip_serializing_if = "Option::is_none")]
     output: Option<String>,
 }
 
@@ -261,7 +262,7 @@ fn fit_cmd(a: FitArgs) -> Result<()> {
     // everything succeeded: a failed run leaves no file behind
     let mut files: Vec<(&Path, Vec<u8>)> = Vec::new();
     if let Some(out) = &a.output {
-        files.push((out, doc.to_json().into_bytes()));
+        files.push((out, doc.to_json()?.into_bytes()));
     }
     let panel = || Panel {
         title: format!("{} ({kind}, degree {})", r.fit.method, a.degree),
@@ -298,7 +299,10 @@ fn fit_cmd(a: FitArgs) -> Result<()> {
             quality: QualityDoc::from(&r.quality),
             output: a.output.as_ref().map(|p| p.display().to_string()),
         };
-        outln!("{}", serde_json::to_string_pretty(&report)?);
+        out!(
+            "{}",
+            scanfit_io::json::finite_json(&report, "the JSON report")?
+        );
         return Ok(());
     }
     print_fit(&a, &r, kind, pts.len())?;
@@ -388,8 +392,11 @@ fn print_fit(a: &FitArgs, r: &CurveReport, kind: &str, n: usize) -> Result<()> {
 struct CompareRow {
     method: String,
     ok: bool,
+    #[serde(skip_serializing_if = "Option::is_none")]
     error: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     quality: Option<QualityDoc>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     condition: Option<f64>,
 }
 
@@ -495,7 +502,10 @@ fn print_compare_json(
         "picture": out.display().to_string(),
         "methods": rows,
     });
-    outln!("{}", serde_json::to_string_pretty(&doc)?);
+    out!(
+        "{}",
+        scanfit_io::json::finite_json(&doc, "the JSON report")?
+    );
     Ok(())
 }
 

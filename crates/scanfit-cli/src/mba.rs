@@ -101,6 +101,11 @@ pub struct MbaArgs {
     pub out: SurfaceOutputArgs,
     #[command(flatten)]
     pub trim: crate::cad::TrimArgs,
+    /// Read the input in chunks of N points, one pass per level, so memory
+    /// depends on the lattice, not the point count (not with --adjust; text
+    /// inputs are read in chunks, others whole).
+    #[arg(long, value_name = "N")]
+    pub chunk_points: Option<usize>,
     /// Print the report as JSON on stdout instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -111,7 +116,7 @@ pub struct MbaArgs {
 
 impl MbaArgs {
     /// The pipeline's settings.
-    fn config(&self) -> MbaRunConfig {
+    pub(crate) fn config(&self) -> MbaRunConfig {
         let mut c = MbaRunConfig::default();
         c.mba.base = self.base;
         c.mba.max_levels = self.levels;
@@ -134,12 +139,16 @@ impl MbaArgs {
     }
 
     /// The settings recorded in the surface document.
-    fn settings(&self, r: &MbaReport) -> BTreeMap<String, serde_json::Value> {
+    pub(crate) fn settings(
+        &self,
+        levels: usize,
+        cells: (usize, usize),
+    ) -> BTreeMap<String, serde_json::Value> {
         let mut s = BTreeMap::new();
-        s.insert("levels".into(), r.levels.len().into());
+        s.insert("levels".into(), levels.into());
         s.insert(
             "lattice_cells".into(),
-            serde_json::json!([r.cells.0, r.cells.1]),
+            serde_json::json!([cells.0, cells.1]),
         );
         let formula = if self.hjelle {
             "hjelle"
@@ -167,8 +176,11 @@ struct Row {
     vertical_max: f64,
     vertical_rmse: f64,
     grid_rmse: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
     adjusted_vertical_rmse: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     adjusted_grid_rmse: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     adjust_steps: Option<usize>,
     seconds: f64,
 }
@@ -197,6 +209,12 @@ pub fn run(a: MbaArgs) -> Result<()> {
     if a.levels == 0 {
         anyhow::bail!("--levels must be at least 1");
     }
+    if let Some(n) = a.chunk_points {
+        if a.trim.trim {
+            anyhow::bail!("--trim finds the outline from all points at once; leave it out with --chunk-points (the surface is then the untrimmed rectangle)");
+        }
+        return crate::stream::mba(&a, n);
+    }
     let progress = Progress::spinner(a.quiet || a.json);
     progress.stage(format!("reading {}", a.input.input.display()));
     let cloud = a.input.load(a.json)?;
@@ -209,10 +227,14 @@ pub fn run(a: MbaArgs) -> Result<()> {
     ];
     let r = mba(&cloud, &a.config(), &progress)
         .map_err(|e| anyhow::anyhow!("{}: {e}{}", input.display(), option_note(&e, &options)))?;
+    let q = &r.assessment.quality;
+    a.out.guard(
+        q,
+        "remove stray points or use fewer levels (--levels) or a tolerance (--tolerance)",
+    )?;
     progress.stage("writing");
     let pts = cloud.points();
     let trimmed = a.trim.apply(true, &r.surface, pts, &r.uv, None)?;
-    let q = &r.assessment.quality;
     let operation = if a.adjust {
         "mba (multilevel B-spline approximation + projection adjustment)"
     } else {
@@ -224,7 +246,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
         Some("xy (u = x, v = y, scaled to [0, 1])".into()),
         input,
         pts.len(),
-        a.settings(&r),
+        a.settings(r.levels.len(), r.cells),
     ));
     doc.quality = Some(quality_doc(q, Vec::new()));
     let deviation = Deviation {
@@ -256,7 +278,10 @@ pub fn run(a: MbaArgs) -> Result<()> {
             "seconds": r.seconds,
             "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
         });
-        outln!("{}", serde_json::to_string_pretty(&report)?);
+        out!(
+            "{}",
+            scanfit_io::json::finite_json(&report, "the JSON report")?
+        );
         return Ok(());
     }
     print_report(&a, &r)?;

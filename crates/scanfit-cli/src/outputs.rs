@@ -48,6 +48,11 @@ pub struct SurfaceOutputArgs {
     /// error figures.
     #[arg(long, value_name = "OUT.png")]
     pub deviation_png: Option<PathBuf>,
+    /// Write the surface even when it leaves the data (samples farther
+    /// outside the points' bounding box than 10 point spacings and a quarter
+    /// of its diagonal).
+    #[arg(long)]
+    pub allow_extrapolation: bool,
     #[command(flatten)]
     pub units: crate::cad::UnitsArgs,
     #[command(flatten)]
@@ -143,6 +148,13 @@ impl SurfaceOutputArgs {
         check_outputs(&[input], &all)
     }
 
+    /// Fails with one line that says how far the surface left the data and
+    /// what to try (`fix`, the command's own options), unless
+    /// `--allow-extrapolation` is given.
+    pub fn guard(&self, q: &SurfaceQuality, fix: &str) -> Result<()> {
+        crate::extent::check(&q.extent, self.allow_extrapolation, fix)
+    }
+
     /// The bytes of every requested output of `surface` fitted to `points`
     /// from `input`, and the vertical exaggeration of the shaded picture.
     pub fn files(
@@ -173,7 +185,7 @@ impl SurfaceOutputArgs {
     ) -> Result<(Files, f64)> {
         let mut files: Files = Vec::new();
         if let Some(o) = &self.output {
-            files.push((o.clone(), doc.to_json().into_bytes()));
+            files.push((o.clone(), doc.to_json()?.into_bytes()));
         }
         let item = trimmed.map_or(CadItem::Surface(surface), CadItem::Trimmed);
         files.extend(
@@ -406,6 +418,10 @@ pub fn samples_json(q: &SurfaceQuality) -> serde_json::Value {
         "point_spacing": s.spacing,
         "far_spacings": s.far_spacings,
         "far_share": s.far_share,
+        "outside_box": q.extent.samples_outside,
+        "outside_box_spacings": q.extent.samples_outside_spacings,
+        "control_net_outside_box": q.extent.control_outside,
+        "leaves_data": q.extent.leaves,
     })
 }
 

@@ -9,6 +9,7 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use scanfit::bspline::{tessellate, Mesh};
 use scanfit::metrics::nearest_points;
+use scanfit::network::layout::{LabelSource, Layout};
 use scanfit::network::FaceFit;
 use scanfit::pde::PdeConfig;
 use scanfit::pipeline::reconstruct::{self, ReconstructConfig, ReconstructReport};
@@ -32,11 +33,15 @@ const EXAMPLES: &str = "Examples:
   scanfit reconstruct examples/data/vessel_30k.ply --step vessel.stp --png vessel.png
   scanfit reconstruct examples/data/umbrella_20k.ply --pde 8x8 -o umbrella.json --mesh umbrella.glb
   scanfit reconstruct examples/data/vessel_30k.ply --labels label --ignore 14 --fit bspline --ctrl 12x12 --json
+  scanfit reconstruct examples/data/blob_30k.ply --layout cube --step blob.stp
+  scanfit reconstruct examples/data/part_30k.ply --segment --png part.png
 
 Input: a point cloud whose points carry an integer patch id (PLY/PCD property
 or text column `label`, `segment`, `segment_id`, `class` or `scalar_label`,
 case-insensitive, or the one named by --labels); negative ids and the ids of
---ignore are left out.
+--ignore are left out. Without labels: --segment cuts the cloud at its sharp
+edges (as `scanfit cloud segment`), --layout cube lays six patches over a
+closed star-shaped object; their ids replace the file's and take the same path.
 Pipeline: each patch's border (alpha shape), the patch across every border
 point (within 3 spacings), corners where three or more patches meet or an
 interface reaches the free border, edges between corners shared by the two
@@ -60,6 +65,13 @@ pub enum FitRoute {
     Bspline,
 }
 
+/// `--layout`: patches for a smooth object without labels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum LayoutArg {
+    /// Six four-sided patches, central projection onto a box (star-shaped objects).
+    Cube,
+}
+
 #[derive(Args, Debug)]
 #[command(after_help = EXAMPLES)]
 pub struct ReconstructArgs {
@@ -69,6 +81,17 @@ pub struct ReconstructArgs {
     /// segment_id, class, scalar_label].
     #[arg(long, value_name = "NAME")]
     pub labels: Option<String>,
+    /// Make the patch ids by segmenting the cloud at its sharp edges (as
+    /// `scanfit cloud segment`; thresholds --angle, --min-cell, --min-region).
+    #[arg(long, conflicts_with = "layout")]
+    pub segment: bool,
+    #[command(flatten)]
+    pub segment_options: crate::segment::SegmentOptions,
+    /// Make the patch ids by a layout for a smooth object: `cube` (six
+    /// four-sided patches by central projection onto a box about the centre;
+    /// closed star-shaped objects).
+    #[arg(long, value_name = "LAYOUT", value_parser = choice::<LayoutArg>())]
+    pub layout: Option<LayoutArg>,
     /// Patch ids to leave out, e.g. "0,99" (negative ids always are).
     #[arg(long, value_name = "LIST", allow_hyphen_values = true, value_parser = IDS)]
     pub ignore: Option<Ids>,
@@ -143,9 +166,10 @@ pub fn run(a: ReconstructArgs) -> Result<()> {
     let files = outputs(&a, &r, &cloud)?;
     write_all_atomic(&files)?;
     if a.json {
-        outln!(
+        let report = json_report(&r, &a, seconds, dropped);
+        out!(
             "{}",
-            serde_json::to_string_pretty(&json_report(&r, &a, seconds, dropped))?
+            scanfit_io::json::finite_json(&report, "the JSON report")?
         );
     } else {
         out!("{}", tables(&r, seconds));
@@ -158,6 +182,11 @@ pub fn run(a: ReconstructArgs) -> Result<()> {
 fn config(a: &ReconstructArgs) -> Result<ReconstructConfig> {
     let mut cfg = ReconstructConfig::default();
     cfg.network.labels.attribute = a.labels.clone();
+    cfg.source = match (a.segment, a.layout) {
+        (true, _) => LabelSource::Segment(a.segment_options.config()),
+        (false, Some(LayoutArg::Cube)) => LabelSource::Layout(Layout::Cube),
+        (false, None) => LabelSource::Attribute,
+    };
     if let Some(Ids(list)) = &a.ignore {
         cfg.network.labels.ignore = list.clone();
     }
@@ -181,7 +210,7 @@ fn config(a: &ReconstructArgs) -> Result<ReconstructConfig> {
 }
 
 /// A distinct colour for patch `k` (hues a golden angle apart).
-fn patch_colour(k: usize) -> [u8; 3] {
+pub(crate) fn patch_colour(k: usize) -> [u8; 3] {
     let h = (k as f64 * 0.618_033_988_75).fract() * 6.0;
     let x = 1.0 - (h % 2.0 - 1.0).abs();
     let (r, g, b) = match h as usize {
@@ -257,10 +286,7 @@ fn outputs(a: &ReconstructArgs, r: &ReconstructReport, cloud: &PointCloud) -> Re
     let mut files: Files = Vec::new();
     let cad = a.output.is_some() || a.step.is_some() || a.iges.is_some();
     if cad {
-        let model = r
-            .complex
-            .as_ref()
-            .map_err(|e| anyhow::anyhow!("cannot write the model: {e}"))?;
+        let model = &r.complex;
         let name = a
             .input
             .input
@@ -302,11 +328,7 @@ fn pictures(
     let mut opts = a.view.options(cloud.points())?;
     opts.iso_lines = 0;
     if let Some(p) = &a.png {
-        // neighbouring ids far apart on the colour map (golden-ratio steps)
-        let values: Vec<f64> = patch
-            .iter()
-            .map(|&k| (k as f64 * 0.618_033_988_75).fract())
-            .collect();
+        let colours: Vec<[u8; 3]> = patch.iter().map(|&k| patch_colour(k)).collect();
         opts.legend = vec![format!(
             "{} patches, {} edges, {} corners",
             r.faces.len(),
@@ -316,10 +338,7 @@ fn pictures(
         let png = render_surface_scene_png(
             mesh,
             None,
-            Colouring::Scalar {
-                values: &values,
-                range: (0.0, 1.0),
-            },
+            Colouring::Rgb(&colours),
             &lines,
             &markers,
             &opts,
@@ -369,6 +388,7 @@ fn tables(r: &ReconstructReport, seconds: f64) -> String {
             "rmse",
             "orth rmse",
             "orth max",
+            "folds",
         ],
         &[],
     );
@@ -385,6 +405,7 @@ fn tables(r: &ReconstructReport, seconds: f64) -> String {
             num(p.errors.rmse),
             num(p.orthogonal.rmse),
             num(p.orthogonal.max),
+            p.fold_overs.to_string(),
         ]);
     }
     let mut e = Table::new(
@@ -442,7 +463,7 @@ fn json_report(
         "patches": r.patches.iter().map(|p| serde_json::json!({
             "id": p.id, "sides": p.sides, "edges": p.edges, "points": p.points,
             "coons": stats(&p.coons_errors), "errors": stats(&p.errors), "orthogonal": stats(&p.orthogonal),
-            "bspline_deviation": p.conversion_deviation,
+            "bspline_deviation": p.conversion_deviation, "fold_overs": p.fold_overs,
         })).collect::<Vec<_>>(),
         "edges": r.edges.iter().map(|e| serde_json::json!({
             "vertices": e.vertices, "patches": e.patches, "max_gap": e.max_gap,
@@ -467,7 +488,7 @@ fn model_files(
 ) -> Result<Files> {
     let mut files: Files = Vec::new();
     if let Some(o) = &a.output {
-        files.push((o.clone(), model_doc(a, r, model).to_json().into_bytes()));
+        files.push((o.clone(), model_doc(a, r, model).to_json()?.into_bytes()));
     }
     if let Some(p) = &a.step {
         files.push((

@@ -23,15 +23,21 @@ use crate::table::{num, Table};
 const EXAMPLES: &str = "Examples:
   scanfit fit examples/data/terrain_50k.xyz --ctrl 40x40 -o terrain.json
   scanfit report terrain.json examples/data/terrain_50k.xyz -o terrain.html
+  scanfit reconstruct examples/data/vessel_30k.ply -o vessel.json
+  scanfit report vessel.json examples/data/vessel_30k.ply
 
 The deviations are orthogonal distances from the points to the surface (point
-inversion); the HTML page embeds its pictures, so it can be mailed as one file.";
+inversion); the HTML page embeds its pictures, so it can be mailed as one file.
+A multi-patch model (scanfit-model/1, from `reconstruct -o`) is reported per
+patch, per edge and in total as tables (or --json), its points assigned by
+their label attribute (as reconstruct), else to the nearest patch.";
 
 /// Arguments of `scanfit report`.
 #[derive(Args, Debug)]
 #[command(after_help = EXAMPLES)]
 pub struct ReportArgs {
-    /// The surface (JSON written by `scanfit fit -o`).
+    /// The surface (JSON written by `scanfit fit -o`), or a multi-patch
+    /// model (written by `scanfit reconstruct -o`).
     pub surface: PathBuf,
     /// The points to compare with and how to read them.
     #[command(flatten)]
@@ -41,6 +47,14 @@ pub struct ReportArgs {
     pub output: Option<PathBuf>,
     #[command(flatten)]
     pub view: crate::view::ViewArgs,
+    /// Model only: the attribute holding the patch ids [default: the first
+    /// of label, segment, segment_id, class, scalar_label; none: each point
+    /// goes to its nearest patch].
+    #[arg(long, value_name = "NAME")]
+    pub labels: Option<String>,
+    /// Model only: patch ids whose points are left out, e.g. "0,99".
+    #[arg(long, value_name = "LIST", allow_hyphen_values = true, value_parser = crate::args::IDS)]
+    pub ignore: Option<crate::args::Ids>,
     /// Print the statistics as JSON on stdout instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -220,6 +234,9 @@ fn page(
 
 /// Runs `scanfit report`.
 pub fn run(a: ReportArgs) -> Result<()> {
+    if crate::report_model::is_model(&a.surface) {
+        return crate::report_model::run(a);
+    }
     let out = a
         .output
         .clone()
@@ -251,7 +268,7 @@ pub fn run(a: ReportArgs) -> Result<()> {
             "samples_to_points": crate::outputs::samples_json(q),
             "report": out.display().to_string(),
         });
-        outln!("{}", serde_json::to_string_pretty(&v)?);
+        out!("{}", scanfit_io::json::finite_json(&v, "the JSON report")?);
         return Ok(());
     }
     let (p, qd) = surface.degrees();

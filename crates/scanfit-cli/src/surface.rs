@@ -68,20 +68,18 @@ pub struct FitArgs {
     /// Degrees, "PxQ" or "P".
     #[arg(long, default_value = "3x3", value_name = "PxQ", value_parser = NXM)]
     pub degree: (usize, usize),
-    /// Control net, "NUxNV" or "N".
-    #[arg(long, default_value = "16x16", value_name = "NUxNV", value_parser = NXM)]
-    pub ctrl: (usize, usize),
+    /// Control net, "NUxNV" or "N" [default: from the point density,
+    /// round(sqrt(points / 16)) per direction, 5 to 32].
+    #[arg(long, value_name = "NUxNV", value_parser = NXM)]
+    pub ctrl: Option<(usize, usize)>,
     /// Knot placement.
     #[arg(long, default_value = "distribution", value_name = "PLACEMENT", value_parser = choice::<KnotsArg>())]
     pub knots: KnotsArg,
-    /// Thin-plate smoothing weight λ on ∫∫ S_uu² + 2 S_uv² + S_vv² (0 = none).
-    #[arg(
-        long,
-        default_value_t = 0.0,
-        value_name = "L",
-        allow_negative_numbers = true
-    )]
-    pub smooth: f64,
+    /// Thin-plate smoothing weight λ on ∫∫ S_uu² + 2 S_uv² + S_vv² (0 = the
+    /// bare least-squares fit) [default: scaled to the data, 0.001 x points /
+    /// (NU x NV)², which keeps sparsely covered spans from flying off].
+    #[arg(long, value_name = "L", allow_negative_numbers = true)]
+    pub smooth: Option<f64>,
     /// The surface closes around in u (needs --params uv-columns).
     #[arg(long)]
     pub periodic_u: bool,
@@ -95,6 +93,11 @@ pub struct FitArgs {
     /// Write the points with u, v, residual and orthogonal distance (.ply or .xyz).
     #[arg(long, value_name = "POINTS")]
     pub points_out: Option<PathBuf>,
+    /// Read the input in chunks of N points, in passes, so memory depends on
+    /// the control net, not the point count (needs --params uv-columns and
+    /// --knots uniform; text inputs are read in chunks, others whole).
+    #[arg(long, value_name = "N")]
+    pub chunk_points: Option<usize>,
     /// Print the report as JSON on stdout instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -105,34 +108,46 @@ pub struct FitArgs {
 
 impl FitArgs {
     /// The pipeline's settings.
-    fn config(&self) -> FitConfig {
+    pub(crate) fn config(&self) -> FitConfig {
         let mut c = FitConfig::default();
         c.params = match self.params {
             ParamsArg::Plane => ParameterSource::Plane,
             ParamsArg::UvColumns => ParameterSource::uv_attributes(),
         };
         c.fit.degree = self.degree;
-        c.fit.ctrl = self.ctrl;
+        if let Some(ctrl) = self.ctrl {
+            c.fit.ctrl = ctrl;
+            c.ctrl_from_density = false;
+        }
         c.fit.periodic_u = self.periodic_u;
         c.fit.knots = match self.knots {
             KnotsArg::Distribution => KnotPlacement::Distribution,
             KnotsArg::Uniform => KnotPlacement::Uniform,
         };
-        c.fit.smoothing = self.smooth;
+        if let Some(l) = self.smooth {
+            c.fit.smoothing = l;
+            c.relative_smoothing = None;
+        }
         c.correction_rounds = self.correct;
         c
     }
 
-    /// The settings recorded in the surface document.
-    fn settings(&self) -> BTreeMap<String, serde_json::Value> {
+    /// The settings recorded in the surface document (the net and weight
+    /// the fit used).
+    pub(crate) fn settings(
+        &self,
+        surface: &scanfit::bspline::Surface,
+        smoothing: f64,
+    ) -> BTreeMap<String, serde_json::Value> {
         let mut s = BTreeMap::new();
         s.insert(
             "degree".into(),
             serde_json::json!([self.degree.0, self.degree.1]),
         );
-        s.insert("ctrl".into(), serde_json::json!([self.ctrl.0, self.ctrl.1]));
+        let (cu, cv) = surface.counts();
+        s.insert("ctrl".into(), serde_json::json!([cu, cv]));
         s.insert("knots".into(), name(&self.knots).into());
-        s.insert("smoothing".into(), self.smooth.into());
+        s.insert("smoothing".into(), smoothing.into());
         s.insert("periodic_u".into(), self.periodic_u.into());
         s.insert("correction_rounds".into(), self.correct.into());
         s
@@ -177,11 +192,18 @@ pub fn run(a: FitArgs) -> Result<()> {
         &a.input.input,
         &[(&a.points_out, "--points-out", &["ply", "xyz"][..])],
     )?;
+    if let Some(n) = a.chunk_points {
+        return crate::stream::fit(&a, n);
+    }
     let progress = Progress::spinner(a.quiet);
     progress.stage(format!("reading {}", a.input.input.display()));
     let table = a.input.table(a.json)?;
     let cloud = cloud_of(&a, &table)?;
     let r = fit(&cloud, &a.config(), &progress).map_err(|e| locate(e, &table))?;
+    a.out.guard(
+        &r.assessment.quality,
+        "raise the smoothing (--smooth; by default it is scaled to the data) or use fewer control points (--ctrl)",
+    )?;
     progress.stage("writing");
     let pts = cloud.points();
     let plane = matches!(a.params, ParamsArg::Plane) && !a.periodic_u;
@@ -194,7 +216,7 @@ pub fn run(a: FitArgs) -> Result<()> {
         Some(name(&a.params)),
         &a.input.input,
         pts.len(),
-        a.settings(),
+        a.settings(&r.surface, r.smoothing),
     ));
     doc.quality = Some(quality.clone());
     let dist = r.assessment.distances();
@@ -237,13 +259,25 @@ pub fn run(a: FitArgs) -> Result<()> {
             "trim": crate::cad::trim_json(trimmed.as_ref()),
             "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
         });
-        outln!("{}", serde_json::to_string_pretty(&report)?);
+        out!(
+            "{}",
+            scanfit_io::json::finite_json(&report, "the JSON report")?
+        );
         return Ok(());
     }
     print_report(&a, &r)?;
     crate::cad::print_trim(trimmed.as_ref())?;
     print_written(&files, a.out.png.as_deref(), exaggeration)?;
     Ok(())
+}
+
+/// ", smoothing λ = ... (scaled to the data)" for the report's first line.
+fn smoothing_note(given: Option<f64>, used: f64) -> String {
+    match given {
+        None => format!(", smoothing {used:.3e} (scaled to the data)"),
+        Some(l) if l > 0.0 => format!(", smoothing {l}"),
+        Some(_) => ", no smoothing".to_string(),
+    }
 }
 
 fn print_report(a: &FitArgs, r: &FitReport) -> Result<()> {
@@ -256,7 +290,7 @@ fn print_report(a: &FitArgs, r: &FitReport) -> Result<()> {
         q.points,
         name(&a.params),
         name(&a.knots),
-        if a.smooth > 0.0 { format!(", smoothing {}", a.smooth) } else { String::new() },
+        smoothing_note(a.smooth, r.smoothing),
         if a.periodic_u { ", periodic in u" } else { "" },
     );
     let mut t = Table::new(

@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use scanfit::base::turntable::{AxisChoice, Ends, STAGES};
+use scanfit::base::turntable::{AxisChoice, EndShape, Ends, STAGES};
 use scanfit::pipeline::turntable::{
     run as turntable, TurntableConfig, TurntableReport, WeightComparison,
 };
@@ -125,8 +125,9 @@ pub struct TurntableArgs {
     /// Refinement rounds of the base surface (projection along the normal, relaxation).
     #[arg(long, default_value_t = 2, value_name = "N")]
     pub refine: usize,
-    /// Fraction of the cloud's height left out at each end of the layers
-    /// (0 for an open tube; closed ends need a section around the axis).
+    /// Fraction of the cloud's height left out at each closed end of the
+    /// layers (closed ends need a section around the axis); an end the data
+    /// show to be open (a rim, no points near the axis) gets none.
     #[arg(long, default_value_t = 0.03, value_name = "F")]
     pub margin: f64,
     /// Points beyond the end layers: "exclude" (kept out of the fit; the
@@ -200,6 +201,10 @@ pub fn run(a: TurntableArgs) -> Result<()> {
         })
         .with_context(|| a.input.input.display().to_string())?;
     let seconds = t0.elapsed().as_secs_f64();
+    a.out.guard(
+        &r.assessment.quality,
+        "check the axis (--axis) or use fewer layers (--layers) or control points (--ctrl)",
+    )?;
     progress.stage("writing");
     progress.inc();
     let (files, exaggeration) = outputs(&a, &cloud, &r)?;
@@ -288,7 +293,7 @@ fn print_json(
     let t = &r.turntable;
     let (ax, c) = (t.frame.axis, t.frame.centre);
     let quality = quality_doc(&r.assessment.quality, Vec::new());
-    let report = serde_json::json!({
+    let mut report = serde_json::json!({
         "input": a.input.input.display().to_string(),
         "point_count": cloud.len(),
         "axis": [ax.x, ax.y, ax.z],
@@ -302,6 +307,7 @@ fn print_json(
         "base_distance": stats_json(&t.base_errors),
         "beyond_end_layers": t.on_v_boundary,
         "ends": crate::args::value_name(&a.ends),
+        "open_ends": [t.end_shapes[0].open, t.end_shapes[1].open],
         "distance_all_points": stats_json(&t.errors_all),
         "surface_to_cloud": stats_json(&t.surface_to_cloud),
         "surface_to_points": samples_json(&r.assessment.quality),
@@ -309,12 +315,40 @@ fn print_json(
         "quality": quality,
         "fold_overs_inside_layers": t.quality_inside.fold_overs,
         "fold_overs_corrected": t.quality_fitted.fold_overs,
-        "weight_comparison": r.weight_comparison.as_ref().map(|c| c.iter().map(|w| serde_json::json!({"weight": w.weight.name(), "rmse": w.rmse})).collect::<Vec<_>>()),
         "seconds": seconds,
         "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
     });
-    outln!("{}", serde_json::to_string_pretty(&report)?);
+    if let Some(c) = &r.weight_comparison {
+        report["weight_comparison"] = c
+            .iter()
+            .map(|w| serde_json::json!({"weight": w.weight.name(), "rmse": w.rmse}))
+            .collect();
+    }
+    out!(
+        "{}",
+        scanfit_io::json::finite_json(&report, "the JSON report")?
+    );
     Ok(())
+}
+
+/// "ends: low closed (3% left out), high open (fitted to the rim)".
+fn ends_line(shapes: &[EndShape; 2], margin: f64) -> String {
+    let say = |e: &EndShape| {
+        if e.open {
+            "open (fitted to the rim)".to_string()
+        } else {
+            format!(
+                "closed ({:.0}% of the height left out; {:.0}% of its points near the axis)",
+                100.0 * margin,
+                100.0 * e.inner_share
+            )
+        }
+    };
+    format!(
+        "ends (along the axis): low {}, high {}",
+        say(&shapes[0]),
+        say(&shapes[1])
+    )
 }
 
 /// The lines above the error table: axis, views, layers, base surface, parameters.
@@ -360,6 +394,7 @@ fn print_steps(
         t.views.len(),
         visible.join(", ")
     );
+    outln!("{}", ends_line(&t.end_shapes, a.margin));
     let counts: Vec<usize> = t.loops.iter().map(Vec::len).collect();
     outln!(
         "layers: {} ({} to {} samples); projection RMSE by round ({}): {}",

@@ -20,6 +20,12 @@ fn s(p: &Path) -> &str {
 /// sectors 0-3, bottom cap 10, top cap 11, deterministic noise 0.002.
 /// `label` maps (point index, default label) to the written label text.
 fn write_can(path: &Path, label: impl Fn(usize, i64) -> String) {
+    write_can_sectors(path, 4, label)
+}
+
+/// [`write_can`] with `sectors` side sectors (labels `0..sectors`): with 6,
+/// each cap has 6 corners and two of its sides run over two edges.
+fn write_can_sectors(path: &Path, sectors: usize, label: impl Fn(usize, i64) -> String) {
     let mut seed = 17u64;
     let mut noise = || {
         seed = seed
@@ -37,7 +43,7 @@ fn write_can(path: &Path, label: impl Fn(usize, i64) -> String) {
         for j in 0..nz {
             let z = (j as f64 + 0.5) / nz as f64 * 2.0;
             let r = 1.0 + noise();
-            let l = ((t / (PI / 2.0)) as i64).min(3);
+            let l = ((t / (TAU / sectors as f64)) as i64).min(sectors as i64 - 1);
             writeln!(
                 out,
                 "{:.6} {:.6} {z:.6} {}",
@@ -315,6 +321,106 @@ fn vessel_is_one_valid_solid_of_the_true_volume() {
             (v / truth_volume - 1.0).abs() < 0.01,
             "volume {v} vs {truth_volume}"
         );
+        assert!(
+            occ["max_face_diff"].as_f64().unwrap() < 1e-9 * diag,
+            "{occ}"
+        );
+    }
+}
+
+/// A cap with 6 corners (a can of 6 sectors) is a four-sided patch two of
+/// whose sides run over two edges each: the model, STEP and IGES files hold
+/// those chains, the STEP face loops list all 6 edges and share them with
+/// the sectors, and OpenCASCADE reads one valid solid with no free edge.
+#[test]
+fn caps_with_six_corners_are_written_as_one_solid() {
+    let d = tmpdir("reconstruct", "six");
+    let input = d.join("can6.xyz");
+    write_can_sectors(&input, 6, |_, l| l.to_string());
+    let (json, step, iges) = (d.join("c.json"), d.join("c.stp"), d.join("c.igs"));
+    let out = ok(&run(&[
+        "reconstruct",
+        s(&input),
+        "-o",
+        s(&json),
+        "--step",
+        s(&step),
+        "--iges",
+        s(&iges),
+        "--json",
+        "-q",
+    ]));
+    let r: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let t = &r["totals"];
+    assert_eq!(
+        (t["faces"].as_u64(), t["edges"].as_u64()),
+        (Some(8), Some(18))
+    );
+    let diag = t["diagonal"].as_f64().unwrap();
+    assert!(t["max_gap"].as_f64().unwrap() <= 1e-9 * diag, "{t}");
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    for p in doc["patches"].as_array().unwrap() {
+        let chains = p["sides"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|s| s.is_array())
+            .map(|s| s.as_array().unwrap().len())
+            .collect::<Vec<_>>();
+        let want: Vec<usize> = if p["id"].as_i64().unwrap() >= 10 {
+            vec![2, 2]
+        } else {
+            vec![]
+        };
+        assert_eq!(chains, want, "patch {}", p["id"]);
+    }
+    assert!(doc["report"]["totals"]["max_gap"].as_f64().unwrap() <= 1e-9 * diag);
+    let text = std::fs::read_to_string(&step).unwrap();
+    assert!(text.contains("CLOSED_SHELL(") && text.contains("MANIFOLD_SOLID_BREP("));
+    assert_eq!(text.matches("EDGE_CURVE(").count(), 18);
+    assert_eq!(text.matches("VERTEX_POINT(").count(), 12);
+    // every edge is used by two face loops: 36 oriented edges
+    assert_eq!(text.matches("ORIENTED_EDGE(").count(), 36);
+    // `report` on the written model: the reconstruction's orthogonal RMSE
+    // per patch (the same surfaces, the same points by label)
+    let rep: serde_json::Value =
+        serde_json::from_str(&ok(&run(&["report", s(&json), s(&input), "--json", "-q"]))).unwrap();
+    assert_eq!(rep["assignment"]["labels"], "label");
+    for (a, b) in rep["patches"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(r["patches"].as_array().unwrap())
+    {
+        assert_eq!(a["id"], b["id"]);
+        assert_eq!(a["points"], b["points"]);
+        let (x, y) = (
+            a["orthogonal"]["rmse"].as_f64().unwrap(),
+            b["orthogonal"]["rmse"].as_f64().unwrap(),
+        );
+        assert!((x - y).abs() <= 1e-9 * y, "patch {}: {x} vs {y}", a["id"]);
+    }
+    assert_eq!(rep["edges"].as_array().unwrap().len(), 18);
+    assert!(rep["totals"]["max_gap"].as_f64().unwrap() <= 1e-9 * diag);
+    let table = ok(&run(&["report", s(&json), s(&input), "-q"]));
+    assert!(
+        table.contains("points assigned by the label attribute 'label'")
+            && table.contains("orth rmse")
+            && table.contains("max normal angle (deg)"),
+        "{table}"
+    );
+    let igs = std::fs::read_to_string(&iges).unwrap();
+    assert_eq!(igs.lines().filter(|l| l.starts_with("128,")).count(), 8);
+    if let Some(occ) = occ_check(&json, &step) {
+        assert_eq!(occ["shells"], 1);
+        assert_eq!(occ["solids"], 1);
+        assert_eq!(occ["faces"], 8);
+        assert_eq!(occ["valid"], true, "{occ}");
+        assert_eq!(occ["free_edges"], 0, "{occ}");
+        let v = occ["volume"].as_f64().unwrap();
+        // pi r^2 h of the can, the 6-sector polygonal rims cost well under 1%
+        assert!((v / (2.0 * PI) - 1.0).abs() < 0.01, "volume {v}");
         assert!(
             occ["max_face_diff"].as_f64().unwrap() < 1e-9 * diag,
             "{occ}"

@@ -49,6 +49,15 @@ pub enum Error {
         /// the library's error
         error: scanfit::Error,
     },
+    /// A document to be written holds a number JSON cannot represent (NaN
+    /// or an infinity, which a JSON writer would turn into `null`).
+    #[error("{what}: the value at {at} is not a finite number; JSON cannot hold NaN or infinity, so nothing was written (a computation produced it: please report this with the input)")]
+    NonFinite {
+        /// the document (a file name or "the JSON report")
+        what: String,
+        /// where in the document, as a path like `.quality.max_anisotropy`
+        at: String,
+    },
 }
 
 /// Result alias of the IO crate.

@@ -8,7 +8,6 @@
 //!   "periodic": false,
 //!   "knots": [0, 0, 0, 0, 0.5, 1, 1, 1, 1],
 //!   "control_points": [[x, y, z], ...],
-//!   "weights": null,
 //!   "provenance": {"tool": "scanfit 0.1.0", "operation": "curve fit (interpolation)",
 //!                  "parameterization": "proposed", "input": "data.csv", "point_count": 10,
 //!                  "settings": {"degree": 3, "smoothing": 0}},
@@ -35,6 +34,55 @@ use scanfit::Point3;
 use serde::{Deserialize, Serialize};
 
 use crate::{Error, Result};
+
+/// Pretty JSON text of `value` (with a final newline), refusing any number
+/// that is not finite: `serde_json` writes NaN and infinities as `null`, and
+/// no scanfit document or report has a `null` of its own (absent values are
+/// left out), so a `null` in the text is a non-finite number and an error
+/// naming where it is. `what` names the document in the error.
+///
+/// ```
+/// let ok = scanfit_io::json::finite_json(&serde_json::json!({"rmse": 0.5}), "report").unwrap();
+/// assert_eq!(ok, "{\n  \"rmse\": 0.5\n}\n");
+/// let bad = scanfit_io::json::finite_json(&[1.0, f64::NAN], "report").unwrap_err();
+/// assert!(bad.to_string().contains("the value at [1] is not a finite number"), "{bad}");
+/// ```
+pub fn finite_json<T: Serialize + ?Sized>(value: &T, what: &str) -> Result<String> {
+    let invalid = |message: String| Error::Invalid {
+        path: what.into(),
+        message,
+    };
+    let text = serde_json::to_string_pretty(value).map_err(|e| invalid(e.to_string()))?;
+    // read back (the text keeps the writer's key order; the value is only searched)
+    let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| invalid(e.to_string()))?;
+    if let Some(at) = first_null(&v) {
+        return Err(Error::NonFinite {
+            what: what.into(),
+            at: if at.is_empty() {
+                "the top level".into()
+            } else {
+                at
+            },
+        });
+    }
+    Ok(text + "\n")
+}
+
+/// The path (`.a.b[3]`) of the first `null` in `v`, depth first.
+fn first_null(v: &serde_json::Value) -> Option<String> {
+    use serde_json::Value;
+    match v {
+        Value::Null => Some(String::new()),
+        Value::Array(items) => items
+            .iter()
+            .enumerate()
+            .find_map(|(k, x)| first_null(x).map(|rest| format!("[{k}]{rest}"))),
+        Value::Object(map) => map
+            .iter()
+            .find_map(|(key, x)| first_null(x).map(|rest| format!(".{key}{rest}"))),
+        _ => None,
+    }
+}
 
 /// Schema identifier written into every document.
 pub const SCHEMA: &str = "scanfit/1";
@@ -124,7 +172,8 @@ pub struct CurveDoc {
     pub knots: Vec<f64>,
     /// Control points.
     pub control_points: Vec<[f64; 3]>,
-    /// Weights (rational curves only).
+    /// Weights (rational curves only; left out otherwise, `null` is read as absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub weights: Option<Vec<f64>>,
     /// Where the curve came from.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -158,10 +207,9 @@ impl CurveDoc {
         }
     }
 
-    /// Pretty JSON text.
-    pub fn to_json(&self) -> String {
-        // serialising plain data with string keys cannot fail
-        serde_json::to_string_pretty(self).unwrap_or_default() + "\n"
+    /// Pretty JSON text; an error if a number is not finite ([`finite_json`]).
+    pub fn to_json(&self) -> Result<String> {
+        finite_json(self, "the curve document")
     }
 
     /// The curve this document describes (validated).
@@ -275,7 +323,9 @@ pub struct SurfaceDoc {
     pub count_v: usize,
     /// Control points, row-major with `u` slow.
     pub control_points: Vec<[f64; 3]>,
-    /// Weights (rational surfaces only), same order.
+    /// Weights (rational surfaces only, same order; left out otherwise,
+    /// `null` is read as absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub weights: Option<Vec<f64>>,
     /// Where the surface came from.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -313,9 +363,9 @@ impl SurfaceDoc {
         }
     }
 
-    /// Pretty JSON text.
-    pub fn to_json(&self) -> String {
-        serde_json::to_string_pretty(self).unwrap_or_default() + "\n"
+    /// Pretty JSON text; an error if a number is not finite ([`finite_json`]).
+    pub fn to_json(&self) -> Result<String> {
+        finite_json(self, "the surface document")
     }
 
     /// The surface this document describes (validated).
@@ -450,7 +500,7 @@ mod tests {
         let c = Curve::new_rational(kv, ctrl, w).unwrap();
         let mut doc = CurveDoc::new(&c);
         doc.params = Some(vec![0.0, 0.1 + 0.2, 1.0]);
-        let text = doc.to_json();
+        let text = doc.to_json().unwrap();
         let (back, c2) = parse_curve(Path::new("x.json"), &text).unwrap();
         assert_eq!(back, doc);
         assert_eq!(c2, c);
@@ -471,7 +521,7 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("scanfit-json-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("s.json");
-        std::fs::write(&path, doc.to_json()).unwrap();
+        std::fs::write(&path, doc.to_json().unwrap()).unwrap();
         let (back, s2) = read_surface(&path).unwrap();
         assert_eq!(back, doc);
         assert_eq!(s2, s);

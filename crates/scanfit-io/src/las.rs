@@ -302,6 +302,16 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<()> {
         }
         _ => raw.data_end,
     };
+    // the decoder picks the layered record decompressor by the first item's
+    // version (3 or 4), whatever the compressor field says: a pointwise
+    // compressor with layered items would skip the layer-size walk below
+    let layered_items = matches!(u16_at(vlr, 38), Some(3 | 4));
+    if layered_items != (compressor == 3) {
+        return Err(binary(vlr_at, format!(
+            "the LASzip VLR declares compressor {compressor} with items of version {}; layered items (version 3 or 4) go with the layered compressor 3 only, so the file is damaged",
+            u16_at(vlr, 38).unwrap_or(0)
+        )));
+    }
     if compressor != 3 {
         return Ok(());
     }

@@ -9,6 +9,7 @@
 
 mod atomic;
 mod binary;
+pub mod chunks;
 pub mod cloud;
 mod error;
 pub mod fuzz;

@@ -16,6 +16,10 @@
 //!   "patches": [
 //!     {"id": 3, "sides": [{"edge": 0, "reversed": false}, {"edge": 4, "reversed": true},
 //!                         {"edge": 5, "reversed": false}, null],
+//!      "surface": {"schema": "scanfit/1", "type": "bspline_surface", ...}},
+//!     {"id": 9, "sides": [{"edge": 6, "reversed": false}, {"edge": 7, "reversed": false},
+//!                         [{"edge": 8, "reversed": true}, {"edge": 9, "reversed": true}],
+//!                         {"edge": 10, "reversed": false}],
 //!      "surface": {"schema": "scanfit/1", "type": "bspline_surface", ...}}
 //!   ],
 //!   "provenance": {"tool": "scanfit 0.1.0", "operation": "reconstruct", ...},
@@ -31,8 +35,12 @@
 //!   four parameter sides in counter-clockwise order: `S(u, v0)` for `u` up,
 //!   `S(u1, v)` for `v` up, `S(u, v1)` for `u` down, `S(u0, v)` for `v` down.
 //!   Each is the edge it lies on and whether it runs against the edge's
-//!   direction, or `null` for a side collapsed to a vertex (a three-sided
-//!   patch). See [`scanfit::topology`] for the model's rules.
+//!   direction; a list of such objects, in order along the side, when the
+//!   side runs over several edges (a patch with more than four corners: the
+//!   surface's side is the edges' curves joined); or `null` for a side
+//!   collapsed to a vertex (a three-sided patch). See [`scanfit::topology`]
+//!   for the model's rules. One-edge sides are written as the single object
+//!   (as documents did before chains), so older documents read unchanged.
 //! * `closed` is true when every edge has two patches (the patches bound a
 //!   solid).
 //! * `report` (optional) holds the pipeline's measurements: per patch
@@ -75,6 +83,44 @@ pub struct SideDoc {
     pub reversed: bool,
 }
 
+/// A patch side in the document: one edge, or a chain of edges in order
+/// along the side.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum SideChain {
+    /// A side on one edge (a JSON object).
+    One(SideDoc),
+    /// A side over several edges (a JSON list of objects).
+    Chain(Vec<SideDoc>),
+}
+
+impl SideChain {
+    /// The document form of a side's chain (`None` for a collapsed side).
+    pub fn of(chain: &[EdgeUse]) -> Option<Self> {
+        let doc = |u: &EdgeUse| SideDoc {
+            edge: u.edge,
+            reversed: u.reversed,
+        };
+        match chain {
+            [] => None,
+            [u] => Some(SideChain::One(doc(u))),
+            more => Some(SideChain::Chain(more.iter().map(doc).collect())),
+        }
+    }
+
+    /// The edges of the side, in order.
+    pub fn uses(&self) -> Vec<EdgeUse> {
+        let use_of = |d: &SideDoc| EdgeUse {
+            edge: d.edge,
+            reversed: d.reversed,
+        };
+        match self {
+            SideChain::One(d) => vec![use_of(d)],
+            SideChain::Chain(v) => v.iter().map(use_of).collect(),
+        }
+    }
+}
+
 /// An edge in the document.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct EdgeDoc {
@@ -93,8 +139,8 @@ pub struct EdgeDoc {
 pub struct PatchDoc {
     /// The patch label.
     pub id: i64,
-    /// The four sides (`null` = collapsed).
-    pub sides: [Option<SideDoc>; 4],
+    /// The four sides (`null` = collapsed; a list = a chain of edges).
+    pub sides: [Option<SideChain>; 4],
     /// The surface.
     pub surface: SurfaceDoc,
 }
@@ -234,7 +280,7 @@ impl ModelDoc {
     /// let s = Surface::new(k.clone(), k, vec![c[0], c[3], c[1], c[2]]).unwrap();
     /// let model = PatchComplex::assemble(c.to_vec(),
     ///     vec![FaceCorners { id: 5, surface: s, corners: [0, 1, 2, 3] }]).unwrap();
-    /// let text = ModelDoc::new(&model).to_json();
+    /// let text = ModelDoc::new(&model).to_json().unwrap();
     /// let (doc, back) = parse_model(std::path::Path::new("m.json"), &text).unwrap();
     /// assert_eq!(back, model);
     /// assert_eq!(doc.edges[0].patches, vec![5]);
@@ -274,12 +320,7 @@ impl ModelDoc {
                 .iter()
                 .map(|f| PatchDoc {
                     id: f.id,
-                    sides: f.sides.map(|s| {
-                        s.map(|u| SideDoc {
-                            edge: u.edge,
-                            reversed: u.reversed,
-                        })
-                    }),
+                    sides: [0, 1, 2, 3].map(|k| SideChain::of(&f.sides[k])),
                     surface: SurfaceDoc::new(&f.surface),
                 })
                 .collect(),
@@ -288,10 +329,10 @@ impl ModelDoc {
         }
     }
 
-    /// Pretty JSON text.
-    pub fn to_json(&self) -> String {
-        // serialising plain data with string keys cannot fail
-        serde_json::to_string_pretty(self).unwrap_or_default() + "\n"
+    /// Pretty JSON text; an error if a number is not finite
+    /// ([`finite_json`](crate::json::finite_json)).
+    pub fn to_json(&self) -> crate::Result<String> {
+        crate::json::finite_json(self, "the model document")
     }
 
     /// The model this document describes, checked (see the module doc);
@@ -396,15 +437,19 @@ impl ModelDoc {
                 }
             }
             let surface = s.surface().map_err(|err| bad(format!("{name}: {err}")))?;
+            let mut sides: [Vec<EdgeUse>; 4] = Default::default();
+            for (k, (side, doc)) in sides.iter_mut().zip(&p.sides).enumerate() {
+                *side = doc.as_ref().map(SideChain::uses).unwrap_or_default();
+                if side.is_empty() && doc.is_some() {
+                    return Err(bad(format!(
+                        "{name}: side {k} is an empty list; write null for a side collapsed to a vertex"
+                    )));
+                }
+            }
             faces.push(Face {
                 id: p.id,
                 surface,
-                sides: p.sides.map(|s| {
-                    s.map(|u| EdgeUse {
-                        edge: u.edge,
-                        reversed: u.reversed,
-                    })
-                }),
+                sides,
             });
         }
         let model = PatchComplex {
@@ -588,7 +633,7 @@ mod tests {
                 ..Default::default()
             },
         });
-        let text = doc.to_json();
+        let text = doc.to_json().unwrap();
         assert!(text.contains("\"pde\": ["), "{text}");
         let (back, m2) = parse_model(Path::new("m.json"), &text).unwrap();
         assert_eq!(back, doc);
@@ -599,12 +644,48 @@ mod tests {
     }
 
     #[test]
+    fn side_chains_are_lists_and_one_edge_sides_objects() {
+        let m = two_patches();
+        let doc = ModelDoc::new(&m);
+        // one-edge sides are written as the single object (the old form)
+        assert!(doc.patches[0]
+            .sides
+            .iter()
+            .all(|s| matches!(s, Some(SideChain::One(_)))));
+        let text = doc.to_json().unwrap();
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        // the same side as a one-edge list reads to the same model
+        let side = v["patches"][0]["sides"][1].clone();
+        v["patches"][0]["sides"][1] = serde_json::json!([side]);
+        let (_, m2) = parse_model(Path::new("m.json"), &v.to_string()).unwrap();
+        assert_eq!(m2, m);
+        // a chain of several edges round-trips as a list
+        let mut chained = m.clone();
+        chained.faces[0].sides[1] = vec![m.faces[0].sides[1][0]; 2];
+        let d = ModelDoc::new(&chained);
+        assert!(matches!(&d.patches[0].sides[1], Some(SideChain::Chain(c)) if c.len() == 2));
+        let back: ModelDoc = serde_json::from_str(&d.to_json().unwrap()).unwrap();
+        assert_eq!(back.patches[0].sides, d.patches[0].sides);
+        // which the topology check then refuses (not a cycle), naming the patch
+        let e = parse_model(Path::new("m.json"), &d.to_json().unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("closed cycle"), "{e}");
+        // an empty list is not a collapsed side
+        v["patches"][0]["sides"][1] = serde_json::json!([]);
+        let e = parse_model(Path::new("m.json"), &v.to_string())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("side 1 is an empty list"), "{e}");
+    }
+
+    #[test]
     fn files_are_read_and_oversized_files_refused_before_reading() {
         let dir = std::env::temp_dir().join(format!("scanfit-model-doc-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let m = two_patches();
         let path = dir.join("m.json");
-        std::fs::write(&path, ModelDoc::new(&m).to_json()).unwrap();
+        std::fs::write(&path, ModelDoc::new(&m).to_json().unwrap()).unwrap();
         let (_, back) = read_model(&path).unwrap();
         assert_eq!(back, m);
         // a sparse file just over the limit: refused by its size, not read
@@ -629,7 +710,8 @@ mod tests {
     #[test]
     fn hostile_documents_are_refused_with_a_reason() {
         let m = two_patches();
-        let good: serde_json::Value = serde_json::from_str(&ModelDoc::new(&m).to_json()).unwrap();
+        let good: serde_json::Value =
+            serde_json::from_str(&ModelDoc::new(&m).to_json().unwrap()).unwrap();
         let with = |f: &dyn Fn(&mut serde_json::Value)| {
             let mut v = good.clone();
             f(&mut v);

@@ -2,8 +2,9 @@
 //!
 //! An orthographic camera looks at the object from an azimuth and elevation
 //! (z up) and fits it into the image; triangles are rasterised with a depth
-//! buffer, shaded (two-sided Lambert plus ambient) and coloured by height or
-//! by a per-vertex scalar (viridis), with darker iso-parameter lines; input
+//! buffer, shaded (two-sided Lambert plus ambient) and coloured by height,
+//! by a per-vertex scalar (viridis, with a colour bar) or by per-vertex RGB
+//! colours (categories such as patches), with darker iso-parameter lines; input
 //! points can be drawn on top where they are not hidden by the surface.
 
 use scanfit::bspline::Mesh;
@@ -23,6 +24,10 @@ pub enum Colouring<'a> {
         /// value range mapped onto the colour map
         range: (f64, f64),
     },
+    /// One colour per mesh vertex (e.g. one per patch), interpolated across
+    /// each triangle; no colour bar, since the colours are categories, not
+    /// a scale.
+    Rgb(&'a [[u8; 3]]),
 }
 
 /// Camera and image settings.
@@ -457,6 +462,11 @@ fn render_rgb_with(
             (heights.as_slice(), (lo, hi))
         }
         Colouring::Scalar { values, range } => (values, range),
+        Colouring::Rgb(_) => (heights.as_slice(), (0.0, 1.0)),
+    };
+    let rgb_of = |k: usize| match colouring {
+        Colouring::Rgb(c) => c.get(k).map(|c| c.map(|x| x as f64 / 255.0)),
+        _ => None,
     };
     let span = if hi > lo { hi - lo } else { 1.0 };
     let ((u0, u1), (v0, v1)) = mesh.uv.iter().fold(
@@ -507,7 +517,12 @@ fn render_rgb_with(
                 };
                 let shade = 0.3 + 0.7 * lambert;
                 let value = w0 * vals[a] + w1 * vals[b] + w2 * vals[c];
-                let mut col = viridis(((value - lo) / span).clamp(0.0, 1.0));
+                let mut col = match (rgb_of(a), rgb_of(b), rgb_of(c)) {
+                    (Some(ca), Some(cb), Some(cc)) => {
+                        [0, 1, 2].map(|ch| w0 * ca[ch] + w1 * cb[ch] + w2 * cc[ch])
+                    }
+                    _ => viridis(((value - lo) / span).clamp(0.0, 1.0)),
+                };
                 if opts.iso_lines > 0 {
                     let u = w0 * mesh.uv[a][0] + w1 * mesh.uv[b][0] + w2 * mesh.uv[c][0];
                     let v = w0 * mesh.uv[a][1] + w1 * mesh.uv[b][1] + w2 * mesh.uv[c][1];
@@ -705,5 +720,45 @@ mod tests {
         }
         let png = encode_png(&img, 200, 150).unwrap();
         assert_eq!(&png[1..4], b"PNG");
+    }
+
+    #[test]
+    fn rgb_colouring_paints_the_given_colours_and_no_colour_bar() {
+        let k = KnotVector::uniform_clamped(1, 2).unwrap();
+        let p = |x: f64, y: f64| Point3::new(x, y, 0.0);
+        let s = Surface::new(
+            k.clone(),
+            k,
+            vec![p(0., 0.), p(0., 1.), p(1., 0.), p(1., 1.)],
+        )
+        .unwrap();
+        let mesh = tessellate(&s, 8, 8);
+        // left half (u < 0.5) pure red, the rest pure blue
+        let colours: Vec<[u8; 3]> = mesh
+            .uv
+            .iter()
+            .map(|t| if t[0] < 0.5 { [255, 0, 0] } else { [0, 0, 255] })
+            .collect();
+        let opts = RenderOptions {
+            width: 300,
+            height: 300,
+            azimuth: -90.0,
+            elevation: 90.0,
+            iso_lines: 0,
+            ..Default::default()
+        };
+        let img = render_rgb(&mesh, None, Colouring::Rgb(&colours), &opts);
+        let px: Vec<&[u8]> = img.chunks(3).collect();
+        // every painted pixel is a shade of red, blue or their blend: no green,
+        // so neither viridis nor its colour bar
+        let painted: Vec<&&[u8]> = px.iter().filter(|c| c != &&[255, 255, 255]).collect();
+        assert!(painted.len() > 300 * 300 / 2, "{}", painted.len());
+        assert!(painted.iter().all(|c| c[1] == 0), "a green (viridis) pixel");
+        let red = painted.iter().filter(|c| c[0] > 0 && c[2] == 0).count();
+        let blue = painted.iter().filter(|c| c[2] > 0 && c[0] == 0).count();
+        assert!(
+            red > painted.len() / 3 && blue > painted.len() / 3,
+            "{red} {blue}"
+        );
     }
 }

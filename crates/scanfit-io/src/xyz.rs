@@ -109,199 +109,275 @@ fn split_fields<'a>(line: &'a str, out: &mut Vec<&'a str>) {
 /// columns is an error. Time is linear in the size of the text.
 pub fn parse_points_with(path: &Path, text: &str, policy: NonFinite) -> Result<PointTable> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let perr = |line: usize, message: String| Error::Parse {
+    let mut parser = TextParser::new(path, policy);
+    let mut rows = TextRows::default();
+    parser.block(text, 0, &mut rows)?;
+    parser.check_not_empty(rows.points.len())?;
+    let warnings = parser.warnings(rows.points.len());
+    Ok(PointTable {
         path: path.to_path_buf(),
-        line,
-        message,
-    };
-    let mut columns: Option<Vec<String>> = None;
-    let mut width = 0usize;
-    let mut points = Vec::new();
-    let mut extra: Vec<Vec<f64>> = Vec::new();
-    let mut extra_index: Vec<usize> = Vec::new();
-    let mut lines = Vec::new();
-    let mut fields: Vec<&str> = Vec::new();
-    let mut values: Vec<f64> = Vec::new();
-    let mut dropped = 0usize;
-    let mut order = [0usize, 1, 2];
-    let mut pts_count: Option<(usize, u64)> = None;
-    let too_wide = |line_no: usize, n: usize| {
-        perr(
-            line_no,
-            format!(
-                "{n} columns; a point file may have at most {} (is this a point file with one point per line?)",
-                MAX_COLUMNS
-            ),
-        )
-    };
-    for (line_no, raw) in split_lines(text) {
-        let line = raw.trim();
-        if line.is_empty() || line.starts_with('#') || line.starts_with("//") {
-            continue;
+        format: Format::Text,
+        points: rows.points,
+        columns: parser.columns(),
+        extra: rows.extra,
+        origin: Origin::Lines(rows.lines),
+        file_index: None,
+        dropped_non_finite: parser.dropped,
+        warnings,
+    })
+}
+
+/// Points parsed from some lines of a text file.
+#[derive(Debug, Default)]
+pub(crate) struct TextRows {
+    pub(crate) points: Vec<Point3>,
+    pub(crate) extra: Vec<Vec<f64>>,
+    pub(crate) lines: Vec<usize>,
+}
+
+/// The state of a text file's parse between blocks of lines (header,
+/// columns, counts), so a file can be parsed in pieces
+/// ([`crate::chunks`]) with the same rules as in one piece.
+#[derive(Debug)]
+pub(crate) struct TextParser {
+    path: std::path::PathBuf,
+    policy: NonFinite,
+    columns: Option<Vec<String>>,
+    width: usize,
+    order: [usize; 3],
+    extra_index: Vec<usize>,
+    pts_count: Option<(usize, u64)>,
+    pub(crate) dropped: usize,
+    any_point: bool,
+}
+
+impl TextParser {
+    pub(crate) fn new(path: &Path, policy: NonFinite) -> Self {
+        Self {
+            path: path.to_path_buf(),
+            policy,
+            columns: None,
+            width: 0,
+            order: [0, 1, 2],
+            extra_index: Vec::new(),
+            pts_count: None,
+            dropped: 0,
+            any_point: false,
         }
-        split_fields(line, &mut fields);
-        if fields.len() > MAX_COLUMNS {
-            return Err(too_wide(line_no, fields.len()));
-        }
-        values.clear();
-        let mut bad: Option<(usize, &str)> = None;
-        for (k, f) in fields.iter().enumerate() {
-            if f.is_empty() {
+    }
+
+    /// Parses the complete lines of `text` (numbered from `first_line + 1`)
+    /// into `rows`.
+    pub(crate) fn block(
+        &mut self,
+        text: &str,
+        first_line: usize,
+        rows: &mut TextRows,
+    ) -> Result<()> {
+        let (path, policy) = (self.path.clone(), self.policy);
+        let perr = |line: usize, message: String| Error::Parse {
+            path: path.to_path_buf(),
+            line,
+            message,
+        };
+        let mut fields: Vec<&str> = Vec::new();
+        let mut values: Vec<f64> = Vec::new();
+        let too_wide = |line_no: usize, n: usize| {
+            perr(
+                line_no,
+                format!(
+                    "{n} columns; a point file may have at most {} (is this a point file with one point per line?)",
+                    MAX_COLUMNS
+                ),
+            )
+        };
+        for (line_no, raw) in split_lines(text) {
+            let line_no = line_no + first_line;
+            let line = raw.trim();
+            if line.is_empty() || line.starts_with('#') || line.starts_with("//") {
+                continue;
+            }
+            split_fields(line, &mut fields);
+            if fields.len() > MAX_COLUMNS {
+                return Err(too_wide(line_no, fields.len()));
+            }
+            values.clear();
+            let mut bad: Option<(usize, &str)> = None;
+            for (k, f) in fields.iter().enumerate() {
+                if f.is_empty() {
+                    if policy == NonFinite::Drop {
+                        values.push(f64::NAN);
+                        continue;
+                    }
+                    return Err(perr(
+                        line_no,
+                        format!(
+                            "value {} is empty (two delimiters in a row, or one at the start or end of the line); write a number there (or 'nan', and read with ReadOptions {{ non_finite: NonFinite::Drop, .. }} to leave such points out)",
+                            k + 1
+                        ),
+                    ));
+                }
+                match f.parse::<f64>() {
+                    Ok(v) => values.push(v),
+                    Err(_) => {
+                        bad = Some((k, f));
+                        break;
+                    }
+                }
+            }
+            if let Some((k, f)) = bad {
+                // the header: before any data, and no field a number (a data line
+                // with a typo such as `0,O,0` is an error, not a header)
+                if !self.any_point
+                    && self.width == 0
+                    && self.columns.is_none()
+                    && values.is_empty()
+                    && fields.iter().all(|f| f.parse::<f64>().is_err())
+                {
+                    if let Some(e) = fields.iter().position(|f| f.is_empty()) {
+                        return Err(perr(
+                            line_no,
+                            format!(
+                                "column {} of the header line has no name; name every column",
+                                e + 1
+                            ),
+                        ));
+                    }
+                    self.columns = Some(
+                        fields
+                            .iter()
+                            .map(|s| s.trim_matches('"').to_string())
+                            .collect(),
+                    );
+                    continue;
+                }
+                return Err(perr(
+                    line_no,
+                    format!("value {} ('{f}') is not a number", k + 1),
+                ));
+            }
+            // Leica PTS: the first data line holds only the point count
+            if self.width == 0
+                && self.pts_count.is_none()
+                && values.len() == 1
+                && values[0] >= 0.0
+                && values[0].fract() == 0.0
+            {
+                self.pts_count = Some((line_no, values[0] as u64));
+                continue;
+            }
+            if self.width == 0 {
+                self.width = self.columns.as_ref().map_or(fields.len(), |c| c.len());
+                if let Some(c) = &self.columns {
+                    // x, y, z by name when the header names them (any order)
+                    let find = |axis: &str| c.iter().position(|n| n.eq_ignore_ascii_case(axis));
+                    if let (Some(x), Some(y), Some(z)) = (find("x"), find("y"), find("z")) {
+                        self.order = [x, y, z];
+                    }
+                }
+                if self.width < 3 {
+                    return Err(perr(
+                        line_no,
+                        format!(
+                            "{} columns found; a point needs at least x, y, z",
+                            self.width
+                        ),
+                    ));
+                }
+                let order = self.order;
+                self.extra_index = (0..self.width).filter(|k| !order.contains(k)).collect();
+            }
+            if rows.extra.len() != self.extra_index.len() {
+                rows.extra = vec![Vec::new(); self.extra_index.len()];
+            }
+            let width = self.width;
+            if values.len() != width {
+                return Err(perr(
+                    line_no,
+                    format!(
+                        "{} values found, but the file has {width} columns",
+                        values.len()
+                    ),
+                ));
+            }
+            let order = self.order;
+            if let Some(k) = order.into_iter().find(|&k| !values[k].is_finite()) {
                 if policy == NonFinite::Drop {
-                    values.push(f64::NAN);
+                    self.dropped += 1;
                     continue;
                 }
                 return Err(perr(
                     line_no,
                     format!(
-                        "value {} is empty (two delimiters in a row, or one at the start or end of the line); write a number there (or 'nan', and read with ReadOptions {{ non_finite: NonFinite::Drop, .. }} to leave such points out)",
-                        k + 1
+                        "value {} is {}; every coordinate must be a finite number (fix the line, or read with ReadOptions {{ non_finite: NonFinite::Drop, .. }} to leave such points out)",
+                        k + 1,
+                        values.get(k).copied().unwrap_or(f64::NAN)
                     ),
                 ));
             }
-            match f.parse::<f64>() {
-                Ok(v) => values.push(v),
-                Err(_) => {
-                    bad = Some((k, f));
-                    break;
-                }
-            }
-        }
-        if let Some((k, f)) = bad {
-            // the header: before any data, and no field a number (a data line
-            // with a typo such as `0,O,0` is an error, not a header)
-            if points.is_empty()
-                && width == 0
-                && columns.is_none()
-                && values.is_empty()
-                && fields.iter().all(|f| f.parse::<f64>().is_err())
-            {
-                if let Some(e) = fields.iter().position(|f| f.is_empty()) {
-                    return Err(perr(
-                        line_no,
-                        format!(
-                            "column {} of the header line has no name; name every column",
-                            e + 1
-                        ),
-                    ));
-                }
-                columns = Some(
-                    fields
-                        .iter()
-                        .map(|s| s.trim_matches('"').to_string())
-                        .collect(),
-                );
-                continue;
-            }
-            return Err(perr(
-                line_no,
-                format!("value {} ('{f}') is not a number", k + 1),
+            let value = |k: usize| values.get(k).copied().unwrap_or(0.0);
+            rows.points.push(Point3::new(
+                value(order[0]),
+                value(order[1]),
+                value(order[2]),
             ));
-        }
-        // Leica PTS: the first data line holds only the point count
-        if width == 0
-            && pts_count.is_none()
-            && values.len() == 1
-            && values[0] >= 0.0
-            && values[0].fract() == 0.0
-        {
-            pts_count = Some((line_no, values[0] as u64));
-            continue;
-        }
-        if width == 0 {
-            width = columns.as_ref().map_or(fields.len(), |c| c.len());
-            if let Some(c) = &columns {
-                // x, y, z by name when the header names them (any order)
-                let find = |axis: &str| c.iter().position(|n| n.eq_ignore_ascii_case(axis));
-                if let (Some(x), Some(y), Some(z)) = (find("x"), find("y"), find("z")) {
-                    order = [x, y, z];
-                }
+            for (col, &k) in rows.extra.iter_mut().zip(&self.extra_index) {
+                col.push(value(k));
             }
-            if width < 3 {
-                return Err(perr(
-                    line_no,
-                    format!("{width} columns found; a point needs at least x, y, z"),
-                ));
-            }
-            extra_index = (0..width).filter(|k| !order.contains(k)).collect();
-            extra = vec![Vec::new(); extra_index.len()];
+            rows.lines.push(line_no);
+            self.any_point = true;
         }
-        if values.len() != width {
-            return Err(perr(
-                line_no,
-                format!(
-                    "{} values found, but the file has {width} columns",
-                    values.len()
-                ),
-            ));
-        }
-        if let Some(k) = order.into_iter().find(|&k| !values[k].is_finite()) {
-            if policy == NonFinite::Drop {
-                dropped += 1;
-                continue;
-            }
-            return Err(perr(
-                line_no,
-                format!(
-                    "value {} is {}; every coordinate must be a finite number (fix the line, or read with ReadOptions {{ non_finite: NonFinite::Drop, .. }} to leave such points out)",
-                    k + 1,
-                    values.get(k).copied().unwrap_or(f64::NAN)
-                ),
-            ));
-        }
-        let value = |k: usize| values.get(k).copied().unwrap_or(0.0);
-        points.push(Point3::new(
-            value(order[0]),
-            value(order[1]),
-            value(order[2]),
-        ));
-        for (col, &k) in extra.iter_mut().zip(&extra_index) {
-            col.push(value(k));
-        }
-        lines.push(line_no);
+        Ok(())
     }
-    if points.is_empty() {
-        return Err(Error::Invalid {
-            path: path.to_path_buf(),
-            message: if dropped > 0 {
-                format!("no points left: all {dropped} have a non-finite coordinate")
+
+    /// Errors when the whole file gave no points (`points` read in all).
+    pub(crate) fn check_not_empty(&self, points: usize) -> Result<()> {
+        if points > 0 {
+            return Ok(());
+        }
+        Err(Error::Invalid {
+            path: self.path.to_path_buf(),
+            message: if self.dropped > 0 {
+                format!(
+                    "no points left: all {} have a non-finite coordinate",
+                    self.dropped
+                )
             } else {
                 "no points found (the file is empty or holds only a header/comments)".into()
             },
-        });
+        })
     }
-    let mut warnings = Vec::new();
-    if let Some((line, declared)) = pts_count {
-        let found = (points.len() + dropped) as u64;
-        if declared != found {
-            warnings.push(format!(
-                "{}:{line}: the count line declares {declared} points, but the file holds {found}; all {found} were read (fix the count, or check whether the file is truncated)",
-                path.display()
-            ));
+
+    /// The warnings once the whole file is read (`points` read in all).
+    pub(crate) fn warnings(&self, points: usize) -> Vec<String> {
+        let mut warnings = Vec::new();
+        if let Some((line, declared)) = self.pts_count {
+            let found = (points + self.dropped) as u64;
+            if declared != found {
+                warnings.push(format!(
+                    "{}:{line}: the count line declares {declared} points, but the file holds {found}; all {found} were read (fix the count, or check whether the file is truncated)",
+                    self.path.display()
+                ));
+            }
+        }
+        warnings
+    }
+
+    /// The table's columns: x, y, z first, then the others in file order.
+    pub(crate) fn columns(&self) -> Vec<String> {
+        match &self.columns {
+            Some(c) => {
+                let mut out: Vec<String> = self.order.iter().map(|&k| c[k].clone()).collect();
+                out.extend(self.extra_index.iter().map(|&k| c[k].clone()));
+                out
+            }
+            None => {
+                let mut c: Vec<String> = ["x", "y", "z"].iter().map(|s| s.to_string()).collect();
+                c.extend((4..=self.width).map(|k| format!("col{k}")));
+                c
+            }
         }
     }
-    // the table's columns are x, y, z first, then the others in file order
-    let columns = columns.map(|c| {
-        let mut out: Vec<String> = order.iter().map(|&k| c[k].clone()).collect();
-        out.extend(extra_index.iter().map(|&k| c[k].clone()));
-        out
-    });
-    let columns = columns.unwrap_or_else(|| {
-        let mut c: Vec<String> = ["x", "y", "z"].iter().map(|s| s.to_string()).collect();
-        c.extend((4..=width).map(|k| format!("col{k}")));
-        c
-    });
-    Ok(PointTable {
-        path: path.to_path_buf(),
-        format: Format::Text,
-        points,
-        columns,
-        extra,
-        origin: Origin::Lines(lines),
-        file_index: None,
-        dropped_non_finite: dropped,
-        warnings,
-    })
 }
 
 #[cfg(test)]

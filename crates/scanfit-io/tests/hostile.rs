@@ -279,3 +279,19 @@ fn a_chunk_table_is_checked_even_without_points() {
     let e = read("f.laz", &bytes).unwrap_err();
     assert!(e.contains("the LAZ chunk table declares"), "{e}");
 }
+
+/// Fuzz finding (laz target, campaign of 2 December 2026): a LASzip VLR with
+/// the pointwise compressor (1) but a layered point-14 item (version 3). The
+/// decoder picks the layered decompressor by the item version, so the
+/// layer sizes went unchecked and it reserved 2.9 GB for a 561-byte file.
+#[test]
+fn layered_items_need_the_layered_compressor() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fuzz/regressions/laz/pointwise-compressor-with-layered-items.laz");
+    let bytes = std::fs::read(path).unwrap();
+    let e = read("f.laz", &bytes).unwrap_err();
+    assert!(
+        e.contains("declares compressor 1 with items of version 3"),
+        "{e}"
+    );
+}

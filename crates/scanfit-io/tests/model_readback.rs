@@ -247,7 +247,7 @@ fn occ_available() -> bool {
 fn check(m: &PatchComplex, name: &str) -> Option<serde_json::Value> {
     let dir = std::env::temp_dir().join(format!("scanfit-model-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let json = ModelDoc::new(m).to_json();
+    let json = ModelDoc::new(m).to_json().unwrap();
     let (_, back) = parse_model(Path::new("m.json"), &json).unwrap();
     assert_eq!(&back, m);
     let step = step_shell_file(m, name).unwrap();
@@ -256,7 +256,7 @@ fn check(m: &PatchComplex, name: &str) -> Option<serde_json::Value> {
     assert_eq!(t.matches("VERTEX_POINT(").count(), m.vertices.len());
     assert_eq!(t.matches("EDGE_CURVE(").count(), m.edges.len());
     assert_eq!(t.matches("ADVANCED_FACE(").count(), m.faces.len());
-    let uses: usize = m.faces.iter().map(|f| f.side_count()).sum();
+    let uses: usize = m.faces.iter().map(|f| f.use_count()).sum();
     assert_eq!(t.matches("ORIENTED_EDGE(").count(), uses);
     let closed = m.is_closed();
     assert_eq!(t.contains("CLOSED_SHELL("), closed);
@@ -449,7 +449,7 @@ fn tetrahedron_of_three_sided_faces_is_a_valid_solid() {
     let collapsed: Vec<usize> = m
         .faces
         .iter()
-        .map(|f| f.sides.iter().position(|s| s.is_none()).unwrap())
+        .map(|f| f.sides.iter().position(|s| s.is_empty()).unwrap())
         .collect();
     assert_eq!(collapsed, vec![3, 0, 1, 2]);
     let step = step_shell_file(&m, "tetrahedron").unwrap();

@@ -42,6 +42,7 @@
 
 pub mod base;
 pub mod bspline;
+pub mod centring;
 pub mod cloud;
 mod error;
 pub mod fit;

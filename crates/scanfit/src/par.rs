@@ -162,11 +162,35 @@ pub fn accumulate_bounded<A: Send>(
     fold: impl Fn(&mut A, Range<usize>) + Sync,
     mut merge: impl FnMut(&mut A, A),
 ) -> A {
+    let mut total = init();
+    accumulate_into(
+        &mut total,
+        0..len,
+        chunk,
+        max_partials,
+        init,
+        fold,
+        &mut merge,
+    );
+    total
+}
+
+/// The core of [`accumulate_bounded`]: the chunks of `items` (cut from
+/// `items.start`) summed in parallel and merged into `total` in chunk order.
+fn accumulate_into<A: Send>(
+    total: &mut A,
+    items: Range<usize>,
+    chunk: usize,
+    max_partials: usize,
+    init: impl Fn() -> A + Sync,
+    fold: impl Fn(&mut A, Range<usize>) + Sync,
+    merge: &mut impl FnMut(&mut A, A),
+) {
     let chunk = chunk.max(1);
     let wave = max_partials.max(1);
+    let (start, len) = (items.start, items.len());
     let chunks = len.div_ceil(chunk);
-    let mut total = init();
-    let range = |c: usize| c * chunk..((c + 1) * chunk).min(len);
+    let range = |c: usize| start + c * chunk..start + ((c + 1) * chunk).min(len);
     for first in (0..chunks).step_by(wave) {
         let partials: Vec<A> = (first..(first + wave).min(chunks))
             .into_par_iter()
@@ -177,10 +201,130 @@ pub fn accumulate_bounded<A: Send>(
             })
             .collect();
         for p in partials {
-            merge(&mut total, p);
+            merge(total, p);
         }
     }
-    total
+}
+
+/// A streamed [`accumulate`]: items arrive in batches of any size
+/// ([`BlockSum::add`]), and the sum is the one [`accumulate`] gives over all
+/// of them at once with `chunk = block`, **bit for bit**, however the items
+/// were cut into batches. The items are cut into blocks of `block` counted
+/// from the first item ever added (not from each batch): complete blocks are
+/// summed in parallel and merged into the total in order, and the partial
+/// block at the end of a batch stays open and continues with the next batch.
+///
+/// Two sums over different items merge ([`BlockSum::merge`], for chunks
+/// summed on different machines); a merged sum equals the one-pass sum up to
+/// the rounding of the additions (floating-point addition is not
+/// associative), not bit for bit.
+///
+/// ```
+/// use scanfit::par::{accumulate, BlockSum};
+/// let x: Vec<f64> = (0..10_000).map(|i| 1.0 / (1.0 + i as f64)).collect();
+/// let sum = |a: &mut f64, r: std::ops::Range<usize>| *a += x[r].iter().sum::<f64>();
+/// let once = accumulate(x.len(), 64, || 0.0, |a, r| sum(a, r), |a, p| *a += p);
+/// // the same items in batches of 1000, 333 and the rest
+/// let mut s = BlockSum::new(0.0, 64);
+/// let mut at = 0;
+/// for len in [1000, 333, 10_000 - 1333] {
+///     s.add(len, 4, || 0.0, |a, r| sum(a, at + r.start..at + r.end), |a, p| *a += p);
+///     at += len;
+/// }
+/// assert_eq!(s.finish(|a, p| *a += p).to_bits(), once.to_bits());
+/// ```
+#[derive(Debug, Clone)]
+pub struct BlockSum<A> {
+    total: A,
+    open: Option<A>,
+    open_len: usize,
+    block: usize,
+    items: u64,
+}
+
+impl<A: Send> BlockSum<A> {
+    /// An empty sum (`total` is the zero of the accumulator) cutting the
+    /// items into blocks of `block` (at least 1).
+    pub fn new(total: A, block: usize) -> Self {
+        Self {
+            total,
+            open: None,
+            open_len: 0,
+            block: block.max(1),
+            items: 0,
+        }
+    }
+
+    /// The items added so far.
+    pub fn items(&self) -> u64 {
+        self.items
+    }
+
+    /// Adds a batch of `len` items: `fold(&mut partial, range)` adds the
+    /// items `range` of the batch (indices from 0 within the batch) to a
+    /// partial that started as `init()`; `merge` adds a partial to the
+    /// total. At most `max_partials` partials exist at a time (it bounds the
+    /// memory and the parallelism, not the result).
+    pub fn add(
+        &mut self,
+        len: usize,
+        max_partials: usize,
+        init: impl Fn() -> A + Sync,
+        fold: impl Fn(&mut A, Range<usize>) + Sync,
+        mut merge: impl FnMut(&mut A, A),
+    ) {
+        let mut start = 0;
+        if let Some(open) = self.open.as_mut() {
+            let take = len.min(self.block - self.open_len);
+            fold(open, 0..take);
+            self.open_len += take;
+            start = take;
+            if self.open_len == self.block {
+                if let Some(full) = self.open.take() {
+                    merge(&mut self.total, full);
+                }
+                self.open_len = 0;
+            }
+        }
+        let full_end = start + (len - start) / self.block * self.block;
+        accumulate_into(
+            &mut self.total,
+            start..full_end,
+            self.block,
+            max_partials,
+            &init,
+            &fold,
+            &mut merge,
+        );
+        if full_end < len {
+            let mut open = init();
+            fold(&mut open, full_end..len);
+            self.open = Some(open);
+            self.open_len = len - full_end;
+        }
+        self.items += len as u64;
+    }
+
+    /// Adds the items of `other` (summed separately, e.g. on another
+    /// machine) to this sum; see the type's documentation for the rounding.
+    pub fn merge(&mut self, other: Self, mut merge: impl FnMut(&mut A, A)) {
+        let items = other.items;
+        let theirs = other.finish(&mut merge);
+        if let Some(open) = self.open.take() {
+            merge(&mut self.total, open);
+            self.open_len = 0;
+        }
+        merge(&mut self.total, theirs);
+        self.items += items;
+    }
+
+    /// The total.
+    pub fn finish(mut self, mut merge: impl FnMut(&mut A, A)) -> A {
+        if let Some(open) = self.open.take() {
+            merge(&mut self.total, open);
+        }
+        self.total
+    }
 }
 
 #[cfg(test)]

@@ -181,6 +181,13 @@ pub struct BsplineConversionConfig {
     pub tolerance: f64,
     /// Most knot spans per direction before giving up (default 512).
     pub max_spans: usize,
+    /// Most control points of the result (default `None`: no cap). When the
+    /// next refinement would exceed it, the conversion stops at the last
+    /// one within the cap, whatever its deviation, and says so
+    /// ([`PdeBspline::capped`]); the pipelines cap at the number of input
+    /// points, so the exported net never holds more control points than
+    /// there are data.
+    pub max_control_points: Option<usize>,
 }
 
 impl BsplineConversionConfig {
@@ -189,6 +196,7 @@ impl BsplineConversionConfig {
         Self {
             tolerance,
             max_spans: 512,
+            max_control_points: None,
         }
     }
 }
@@ -202,6 +210,9 @@ pub struct PdeBspline {
     pub max_deviation: f64,
     /// Uniform interpolation spans per direction used for `S_PDE`.
     pub spans: usize,
+    /// The control-point cap stopped the refinement before the tolerance
+    /// was met (`max_deviation` is then above it).
+    pub capped: bool,
 }
 
 impl PdeSurface {
@@ -229,6 +240,8 @@ impl PdeSurface {
         let (p, q) = base.degrees();
         let (m, n) = self.deformation.terms();
         let mut k = (2 * m.max(n)).max(8).max(p.max(q) + 1);
+        let cap = cfg.max_control_points.unwrap_or(usize::MAX);
+        let mut best: Option<PdeBspline> = None;
         loop {
             if k > cfg.max_spans {
                 return Err(Error::InvalidInput(format!(
@@ -253,27 +266,42 @@ impl PdeSurface {
                         .fold(0.0, f64::max)
                 })
                 .reduce(|| 0.0, f64::max);
-            if dev * 1.2 <= cfg.tolerance {
-                let (ku, kv) = (
-                    knot_union(base.knots_u(), w.knots_u())?,
-                    knot_union(base.knots_v(), w.knots_v())?,
-                );
-                let (a, b) = (
-                    refine_surface_to(&base, &ku, &kv)?,
-                    refine_surface_to(&w, &ku, &kv)?,
-                );
-                let ctrl = a
-                    .control_points()
-                    .iter()
-                    .zip(b.control_points())
-                    .map(|(x, y)| x + y.coords)
-                    .collect();
-                return Ok(PdeBspline {
-                    surface: Surface::new(ku, kv, ctrl)?,
-                    max_deviation: dev,
-                    spans: k,
-                });
+            let (ku, kv) = (
+                knot_union(base.knots_u(), w.knots_u())?,
+                knot_union(base.knots_v(), w.knots_v())?,
+            );
+            let count = ku.basis_count() * kv.basis_count();
+            if count > cap {
+                return match best {
+                    Some(mut b) => {
+                        b.capped = true;
+                        Ok(b)
+                    }
+                    None => Err(Error::InvalidInput(format!(
+                        "the B-spline form of the PDE surface needs {count} control points with the fewest spans ({k}), more than the cap of {cap}; use fewer PDE terms or boundary-curve control points"
+                    ))),
+                };
             }
+            let (a, b) = (
+                refine_surface_to(&base, &ku, &kv)?,
+                refine_surface_to(&w, &ku, &kv)?,
+            );
+            let ctrl = a
+                .control_points()
+                .iter()
+                .zip(b.control_points())
+                .map(|(x, y)| x + y.coords)
+                .collect();
+            let result = PdeBspline {
+                surface: Surface::new(ku, kv, ctrl)?,
+                max_deviation: dev,
+                spans: k,
+                capped: false,
+            };
+            if dev * 1.2 <= cfg.tolerance {
+                return Ok(result);
+            }
+            best = Some(result);
             if 2 * k > cfg.max_spans {
                 return Err(Error::InvalidInput(format!(
                     "the B-spline form of the PDE surface deviates by {dev:e} with {k} x {k} spans, more than the tolerance {:e}; allow a larger tolerance or fewer PDE terms",

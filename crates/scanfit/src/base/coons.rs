@@ -507,6 +507,21 @@ impl CoonsPatch {
     }
 }
 
+/// A Coons patch translates with its four boundary curves (eq. 16 is affine
+/// in them).
+impl crate::centring::Translate for CoonsPatch {
+    fn translate(&mut self, by: &Vector3) {
+        for c in [
+            &mut self.bottom,
+            &mut self.top,
+            &mut self.left,
+            &mut self.right,
+        ] {
+            crate::centring::Translate::translate(c, by);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

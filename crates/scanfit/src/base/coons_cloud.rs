@@ -11,8 +11,10 @@
 use super::coons::{fit_boundary_curves, BoundaryCurve, BoundaryCurveConfig, CoonsPatch};
 use crate::cloud::boundary::{boundary_loops, Boundary, BoundaryConfig};
 use crate::cloud::corners::{
-    corner_values, find_corners, split_at_corners, CornerConfig, CornerCriterion, Corners,
+    find_corners, split_at_corners, values_for, CornerConfig, CornerCriterion, Corners,
 };
+use std::f64::consts::PI;
+
 use crate::{Error, Point3, Result};
 
 /// Settings of [`coons_from_cloud`].
@@ -26,11 +28,20 @@ pub struct CoonsFromCloudConfig {
     pub corner_positions: Option<Vec<usize>>,
     /// Boundary curves (default: cubic, end-pinned least squares).
     pub curves: BoundaryCurveConfig,
-    /// A detected corner whose turning angle (eq. 12, at the corner
-    /// criterion's neighbour offset) exceeds this is not a corner: the loop
-    /// has fewer corners than asked and the run stops with an error.
-    /// Radians; default 160 degrees (a straight run is 180).
+    /// A detected corner whose angle (eq. 12, at the corner criterion's
+    /// neighbours) exceeds this is not clearly a corner. Radians; default
+    /// 150 degrees, i.e. the outline must turn by at least 30 degrees there
+    /// (a straight run is 180; the four best picks on a face's rounded
+    /// outline turn by 3 to 23 degrees, a rectangle's corners by 90).
     pub max_corner_angle: f64,
+    /// Detected corners crowd into one part of the loop when one side spans
+    /// more than this share of the loop's length (default 0.6; a 15:1
+    /// rectangle's long sides span 47%, four picks within 8% of a rounded
+    /// outline leave one side of 92%).
+    pub max_side_share: f64,
+    /// Build the patch on detected corners that are not clearly corners
+    /// (flat or crowded) instead of stopping with an error (default false).
+    pub force_corners: bool,
 }
 
 impl Default for CoonsFromCloudConfig {
@@ -40,7 +51,9 @@ impl Default for CoonsFromCloudConfig {
             corners: CornerConfig::default(),
             corner_positions: None,
             curves: BoundaryCurveConfig::default(),
-            max_corner_angle: 160f64.to_radians(),
+            max_corner_angle: 150f64.to_radians(),
+            max_side_share: 0.6,
+            force_corners: false,
         }
     }
 }
@@ -54,8 +67,13 @@ pub struct CoonsFromCloud {
     pub boundary: Boundary,
     /// Corners (positions in the outer loop) and sides.
     pub corners: Corners,
-    /// Turning angle (eq. 12, radians) at each corner.
+    /// The angle of eq. 12 (radians) at each corner: `pi` on a straight run.
     pub corner_angles: Vec<f64>,
+    /// The strength of each corner: how far the outline turns there, `pi -`
+    /// its angle (radians; `pi / 2` at a rectangle's corner).
+    pub corner_strengths: Vec<f64>,
+    /// Each side's share of the loop's length.
+    pub side_shares: Vec<f64>,
     /// The points of each side, in loop order, corner to corner.
     pub side_points: Vec<Vec<Point3>>,
     /// The fitted curve of each side (in loop order, before orientation).
@@ -81,7 +99,6 @@ pub fn coons_from_cloud(points: &[Point3], cfg: &CoonsFromCloudConfig) -> Result
     let boundary = boundary_loops(points, &cfg.boundary)?;
     let outer = boundary.outer_loop().to_vec();
     let loop_points: Vec<Point3> = outer.iter().map(|&i| points[i]).collect();
-    let offset_default = ((loop_points.len() as f64 / 100.0).round() as usize).max(1);
     let corners = match &cfg.corner_positions {
         Some(c) => {
             if let Some(&bad) = c.iter().find(|&&k| k >= outer.len()) {
@@ -92,8 +109,7 @@ pub fn coons_from_cloud(points: &[Point3], cfg: &CoonsFromCloudConfig) -> Result
                 )));
             }
             let sides = split_at_corners(outer.len(), c)?;
-            let offset = cfg.corners.offset.unwrap_or(offset_default);
-            let values = corner_values(&loop_points, cfg.corners.criterion, offset)?;
+            let (values, offset) = values_for(&loop_points, &cfg.corners)?;
             Corners {
                 corners: c.clone(),
                 sides,
@@ -112,27 +128,18 @@ pub fn coons_from_cloud(points: &[Point3], cfg: &CoonsFromCloudConfig) -> Result
     let angles = match cfg.corners.criterion {
         CornerCriterion::TurningAngle => corners.values.clone(),
         CornerCriterion::ThreePointCurvature => {
-            corner_values(&loop_points, CornerCriterion::TurningAngle, corners.offset)?
+            let turning = CornerConfig {
+                criterion: CornerCriterion::TurningAngle,
+                ..cfg.corners
+            };
+            values_for(&loop_points, &turning)?.0
         }
     };
     let corner_angles: Vec<f64> = corners.corners.iter().map(|&k| angles[k]).collect();
-    if cfg.corner_positions.is_none() {
-        let sharp = corner_angles
-            .iter()
-            .filter(|&&a| a <= cfg.max_corner_angle)
-            .count();
-        if sharp < count {
-            let flat = corner_angles
-                .iter()
-                .copied()
-                .fold(f64::NEG_INFINITY, f64::max);
-            return Err(Error::InvalidInput(format!(
-                "the boundary ({} points) has only {sharp} corner(s) sharper than {:.0} degrees but {count} were asked for (the flattest pick turns by only {:.1} degrees); give the corners' loop positions, ask for 3 sides, or raise the angle limit",
-                outer.len(),
-                cfg.max_corner_angle.to_degrees(),
-                180.0 - flat.to_degrees()
-            )));
-        }
+    let corner_strengths: Vec<f64> = corner_angles.iter().map(|a| PI - a).collect();
+    let side_shares = side_shares(&loop_points, &corners.sides);
+    if cfg.corner_positions.is_none() && !cfg.force_corners {
+        check_corners(cfg, outer.len(), &corner_strengths, &side_shares)?;
     }
     let side_points: Vec<Vec<Point3>> = corners
         .sides
@@ -147,8 +154,69 @@ pub fn coons_from_cloud(points: &[Point3], cfg: &CoonsFromCloudConfig) -> Result
         boundary,
         corners,
         corner_angles,
+        corner_strengths,
+        side_shares,
         side_points,
         curves,
+    })
+}
+
+/// Each side's share of the closed loop's length.
+fn side_shares(loop_points: &[Point3], sides: &[Vec<usize>]) -> Vec<f64> {
+    let n = loop_points.len();
+    let len = |s: &[usize]| -> f64 {
+        s.windows(2)
+            .map(|w| (loop_points[w[1]] - loop_points[w[0]]).norm())
+            .sum()
+    };
+    let total: f64 = (0..n)
+        .map(|i| (loop_points[(i + 1) % n] - loop_points[i]).norm())
+        .sum();
+    sides
+        .iter()
+        .map(|s| len(s) / total.max(f64::MIN_POSITIVE))
+        .collect()
+}
+
+/// Refuses detected corners that are not clearly corners: too flat (turning
+/// by less than `pi - max_corner_angle`) or crowded (one side longer than
+/// `max_side_share` of the loop).
+fn check_corners(
+    cfg: &CoonsFromCloudConfig,
+    loop_len: usize,
+    strengths: &[f64],
+    shares: &[f64],
+) -> Result<()> {
+    let min_turn = PI - cfg.max_corner_angle;
+    let weak = strengths.iter().filter(|&&s| s < min_turn).count();
+    let longest = shares.iter().copied().fold(0.0, f64::max);
+    if weak == 0 && longest <= cfg.max_side_share {
+        return Ok(());
+    }
+    let turns: Vec<String> = strengths
+        .iter()
+        .map(|s| format!("{:.0}", s.to_degrees()))
+        .collect();
+    let why = if weak > 0 {
+        format!(
+            "{weak} of them turn by less than {:.0} degrees",
+            min_turn.to_degrees()
+        )
+    } else {
+        format!(
+            "they crowd into {:.0}% of the loop (one side spans {:.0}% of it, more than {:.0}%)",
+            100.0 * (1.0 - longest),
+            100.0 * longest,
+            100.0 * cfg.max_side_share
+        )
+    };
+    Err(Error::InvalidSetting {
+        setting: "corners",
+        value: format!("turning angles {} degrees", turns.join(", ")),
+        hint: format!(
+            "the {} strongest corners of the boundary ({loop_len} points) are not clearly corners: {why}. The outline looks rounded, and a patch on these corners would fold; give the corners' loop positions, or split the cloud into four-sided patches (a layout), or force the detected corners",
+            strengths.len()
+        ),
     })
 }
 
@@ -209,7 +277,7 @@ mod tests {
         let e = coons_from_cloud(&pts, &CoonsFromCloudConfig::default()).unwrap_err();
         let m = e.to_string();
         assert!(
-            m.contains("sharper than 160 degrees") && m.contains("4 were asked"),
+            m.contains("not clearly corners") && m.contains("turn by less than 30 degrees"),
             "{m}"
         );
     }

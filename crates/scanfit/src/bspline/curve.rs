@@ -490,6 +490,16 @@ fn check_periodic(kv: &KnotVector, ctrl: &[Point3], w: Option<&[f64]>) -> Result
     Ok(())
 }
 
+/// A curve translates with its control points (also a rational one: the
+/// basis sums to one).
+impl crate::centring::Translate for Curve {
+    fn translate(&mut self, by: &Vector3) {
+        for p in &mut self.ctrl {
+            *p += by;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -383,6 +383,16 @@ impl Surface {
     }
 }
 
+/// A surface translates with its control points (also a rational one: the
+/// basis sums to one).
+impl crate::centring::Translate for Surface {
+    fn translate(&mut self, by: &Vector3) {
+        for p in &mut self.ctrl {
+            *p += by;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

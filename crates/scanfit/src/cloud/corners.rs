@@ -50,11 +50,16 @@ pub struct CornerConfig {
     /// Number of corners (and sides): 4 for a four-sided Coons patch, 3 for
     /// a three-sided one ([PDE23] §4.1, §5). Default 4; at least 2.
     pub count: usize,
-    /// Neighbour offset `m` (in loop positions). `None` (default):
-    /// `max(1, round(n / 100))` for a loop of `n` points, i.e. neighbours
-    /// about 1% of the loop away, which averages out the zig-zag of an alpha
-    /// shape boundary while staying well inside a side of a patch with
-    /// aspect ratio up to ~25:1. Must satisfy `2 m < n`.
+    /// Neighbour offset `m` (in loop positions; must satisfy `2 m < n`).
+    /// `None` (default): the neighbours of each point are the first loop
+    /// points at least [`ARC_NEIGHBOUR`] (2.5%) of the loop's length away
+    /// along it, before and after ([`arc_neighbour_values`]). Measured by
+    /// length, not by count, the scale does not change with the uneven
+    /// spacing of an alpha-shape boundary of sparse points, and it is wide
+    /// enough to smooth over the small notches such a boundary bites into
+    /// the outline (which a 1%-of-the-points offset picked as corners on
+    /// 2000 scattered points, missing a true corner by a whole side), while
+    /// staying inside the sides of a patch with aspect ratio up to ~15:1.
     pub offset: Option<usize>,
     /// Smallest distance between two corners along the loop, as a fraction
     /// of the loop's length. Default `0.03`: the best points around one
@@ -74,6 +79,136 @@ impl Default for CornerConfig {
     }
 }
 
+/// The default neighbour distance of the corner measures: 2.5% of the
+/// loop's length (see [`CornerConfig::offset`]).
+pub const ARC_NEIGHBOUR: f64 = 0.025;
+
+/// The criterion's value at every position of the closed loop `points`, the
+/// neighbours of each point being the first loop points at least `fraction`
+/// of the loop's length away along the loop on either side ([COONS19] eqs.
+/// 10-12 or [PDE23]'s `k = 4S/(abc)` on those three points), and the median
+/// of the neighbours' offsets in positions.
+///
+/// ```
+/// use scanfit::cloud::corners::{arc_neighbour_values, CornerCriterion};
+/// use scanfit::Point3;
+/// // a unit square with 10 points a side: 90 degrees at the corners
+/// let mut sq = Vec::new();
+/// for k in 0..40 {
+///     let (s, t) = (k / 10, (k % 10) as f64 / 10.0);
+///     sq.push(match s {
+///         0 => Point3::new(t, 0.0, 0.0),
+///         1 => Point3::new(1.0, t, 0.0),
+///         2 => Point3::new(1.0 - t, 1.0, 0.0),
+///         _ => Point3::new(0.0, 1.0 - t, 0.0),
+///     });
+/// }
+/// let (v, m) = arc_neighbour_values(&sq, CornerCriterion::TurningAngle, 0.05)?;
+/// assert_eq!(m, 2);
+/// assert!((v[10].to_degrees() - 90.0).abs() < 1e-9);
+/// assert!((v[5].to_degrees() - 180.0).abs() < 1e-9);
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+pub fn arc_neighbour_values(
+    points: &[Point3],
+    criterion: CornerCriterion,
+    fraction: f64,
+) -> Result<(Vec<f64>, usize)> {
+    validate_points(points)?;
+    let n = points.len();
+    if n < 3 || !(fraction.is_finite() && fraction > 0.0 && fraction < 0.5) {
+        return Err(Error::InvalidInput(format!(
+            "arc neighbours at {fraction} of the length of a {n}-point loop: need 3 or more points and a fraction in (0, 0.5)"
+        )));
+    }
+    let step: Vec<f64> = (0..n)
+        .map(|i| (points[(i + 1) % n] - points[i]).norm())
+        .collect();
+    if let Some(i) = step.iter().position(|&s| s == 0.0) {
+        let j = (i + 1) % n;
+        return Err(Error::DuplicatePoints {
+            first: i.min(j),
+            second: i.max(j),
+            distance: 0.0,
+        });
+    }
+    let length: f64 = step.iter().sum();
+    let reach = fraction * length;
+    // how many positions forward (backward) the neighbour of each point is
+    let walk = |i: usize, forward: bool| {
+        let (mut d, mut k) = (0.0, 0usize);
+        while d < reach && k < n / 2 {
+            let j = if forward {
+                (i + k) % n
+            } else {
+                (i + n - k - 1) % n
+            };
+            d += step[j];
+            k += 1;
+        }
+        k.max(1)
+    };
+    let mut offsets = Vec::with_capacity(n);
+    let mut out = Vec::with_capacity(n);
+    for i in 0..n {
+        let (kb, kf) = (walk(i, false), walk(i, true));
+        offsets.push(kb.max(kf));
+        let (ia, ic) = ((i + n - kb) % n, (i + kf) % n);
+        out.push(measure(points, criterion, ia, i, ic)?);
+    }
+    let mid = offsets.len() / 2;
+    let median = *offsets.select_nth_unstable(mid).1;
+    Ok((out, median))
+}
+
+/// The criterion at `b` with neighbours `a` and `c` (eqs. 10-12 or `4S/(abc)`).
+fn measure(
+    points: &[Point3],
+    criterion: CornerCriterion,
+    ia: usize,
+    i: usize,
+    ic: usize,
+) -> Result<f64> {
+    let (a, b, c) = (points[ia], points[i], points[ic]);
+    let d1 = a - b; // eq. 10
+    let d2 = c - b; // eq. 11
+    let (l1, l2) = (d1.norm(), d2.norm());
+    for (j, l) in [(ia, l1), (ic, l2)] {
+        if l == 0.0 {
+            return Err(Error::DuplicatePoints {
+                first: j.min(i),
+                second: j.max(i),
+                distance: 0.0,
+            });
+        }
+    }
+    Ok(match criterion {
+        // eq. 12
+        CornerCriterion::TurningAngle => (d1.dot(&d2) / (l1 * l2)).clamp(-1.0, 1.0).acos(),
+        CornerCriterion::ThreePointCurvature => {
+            let s = 0.5 * d1.cross(&d2).norm();
+            let ac = (c - a).norm();
+            if ac == 0.0 {
+                return Err(Error::DuplicatePoints {
+                    first: ia.min(ic),
+                    second: ia.max(ic),
+                    distance: 0.0,
+                });
+            }
+            4.0 * s / (l1 * l2 * ac)
+        }
+    })
+}
+
+/// The criterion's values by the rule of `config` (its index offset, or the
+/// arc neighbours when it has none) and the (median) offset used.
+pub fn values_for(points: &[Point3], config: &CornerConfig) -> Result<(Vec<f64>, usize)> {
+    match config.offset {
+        Some(m) => Ok((corner_values(points, config.criterion, m)?, m)),
+        None => arc_neighbour_values(points, config.criterion, ARC_NEIGHBOUR),
+    }
+}
+
 /// Corners of a loop and its sides. All indices are positions in the loop.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Corners {
@@ -85,7 +220,7 @@ pub struct Corners {
     /// The criterion's value at every loop position (angle in radians or
     /// curvature).
     pub values: Vec<f64>,
-    /// The neighbour offset used.
+    /// The neighbour offset used (the median one with arc neighbours).
     pub offset: usize,
 }
 
@@ -107,41 +242,9 @@ pub fn corner_values(
             "neighbour offset {offset} does not fit a loop of {n} points; it needs 1 <= offset < n / 2"
         )));
     }
-    let mut out = Vec::with_capacity(n);
-    for i in 0..n {
-        let (ia, ic) = ((i + n - offset) % n, (i + offset) % n);
-        let (a, b, c) = (points[ia], points[i], points[ic]);
-        let d1 = a - b; // eq. 10
-        let d2 = c - b; // eq. 11
-        let (l1, l2) = (d1.norm(), d2.norm());
-        for (j, l) in [(ia, l1), (ic, l2)] {
-            if l == 0.0 {
-                return Err(Error::DuplicatePoints {
-                    first: j.min(i),
-                    second: j.max(i),
-                    distance: 0.0,
-                });
-            }
-        }
-        let v = match criterion {
-            // eq. 12
-            CornerCriterion::TurningAngle => (d1.dot(&d2) / (l1 * l2)).clamp(-1.0, 1.0).acos(),
-            CornerCriterion::ThreePointCurvature => {
-                let s = 0.5 * d1.cross(&d2).norm();
-                let ac = (c - a).norm();
-                if ac == 0.0 {
-                    return Err(Error::DuplicatePoints {
-                        first: ia.min(ic),
-                        second: ia.max(ic),
-                        distance: 0.0,
-                    });
-                }
-                4.0 * s / (l1 * l2 * ac)
-            }
-        };
-        out.push(v);
-    }
-    Ok(out)
+    (0..n)
+        .map(|i| measure(points, criterion, (i + n - offset) % n, i, (i + offset) % n))
+        .collect()
 }
 
 /// Finds `config.count` corners on the closed loop `points` (first point not
@@ -178,10 +281,7 @@ pub fn find_corners(points: &[Point3], config: &CornerConfig) -> Result<Corners>
             "min_separation = {sep} must be a fraction of the loop length in [0, 0.5) (default 0.03)"
         )));
     }
-    let offset = config
-        .offset
-        .unwrap_or_else(|| ((n as f64 / 100.0).round() as usize).max(1));
-    let values = corner_values(points, config.criterion, offset)?;
+    let (values, offset) = values_for(points, config)?;
     // arc length along the loop
     let mut s = Vec::with_capacity(n);
     let mut acc = 0.0;
@@ -220,7 +320,30 @@ pub fn find_corners(points: &[Point3], config: &CornerConfig) -> Result<Corners>
             config.count
         )));
     }
+    if config.offset.is_none() {
+        // at the wide arc scale the angle is nearly as small a few points
+        // either side of a corner: move each pick to the apex of its
+        // neighbourhood, the point farthest from the chord between its
+        // neighbours
+        for c in picked.iter_mut() {
+            *c = apex(points, *c, offset);
+        }
+        picked.dedup();
+        if picked.len() < config.count {
+            return Err(Error::InvalidInput(format!(
+                "two of the {} corners of the {n}-point loop fall on one point; lower the count",
+                config.count
+            )));
+        }
+    }
     picked.sort_unstable();
+    picked.dedup();
+    if picked.len() < config.count {
+        return Err(Error::InvalidInput(format!(
+            "two of the {} corners of the {n}-point loop fall on one point; lower the count",
+            config.count
+        )));
+    }
     let sides = split_at_corners(n, &picked)?;
     Ok(Corners {
         corners: picked,
@@ -228,6 +351,31 @@ pub fn find_corners(points: &[Point3], config: &CornerConfig) -> Result<Corners>
         values,
         offset,
     })
+}
+
+/// The loop position within `m` of `i` farthest from the chord between
+/// positions `i - m` and `i + m` (the apex of the turn).
+fn apex(points: &[Point3], i: usize, m: usize) -> usize {
+    let n = points.len();
+    let (a, c) = (points[(i + n - m) % n], points[(i + m) % n]);
+    let chord = c - a;
+    let len2 = chord.norm_squared();
+    let dist = |p: &Point3| {
+        let d = p - a;
+        if len2 > 0.0 {
+            (d - chord * (d.dot(&chord) / len2)).norm()
+        } else {
+            d.norm()
+        }
+    };
+    (0..=2 * m)
+        .map(|k| (i + n - m + k) % n)
+        .max_by(|&x, &y| {
+            dist(&points[x])
+                .total_cmp(&dist(&points[y]))
+                .then(y.cmp(&x))
+        })
+        .unwrap_or(i)
 }
 
 /// Splits a closed loop of `n` points at the given corner positions into
@@ -362,7 +510,8 @@ mod tests {
                 ..Default::default()
             };
             let c = find_corners(&p, &cfg).unwrap();
-            assert_eq!(c.offset, 6);
+            // neighbours 2.5% of the perimeter (0.3) away: 15 spacings
+            assert!((14..=17).contains(&c.offset), "{}", c.offset);
             assert_eq!(c.corners.len(), 4);
             assert_near_each(&c.corners, &truth, 600, 2);
             check_sides(&c, 600);
@@ -400,17 +549,11 @@ mod tests {
                 ..Default::default()
             };
             let c = find_corners(&p, &cfg).unwrap();
-            match criterion {
-                // the angle is smallest exactly at a corner
-                CornerCriterion::TurningAngle => assert_eq!(c.corners, truth),
-                // 4S/(abc) with neighbours m apart peaks next to an acute
-                // corner: moving B off the corner along a side opens the
-                // angle at B and shrinks the circumradius |AC| / (2 sin B)
-                CornerCriterion::ThreePointCurvature => {
-                    assert_near_each(&c.corners, &truth, n, c.offset / 2);
-                    assert_ne!(c.corners, truth);
-                }
-            }
+            // 4S/(abc) with neighbours m apart peaks next to an acute corner
+            // (moving B off the corner along a side opens the angle at B and
+            // shrinks the circumradius |AC| / (2 sin B)); the apex step moves
+            // every pick onto the corner, for both criteria
+            assert_eq!(c.corners, truth);
             check_sides(&c, n);
         }
         // the turning angle at a corner is the triangle's interior angle
@@ -474,12 +617,11 @@ mod tests {
                 criterion,
                 ..Default::default()
             };
-            // the default offset (n / 100 = 11) is below half an arc (26
-            // points): every arc point 11 or more from the arc's ends scores
-            // the same (inscribed angle), the corner is somewhere on that plateau
+            // the default neighbours (2.5% of the loop, 29 points) reach
+            // past half an arc (26 points): the apex is the arc middle
             let c = find_corners(&p, &cfg).unwrap();
-            assert_eq!((n, c.offset), (1140, 11));
-            assert_near_each(&c.corners, &mids, n, 26 - 11);
+            assert_eq!((n, c.offset), (1140, 29));
+            assert_near_each(&c.corners, &mids, n, 2);
             check_sides(&c, n);
             // an offset reaching past the arc's ends peaks at the arc middle
             let cfg = CornerConfig {

@@ -17,6 +17,8 @@
 //!   of its projection on the best-fit plane.
 //! * [`corners`]: corners of a closed boundary loop (smallest turning angle or
 //!   largest three-point curvature) and the loop's split into sides.
+//! * [`segment`]: regions bounded by sharp edges, by octree cells subdivided
+//!   where the normals vary ([COONS19]).
 
 pub mod boundary;
 pub mod corners;
@@ -24,6 +26,7 @@ pub mod hpr;
 pub mod hull;
 pub mod neighbours;
 pub mod normals;
+pub mod segment;
 #[cfg(test)]
 pub(crate) mod testutil;
 

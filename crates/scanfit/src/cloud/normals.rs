@@ -20,6 +20,7 @@ use std::collections::BinaryHeap;
 
 use rayon::prelude::*;
 
+use super::neighbours::Neighbourhoods;
 use super::PointCloud;
 use crate::{pca, Error, Point3, Result, Vector3};
 
@@ -91,6 +92,36 @@ pub fn estimate_normals(cloud: &PointCloud, config: &NormalsConfig) -> Result<No
         });
     }
     let graph = cloud.knn_graph(config.k)?;
+    estimate_normals_on(cloud, &graph, config)
+}
+
+/// [`estimate_normals`] over a neighbour graph already built
+/// (`cloud.knn_graph(k)`; its `k` is the one used), for callers that need
+/// the graph too (segmentation grows regions over it).
+///
+/// ```
+/// use scanfit::cloud::normals::{estimate_normals_on, NormalsConfig, Orientation};
+/// use scanfit::{Point3, PointCloud};
+/// let pts = (0..100).map(|i| Point3::new((i % 10) as f64, (i / 10) as f64, 0.0)).collect();
+/// let cloud = PointCloud::new(pts)?;
+/// let graph = cloud.knn_graph(8)?;
+/// let cfg = NormalsConfig { k: 8, orientation: Orientation::None };
+/// let n = estimate_normals_on(&cloud, &graph, &cfg)?;
+/// assert!(n.normals.iter().all(|n| n.z.abs() > 1.0 - 1e-12));
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+pub fn estimate_normals_on(
+    cloud: &PointCloud,
+    graph: &Neighbourhoods,
+    config: &NormalsConfig,
+) -> Result<Normals> {
+    if graph.len() != cloud.len() {
+        return Err(Error::LengthMismatch {
+            what: "neighbour graph rows",
+            expected: cloud.len(),
+            got: graph.len(),
+        });
+    }
     let points = cloud.points();
     let scale = cloud.diagonal();
     let per_point: Vec<(Vector3, f64, bool)> = (0..points.len())
@@ -167,7 +198,7 @@ struct Adjacency {
 }
 
 impl Adjacency {
-    fn of(graph: &super::neighbours::Neighbourhoods) -> Self {
+    fn of(graph: &Neighbourhoods) -> Self {
         let n = graph.len();
         let mut offsets = vec![0usize; n + 1];
         for i in 0..n {

@@ -20,6 +20,7 @@ use faer::{Mat, Side};
 
 use super::gram;
 use crate::bspline::{BasisWorkspace, KnotVector, Surface};
+use crate::par::BlockSum;
 use crate::{Error, Point3, Result};
 
 /// How the knots of a least-squares surface are placed.
@@ -79,6 +80,33 @@ pub const MAX_SURFACE_CONTROL_POINTS: usize = 1 << 22;
 
 /// Fits a surface to `points` with parameters `uv` in `[0, 1]^2`.
 pub fn fit_surface(points: &[Point3], uv: &[[f64; 2]], cfg: &SurfaceFitConfig) -> Result<Surface> {
+    check_net(cfg)?;
+    let (p, q) = cfg.degree;
+    let (nu, nv) = cfg.ctrl;
+    let ku = if cfg.periodic_u {
+        KnotVector::uniform_periodic(p, nu)?
+    } else {
+        match cfg.knots {
+            KnotPlacement::Uniform => KnotVector::uniform_clamped(p, nu)?,
+            KnotPlacement::Distribution => distribution_knots(uv.iter().map(|t| t[0]), p, nu)?,
+        }
+    };
+    let kv = match cfg.knots {
+        KnotPlacement::Uniform => KnotVector::uniform_clamped(q, nv)?,
+        KnotPlacement::Distribution => distribution_knots(uv.iter().map(|t| t[1]), q, nv)?,
+    };
+    let opts = SurfaceLsqOptions {
+        smoothing: cfg.smoothing,
+        weights: cfg.weights.as_deref(),
+        periodic_u: cfg.periodic_u,
+    };
+    least_squares_surface_with(points, uv, ku, kv, opts)
+}
+
+/// The degrees and net of `cfg` are usable: degrees 1 to 10, at least
+/// `p + 1` (periodic: `2p + 1`) by `q + 1` control points, at most
+/// [`MAX_SURFACE_CONTROL_POINTS`].
+fn check_net(cfg: &SurfaceFitConfig) -> Result<()> {
     let (p, q) = cfg.degree;
     let (nu, nv) = cfg.ctrl;
     if p == 0 || q == 0 {
@@ -102,24 +130,48 @@ pub fn fit_surface(points: &[Point3], uv: &[[f64; 2]], cfg: &SurfaceFitConfig) -
             "a {nu} x {nv} control net of degrees {p} x {q} is beyond the limits ({MAX_SURFACE_CONTROL_POINTS} control points, degree 10); choose a smaller net"
         )));
     }
-    let ku = if cfg.periodic_u {
-        KnotVector::uniform_periodic(p, nu)?
-    } else {
-        match cfg.knots {
-            KnotPlacement::Uniform => KnotVector::uniform_clamped(p, nu)?,
-            KnotPlacement::Distribution => distribution_knots(uv.iter().map(|t| t[0]), p, nu)?,
+    Ok(())
+}
+
+impl SurfaceFitConfig {
+    /// Empty normal equations for this configuration with uniform knots
+    /// (the knots of [`fit_surface`] with [`KnotPlacement::Uniform`]), for
+    /// points that arrive in chunks. Errors for the distribution knots
+    /// (NURBS Book eq. 9.69 needs all parameters sorted at once) and for
+    /// weights (give them per chunk to [`NormalEquations::add`]).
+    ///
+    /// ```
+    /// use scanfit::fit::surface::{KnotPlacement, SurfaceFitConfig};
+    /// let cfg = SurfaceFitConfig { knots: KnotPlacement::Uniform, ctrl: (10, 8), ..Default::default() };
+    /// let eq = cfg.uniform_equations()?;
+    /// assert_eq!(eq.points(), 0);
+    /// assert!(SurfaceFitConfig::default().uniform_equations().is_err());
+    /// # Ok::<(), scanfit::Error>(())
+    /// ```
+    pub fn uniform_equations(&self) -> Result<NormalEquations> {
+        check_net(self)?;
+        if self.knots != KnotPlacement::Uniform {
+            return Err(Error::InvalidSetting {
+                setting: "knots",
+                value: "distribution".into(),
+                hint: "knots from the parameter distribution (NURBS Book eq. 9.69) need all parameters sorted at once; use uniform knots for points read in chunks".into(),
+            });
         }
-    };
-    let kv = match cfg.knots {
-        KnotPlacement::Uniform => KnotVector::uniform_clamped(q, nv)?,
-        KnotPlacement::Distribution => distribution_knots(uv.iter().map(|t| t[1]), q, nv)?,
-    };
-    let opts = SurfaceLsqOptions {
-        smoothing: cfg.smoothing,
-        weights: cfg.weights.as_deref(),
-        periodic_u: cfg.periodic_u,
-    };
-    least_squares_surface_with(points, uv, ku, kv, opts)
+        if self.weights.is_some() {
+            return Err(Error::InvalidSetting {
+                setting: "weights",
+                value: "given".into(),
+                hint: "give the weights of points read in chunks with each chunk (NormalEquations::add)".into(),
+            });
+        }
+        let ((p, q), (nu, nv)) = (self.degree, self.ctrl);
+        let ku = if self.periodic_u {
+            KnotVector::uniform_periodic(p, nu)?
+        } else {
+            KnotVector::uniform_clamped(p, nu)?
+        };
+        NormalEquations::new(ku, KnotVector::uniform_clamped(q, nv)?, self.periodic_u)
+    }
 }
 
 /// Clamped knots on `[0, 1]` whose interior knots follow the distribution of the
@@ -156,65 +208,276 @@ pub fn least_squares_surface_with(
     kv: KnotVector,
     opts: SurfaceLsqOptions,
 ) -> Result<Surface> {
-    let (p, q) = (ku.degree(), kv.degree());
-    let nu_total = ku.basis_count();
+    let p = ku.degree();
     let nu = if opts.periodic_u {
-        nu_total - p
+        ku.basis_count().saturating_sub(p)
     } else {
-        nu_total
+        ku.basis_count()
     };
-    let nv = kv.basis_count();
-    let n = nu * nv;
-    validate(points, uv, &ku, &kv, &opts, n)?;
-    if opts.periodic_u && nu < 2 * p + 1 {
-        return Err(Error::InvalidInput(format!(
-            "periodic in u with degree {p} needs at least {} distinct control rows, got {nu}",
-            2 * p + 1
-        )));
+    validate(points, uv, &ku, &kv, &opts, nu * kv.basis_count())?;
+    let mut eq = NormalEquations::new(ku, kv, opts.periodic_u)?;
+    eq.add_checked(points, uv, opts.weights);
+    eq.finish(opts.smoothing)
+}
+
+/// The normal equations of the least-squares surface (see the module
+/// documentation) as a sum over points that can be built in pieces: create
+/// it from the knot vectors, [`add`](Self::add) chunks of points with their
+/// parameters (and weights), [`merge`](Self::merge) the equations of other
+/// chunks, and [`finish`](Self::finish) with the smoothing weight to solve
+/// for the surface. Memory is that of the band-block matrix, `nu nv
+/// (2p+1)(2q+1)` values, whatever the number of points.
+///
+/// Points are summed in blocks of 16384 counted from the first point added
+/// (a constant, so the order of the floating-point operations depends on
+/// neither the thread count nor the chunks): adding the points of a file in
+/// chunks of any size, in file order, gives the same surface, bit for bit,
+/// as [`least_squares_surface_with`] on all of them at once (which goes
+/// through this type). Merging equations summed separately (other machines)
+/// equals the one-pass sum up to the rounding of the additions.
+///
+/// ```
+/// use scanfit::bspline::KnotVector;
+/// use scanfit::fit::surface::{least_squares_surface_with, NormalEquations, SurfaceLsqOptions};
+/// use scanfit::Point3;
+///
+/// let (mut pts, mut uv) = (Vec::new(), Vec::new());
+/// for k in 0..2000 {
+///     let (u, v) = ((k % 50) as f64 / 49.0, (k / 50) as f64 / 39.0);
+///     pts.push(Point3::new(u, v, (3.0 * u).sin() * v));
+///     uv.push([u, v]);
+/// }
+/// let k = KnotVector::uniform_clamped(3, 8)?;
+/// let once = least_squares_surface_with(&pts, &uv, k.clone(), k.clone(), SurfaceLsqOptions::default())?;
+/// // two halves summed separately, then merged
+/// let mut a = NormalEquations::new(k.clone(), k.clone(), false)?;
+/// let mut b = NormalEquations::new(k.clone(), k, false)?;
+/// a.add(&pts[..700], &uv[..700], None)?;
+/// b.add(&pts[700..], &uv[700..], None)?;
+/// a.merge(b)?;
+/// assert_eq!(a.points(), 2000);
+/// let merged = a.finish(0.0)?;
+/// for (x, y) in once.control_points().iter().zip(merged.control_points()) {
+///     assert!((x - y).norm() < 1e-12);
+/// }
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct NormalEquations {
+    ku: KnotVector,
+    kv: KnotVector,
+    layout: Layout,
+    sums: BlockSum<(Vec<f64>, Vec<f64>)>,
+}
+
+impl NormalEquations {
+    /// Empty equations for the clamped knot vectors `ku`, `kv` (periodic in
+    /// `u` when `periodic_u`: the last `p` control rows repeat the first).
+    /// Errors for nets beyond [`MAX_SURFACE_CONTROL_POINTS`] or degree 10, or
+    /// a periodic net with fewer than `2p + 1` rows.
+    pub fn new(ku: KnotVector, kv: KnotVector, periodic_u: bool) -> Result<Self> {
+        let (p, q) = (ku.degree(), kv.degree());
+        let nu_total = ku.basis_count();
+        let nu = if periodic_u {
+            nu_total.saturating_sub(p)
+        } else {
+            nu_total
+        };
+        let nv = kv.basis_count();
+        if nu
+            .checked_mul(nv)
+            .is_none_or(|n| n > MAX_SURFACE_CONTROL_POINTS)
+            || p > 10
+            || q > 10
+        {
+            return Err(Error::InvalidInput(format!(
+                "a {nu} x {nv} control net of degrees {p} x {q} is beyond the limits ({MAX_SURFACE_CONTROL_POINTS} control points, degree 10); choose a smaller net"
+            )));
+        }
+        if periodic_u && nu < 2 * p + 1 {
+            return Err(Error::InvalidInput(format!(
+                "periodic in u with degree {p} needs at least {} distinct control rows, got {nu}",
+                2 * p + 1
+            )));
+        }
+        let layout = Layout {
+            p,
+            q,
+            nu,
+            nv,
+            periodic: periodic_u,
+        };
+        let block = ASSEMBLY_CHUNK;
+        Ok(Self {
+            ku,
+            kv,
+            sums: BlockSum::new(layout.zeros(), block),
+            layout,
+        })
     }
-    let layout = Layout {
-        p,
-        q,
-        nu,
-        nv,
-        periodic: opts.periodic_u,
-    };
-    let (mut acc, rhs, diag_data) = assemble(points, uv, &ku, &kv, opts.weights, &layout);
-    if opts.smoothing > 0.0 {
-        add_thin_plate(&mut acc, &ku, &kv, opts.smoothing, &layout);
-    } else if let Some((i, j)) = diag_data
-        .iter()
-        .position(|&d| d <= 0.0)
-        .map(|k| (k / nv, k % nv))
-    {
-        let tu = ku.as_slice();
-        let tv = kv.as_slice();
-        return Err(Error::Singular {
-            what: "least-squares surface".into(),
-            condition: f64::INFINITY,
-            hint: format!(
-                "no data point influences control point ({i}, {j}): the region u in [{:.4}, {:.4}], v in [{:.4}, {:.4}] is empty; add smoothing (--smooth) or use fewer control points",
-                tu[i].max(ku.domain().0),
-                tu[i + p + 1].min(ku.domain().1),
-                tv[j].max(kv.domain().0),
-                tv[j + q + 1].min(kv.domain().1)
-            ),
+
+    /// Points added so far (over all merged equations).
+    pub fn points(&self) -> u64 {
+        self.sums.items()
+    }
+
+    /// Bytes the equations hold (the matrix band and the right-hand sides),
+    /// for a memory estimate before any point is read.
+    pub fn bytes(&self) -> usize {
+        self.layout.values() * std::mem::size_of::<f64>()
+    }
+
+    /// Adds the points `points` with parameters `uv` (inside the knot
+    /// vectors' domains) and optional non-negative `weights` (default 1).
+    /// Errors name the index of the offending point within the chunk.
+    pub fn add(
+        &mut self,
+        points: &[Point3],
+        uv: &[[f64; 2]],
+        weights: Option<&[f64]>,
+    ) -> Result<()> {
+        check_chunk(points, uv, &self.ku, &self.kv, weights)?;
+        self.add_checked(points, uv, weights);
+        Ok(())
+    }
+
+    /// Adds the equations of another set of points (the same knot vectors
+    /// and periodicity).
+    pub fn merge(&mut self, other: Self) -> Result<()> {
+        if self.ku != other.ku
+            || self.kv != other.kv
+            || self.layout.periodic != other.layout.periodic
+        {
+            return Err(Error::InvalidInput(
+                "cannot merge normal equations of different knot vectors or periodicity; every chunk must be summed with the same knots".into(),
+            ));
+        }
+        self.sums.merge(other.sums, merge_sums);
+        Ok(())
+    }
+
+    /// Solves for the surface, with `smoothing` times the thin-plate energy
+    /// (exact Gram matrices, [`super::gram`]). Errors when the points do not
+    /// determine the net: fewer points than control points without
+    /// smoothing, a control point no point influences, or a singular matrix.
+    pub fn finish(self, smoothing: f64) -> Result<Surface> {
+        super::validate_weights_and_smoothing(None, 0, smoothing)?;
+        let l = self.layout;
+        let (ku, kv) = (self.ku, self.kv);
+        let points = self.sums.items();
+        let n = l.nu * l.nv;
+        if smoothing == 0.0 && points < n as u64 {
+            return Err(Error::TooFewPoints {
+                got: usize::try_from(points).unwrap_or(usize::MAX),
+                needed: n,
+                what: format!(
+                    "a least-squares surface with {n} control points (without smoothing)"
+                ),
+            });
+        }
+        let (mut acc, rhs) = self.sums.finish(merge_sums);
+        let (p, q, nv) = (l.p, l.q, l.nv);
+        let centre = l.slot(p, q);
+        if smoothing > 0.0 {
+            add_thin_plate(&mut acc, &ku, &kv, smoothing, &l);
+        } else if let Some((i, j)) = (0..n)
+            .position(|r| acc[r * l.slots() + centre] <= 0.0)
+            .map(|k| (k / nv, k % nv))
+        {
+            let tu = ku.as_slice();
+            let tv = kv.as_slice();
+            return Err(Error::Singular {
+                what: "least-squares surface".into(),
+                condition: f64::INFINITY,
+                hint: format!(
+                    "no data point influences control point ({i}, {j}): the region u in [{:.4}, {:.4}], v in [{:.4}, {:.4}] is empty; add smoothing (--smooth) or use fewer control points",
+                    tu[i].max(ku.domain().0),
+                    tu[i + p + 1].min(ku.domain().1),
+                    tv[j].max(kv.domain().0),
+                    tv[j + q + 1].min(kv.domain().1)
+                ),
+            });
+        }
+        let sol = solve(acc, rhs, &l)?;
+        // unfold into the control net (repeating the first p rows when periodic)
+        let nu_total = ku.basis_count();
+        let mut ctrl = Vec::with_capacity(nu_total * nv);
+        for i in 0..nu_total {
+            let fi = i % l.nu;
+            for j in 0..nv {
+                let r = fi * nv + j;
+                ctrl.push(Point3::new(sol[(r, 0)], sol[(r, 1)], sol[(r, 2)]));
+            }
+        }
+        Surface::with_options(ku, kv, ctrl, None, l.periodic, false)
+    }
+
+    /// [`add`](Self::add) without the checks (the caller made them).
+    fn add_checked(&mut self, points: &[Point3], uv: &[[f64; 2]], weights: Option<&[f64]>) {
+        let l = &self.layout;
+        let partials = (PARTIAL_BUDGET / self.bytes().max(1)).clamp(1, 16);
+        let (ku, kv) = (&self.ku, &self.kv);
+        self.sums.add(
+            points.len(),
+            partials,
+            || l.zeros(),
+            |sums, range| assemble_range(sums, points, uv, ku, kv, weights, l, range),
+            merge_sums,
+        );
+    }
+}
+
+/// Bytes of partial sums that may exist at a time during an assembly.
+const PARTIAL_BUDGET: usize = 256 << 20;
+
+/// Adds a partial (matrix band, right-hand sides) to a total.
+fn merge_sums(total: &mut (Vec<f64>, Vec<f64>), part: (Vec<f64>, Vec<f64>)) {
+    total.0.iter_mut().zip(&part.0).for_each(|(x, y)| *x += y);
+    total.1.iter_mut().zip(&part.1).for_each(|(x, y)| *x += y);
+}
+
+/// Checks a chunk for [`NormalEquations::add`]: equal lengths, finite
+/// points, parameters inside the domains, valid weights.
+fn check_chunk(
+    points: &[Point3],
+    uv: &[[f64; 2]],
+    ku: &KnotVector,
+    kv: &KnotVector,
+    weights: Option<&[f64]>,
+) -> Result<()> {
+    if points.len() != uv.len() {
+        return Err(Error::LengthMismatch {
+            what: "parameter pairs",
+            expected: points.len(),
+            got: uv.len(),
         });
     }
-    let sol = solve(acc, rhs, &layout)?;
-    // unfold into the control net (repeating the first p rows when periodic)
-    let mut ctrl = Vec::with_capacity(nu_total * nv);
-    for i in 0..nu_total {
-        let fi = i % nu;
-        for j in 0..nv {
-            let r = fi * nv + j;
-            ctrl.push(Point3::new(sol[(r, 0)], sol[(r, 1)], sol[(r, 2)]));
+    crate::validate_points(points)?;
+    check_domain(uv, ku, kv)?;
+    super::validate_weights_and_smoothing(weights, points.len(), 0.0)
+}
+
+/// Every parameter pair finite and inside the knot vectors' domains.
+fn check_domain(uv: &[[f64; 2]], ku: &KnotVector, kv: &KnotVector) -> Result<()> {
+    let ((u0, u1), (v0, v1)) = (ku.domain(), kv.domain());
+    let tol = 1e-12;
+    for (k, t) in uv.iter().enumerate() {
+        let inside = t[0] >= u0 - tol && t[0] <= u1 + tol && t[1] >= v0 - tol && t[1] <= v1 + tol;
+        if !inside || !t[0].is_finite() || !t[1].is_finite() {
+            return Err(Error::ParametersOutsideDomain {
+                index: k,
+                u: t[0],
+                v: t[1],
+                u_range: (u0, u1),
+                v_range: (v0, v1),
+            });
         }
     }
-    Surface::with_options(ku, kv, ctrl, None, opts.periodic_u, false)
+    Ok(())
 }
 
 /// Index bookkeeping of the band-block normal matrix.
+#[derive(Debug, Clone, Copy)]
 struct Layout {
     p: usize,
     q: usize,
@@ -224,6 +487,15 @@ struct Layout {
 }
 
 impl Layout {
+    /// Values of the matrix band and the three right-hand sides.
+    fn values(&self) -> usize {
+        self.nu * self.nv * (self.slots() + 3)
+    }
+    /// A zero matrix band and right-hand sides.
+    fn zeros(&self) -> (Vec<f64>, Vec<f64>) {
+        let n = self.nu * self.nv;
+        (vec![0.0; n * self.slots()], vec![0.0; n * 3])
+    }
     /// Slots per row: `(2p+1)(2q+1)`.
     fn slots(&self) -> usize {
         (2 * self.p + 1) * (2 * self.q + 1)
@@ -280,20 +552,7 @@ fn validate(
         });
     }
     crate::validate_points(points)?;
-    let ((u0, u1), (v0, v1)) = (ku.domain(), kv.domain());
-    let tol = 1e-12;
-    for (k, t) in uv.iter().enumerate() {
-        let inside = t[0] >= u0 - tol && t[0] <= u1 + tol && t[1] >= v0 - tol && t[1] <= v1 + tol;
-        if !inside || !t[0].is_finite() || !t[1].is_finite() {
-            return Err(Error::ParametersOutsideDomain {
-                index: k,
-                u: t[0],
-                v: t[1],
-                u_range: (u0, u1),
-                v_range: (v0, v1),
-            });
-        }
-    }
+    check_domain(uv, ku, kv)?;
     super::validate_weights_and_smoothing(opts.weights, points.len(), opts.smoothing)?;
     if opts.smoothing == 0.0 {
         if points.len() < unknowns {
@@ -325,78 +584,64 @@ fn validate(
     Ok(())
 }
 
-/// Points per chunk of the parallel assembly ([`crate::par::accumulate`]): a
-/// constant, so the summation order does not depend on the thread count.
+/// Points per block of the assembly ([`BlockSum`]): a constant, so the
+/// summation order depends on neither the thread count nor the chunks.
 const ASSEMBLY_CHUNK: usize = 16_384;
 
-/// Normal equations in band-block layout, right-hand sides, and the diagonal
-/// data term per unknown (zero where no point influences a control point).
-fn assemble(
+/// Adds the points `range` to the matrix band and right-hand sides `sums`.
+#[allow(clippy::too_many_arguments)]
+fn assemble_range(
+    sums: &mut (Vec<f64>, Vec<f64>),
     points: &[Point3],
     uv: &[[f64; 2]],
     ku: &KnotVector,
     kv: &KnotVector,
     weights: Option<&[f64]>,
     l: &Layout,
-) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-    let n = l.nu * l.nv;
+    range: std::ops::Range<usize>,
+) {
+    let (acc, rhs) = sums;
     let s = l.slots();
     let (p, q) = (l.p, l.q);
     let tu = ku.as_slice();
     let tv = kv.as_slice();
-    // fixed chunks merged in order (crate::par): the sums, and so the
-    // surface, are bit-identical for every thread count
-    let (acc, rhs) = crate::par::accumulate(
-        points.len(),
-        ASSEMBLY_CHUNK,
-        || (vec![0.0; n * s], vec![0.0; n * 3]),
-        |(acc, rhs), range| {
-            let mut wu = BasisWorkspace::new(p, 0);
-            let mut wv = BasisWorkspace::new(q, 0);
-            let mut b = vec![0.0; (p + 1) * (q + 1)];
-            let mut rows = vec![0usize; (p + 1) * (q + 1)];
-            for idx in range {
-                let pt = &points[idx];
-                let [u, v] = uv[idx];
-                let w = weights.map_or(1.0, |w| w[idx]);
-                let (su, sv) = (ku.find_span(u), kv.find_span(v));
-                let nu_ = wu.values(tu, su, u);
-                let nv_ = wv.values(tv, sv, v);
-                for a in 0..=p {
-                    for bb in 0..=q {
-                        b[a * (q + 1) + bb] = nu_[a] * nv_[bb];
-                        rows[a * (q + 1) + bb] = l.fold(su - p + a) * l.nv + sv - q + bb;
-                    }
-                }
-                for a in 0..=p {
-                    for bb in 0..=q {
-                        let x = w * b[a * (q + 1) + bb];
-                        if x == 0.0 {
-                            continue;
-                        }
-                        let r = rows[a * (q + 1) + bb];
-                        let base = r * s;
-                        for c2 in 0..=p {
-                            let srow = l.slot(c2 + p - a, 0);
-                            for d in 0..=q {
-                                acc[base + srow + d + q - bb] += x * b[c2 * (q + 1) + d];
-                            }
-                        }
-                        rhs[r * 3] += x * pt.x;
-                        rhs[r * 3 + 1] += x * pt.y;
-                        rhs[r * 3 + 2] += x * pt.z;
-                    }
-                }
+    let mut wu = BasisWorkspace::new(p, 0);
+    let mut wv = BasisWorkspace::new(q, 0);
+    let mut b = vec![0.0; (p + 1) * (q + 1)];
+    let mut rows = vec![0usize; (p + 1) * (q + 1)];
+    for idx in range {
+        let pt = &points[idx];
+        let [u, v] = uv[idx];
+        let w = weights.map_or(1.0, |w| w[idx]);
+        let (su, sv) = (ku.find_span(u), kv.find_span(v));
+        let nu_ = wu.values(tu, su, u);
+        let nv_ = wv.values(tv, sv, v);
+        for a in 0..=p {
+            for bb in 0..=q {
+                b[a * (q + 1) + bb] = nu_[a] * nv_[bb];
+                rows[a * (q + 1) + bb] = l.fold(su - p + a) * l.nv + sv - q + bb;
             }
-        },
-        |(a1, r1), (a2, r2)| {
-            a1.iter_mut().zip(&a2).for_each(|(x, y)| *x += y);
-            r1.iter_mut().zip(&r2).for_each(|(x, y)| *x += y);
-        },
-    );
-    let centre = l.slot(p, q);
-    let diag = (0..n).map(|r| acc[r * s + centre]).collect();
-    (acc, rhs, diag)
+        }
+        for a in 0..=p {
+            for bb in 0..=q {
+                let x = w * b[a * (q + 1) + bb];
+                if x == 0.0 {
+                    continue;
+                }
+                let r = rows[a * (q + 1) + bb];
+                let base = r * s;
+                for c2 in 0..=p {
+                    let srow = l.slot(c2 + p - a, 0);
+                    for d in 0..=q {
+                        acc[base + srow + d + q - bb] += x * b[c2 * (q + 1) + d];
+                    }
+                }
+                rhs[r * 3] += x * pt.x;
+                rhs[r * 3 + 1] += x * pt.y;
+                rhs[r * 3 + 2] += x * pt.z;
+            }
+        }
+    }
 }
 
 /// Adds `lambda` times the thin-plate energy matrix
@@ -468,4 +713,120 @@ fn solve(acc: Vec<f64>, rhs: Vec<f64>, l: &Layout) -> Result<Mat<f64>> {
         return Err(singular("the solution is not finite; add smoothing".into()));
     }
     Ok(x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A wavy sheet with scattered parameters, weights and a far offset.
+    fn data(n: usize) -> (Vec<Point3>, Vec<[f64; 2]>, Vec<f64>) {
+        let mut rng = crate::testdata::Lcg::new(3);
+        let (mut p, mut uv, mut w) = (Vec::new(), Vec::new(), Vec::new());
+        for _ in 0..n {
+            let (u, v) = (rng.next_f64(), rng.next_f64());
+            p.push(Point3::new(
+                1e5 + 50.0 * u,
+                -2e5 + 30.0 * v,
+                4.0 * (5.0 * u).sin() * (3.0 * v).cos(),
+            ));
+            uv.push([u, v]);
+            w.push(0.5 + rng.next_f64());
+        }
+        (p, uv, w)
+    }
+
+    fn max_diff(a: &Surface, b: &Surface) -> f64 {
+        a.control_points()
+            .iter()
+            .zip(b.control_points())
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).norm()))
+    }
+
+    #[test]
+    fn chunks_in_order_give_the_one_call_surface_bit_for_bit_and_trees_to_1e12() {
+        let (p, uv, w) = data(50_000);
+        for periodic in [false, true] {
+            let ku = if periodic {
+                KnotVector::uniform_periodic(3, 12).unwrap()
+            } else {
+                KnotVector::uniform_clamped(3, 12).unwrap()
+            };
+            let kv = KnotVector::uniform_clamped(2, 9).unwrap();
+            let opts = SurfaceLsqOptions {
+                smoothing: 1e-7,
+                weights: Some(&w),
+                periodic_u: periodic,
+            };
+            let once = least_squares_surface_with(&p, &uv, ku.clone(), kv.clone(), opts).unwrap();
+            let scale = once
+                .control_points()
+                .iter()
+                .fold(0.0f64, |m, c| m.max(c.coords.norm()));
+            for chunk in [1000, 16_384, 20_001, 50_000] {
+                // one accumulator fed chunk by chunk: bit-identical
+                let mut eq = NormalEquations::new(ku.clone(), kv.clone(), periodic).unwrap();
+                for s in (0..p.len()).step_by(chunk) {
+                    let e = (s + chunk).min(p.len());
+                    eq.add(&p[s..e], &uv[s..e], Some(&w[s..e])).unwrap();
+                }
+                assert_eq!(eq.points(), 50_000);
+                assert_eq!(eq.finish(1e-7).unwrap(), once, "chunk {chunk}");
+                // one accumulator per chunk, merged right to left: rounding only
+                let mut parts: Vec<NormalEquations> = (0..p.len())
+                    .step_by(chunk)
+                    .map(|s| {
+                        let e = (s + chunk).min(p.len());
+                        let mut eq =
+                            NormalEquations::new(ku.clone(), kv.clone(), periodic).unwrap();
+                        eq.add(&p[s..e], &uv[s..e], Some(&w[s..e])).unwrap();
+                        eq
+                    })
+                    .collect();
+                let mut acc = parts.pop().unwrap();
+                while let Some(mut next) = parts.pop() {
+                    next.merge(acc).unwrap();
+                    acc = next;
+                }
+                let merged = acc.finish(1e-7).unwrap();
+                let d = max_diff(&merged, &once);
+                assert!(
+                    d <= 1e-12 * scale,
+                    "chunk {chunk} periodic {periodic}: {d:e}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn bad_chunks_and_merges_are_errors() {
+        let k = KnotVector::uniform_clamped(3, 6).unwrap();
+        let mut eq = NormalEquations::new(k.clone(), k.clone(), false).unwrap();
+        let p = [Point3::new(0.0, 0.0, 0.0)];
+        let e = eq.add(&p, &[[1.5, 0.5]], None).unwrap_err();
+        assert!(
+            matches!(e, Error::ParametersOutsideDomain { index: 0, .. }),
+            "{e}"
+        );
+        assert!(eq.add(&p, &[], None).is_err());
+        assert!(eq.add(&p, &[[0.5, 0.5]], Some(&[-1.0])).is_err());
+        let other =
+            NormalEquations::new(KnotVector::uniform_clamped(3, 7).unwrap(), k.clone(), false)
+                .unwrap();
+        assert!(eq.merge(other).is_err());
+        // 1 point for 36 control points: refused at finish, not singular
+        eq.add(&p, &[[0.5, 0.5]], None).unwrap();
+        let e = eq.finish(0.0).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                Error::TooFewPoints {
+                    got: 1,
+                    needed: 36,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+    }
 }

@@ -26,7 +26,7 @@ use crate::project::{project_directed_batch, DirectedConfig};
 use crate::{Error, Point3, Result, Vector3};
 
 use super::lattice::Lattice;
-use super::{Frame, Mba, MbaConfig, MbaRun};
+use super::{Frame, Mba, MbaConfig, MbaLevels};
 
 /// Settings of the projection adjustment.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -295,7 +295,7 @@ pub fn mba_adjusted(
     let mut residual: Vec<f64> = points.iter().map(|p| p.z - frame.z0).collect();
     // the level loop's own tolerance is on the vertical residual; here the
     // paper's eq. 17 decides, after adjusting
-    let mut run = MbaRun::new(
+    let mut run = MbaLevels::new(
         frame,
         &MbaConfig {
             tolerance: None,

@@ -8,6 +8,7 @@
 //! `t = y - floor(y)` and the uniform cubic B-spline basis `B_0..B_3`. The
 //! paper numbers the lattice from -1; here index `a = i + 1` runs from 0.
 
+use super::sums::BaAccumulator;
 use crate::{Error, Result};
 
 /// The four uniform cubic B-spline basis functions at `s` in [0, 1]
@@ -24,10 +25,6 @@ pub fn uniform_cubic_basis(s: f64) -> [f64; 4] {
         s3 / 6.0,
     ]
 }
-
-/// Points per chunk of the parallel BA sums ([`crate::par::accumulate`]): a
-/// constant, so the summation order does not depend on the thread count.
-const BA_CHUNK: usize = 16_384;
 
 /// Most control values of one lattice (2^24: 128 MiB of f64, a 4096 x 4096
 /// net), so that a level count or base lattice from the command line cannot
@@ -67,7 +64,7 @@ pub struct Lattice {
 /// Span index and local coordinate of `x` in `[0, cells]`: `x = cells`
 /// belongs to the last cell (with `s = 1`).
 #[inline]
-fn locate(x: f64, cells: usize) -> (usize, f64) {
+pub(crate) fn locate(x: f64, cells: usize) -> (usize, f64) {
     let i = (x.floor().max(0.0) as usize).min(cells - 1);
     (i, x - i as f64)
 }
@@ -139,55 +136,9 @@ impl Lattice {
         z: &[f64],
         formula: ControlFormula,
     ) -> Result<Self> {
-        let mut lattice = Self::zeros(m, n)?;
-        let len = lattice.phi.len();
-        let st = lattice.stride();
-        // (numerator, denominator) per control value, summed over fixed
-        // chunks merged in order (crate::par): bit-identical for every
-        // thread count
-        let (num, den) = crate::par::accumulate(
-            xy.len(),
-            BA_CHUNK,
-            || (vec![0.0; len], vec![0.0; len]),
-            |(num, den), range| {
-                for (p, &zc) in xy[range.clone()].iter().zip(&z[range]) {
-                    let (i, s) = locate(p[0].clamp(0.0, m as f64), m);
-                    let (j, t) = locate(p[1].clamp(0.0, n as f64), n);
-                    let (bs, bt) = (uniform_cubic_basis(s), uniform_cubic_basis(t));
-                    let mut sum2 = 0.0;
-                    for bk in bs {
-                        for bl in bt {
-                            sum2 += (bk * bl) * (bk * bl);
-                        }
-                    }
-                    for k in 0..4 {
-                        for l in 0..4 {
-                            let w = bs[k] * bt[l];
-                            let phi_c = w * zc / sum2; // eq. 3
-                            let at = (i + k) * st + j + l;
-                            let weight = match formula {
-                                ControlFormula::LeeWolbergShin => w * w,
-                                ControlFormula::Hjelle => w,
-                            };
-                            num[at] += weight * phi_c; // eq. 4 numerator
-                            den[at] += weight;
-                        }
-                    }
-                }
-            },
-            |(a, b), (c, d)| {
-                for (x, y) in a.iter_mut().zip(&c) {
-                    *x += y;
-                }
-                for (x, y) in b.iter_mut().zip(&d) {
-                    *x += y;
-                }
-            },
-        );
-        for ((p, nu), de) in lattice.phi.iter_mut().zip(&num).zip(&den) {
-            *p = if *de > 0.0 { nu / de } else { 0.0 };
-        }
-        Ok(lattice)
+        let mut sums = BaAccumulator::new(m, n, formula)?;
+        sums.add(xy, z)?;
+        Ok(sums.finish())
     }
 
     /// The same function on the lattice with twice the cells in each

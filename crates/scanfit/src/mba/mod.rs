@@ -17,6 +17,7 @@
 
 pub mod adjust;
 pub mod lattice;
+pub mod sums;
 
 use std::time::Instant;
 
@@ -25,9 +26,10 @@ use rayon::prelude::*;
 use crate::bspline::ops::greville;
 use crate::bspline::{KnotVector, Surface};
 use crate::metrics::ErrorStats;
-use crate::{validate_points, Error, Point3, Result};
+use crate::{Error, Point3, Result};
 
 pub use lattice::{ControlFormula, Lattice};
+pub use sums::{BaAccumulator, FrameSums, ResidualSums};
 
 /// When the level loop stops.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -72,40 +74,12 @@ pub struct Frame {
 }
 
 impl Frame {
-    /// The frame of `points`; errors for data without extent in x or y.
+    /// The frame of `points`; errors for data without extent in x or y
+    /// ([`FrameSums`] over all points).
     pub fn of(points: &[Point3]) -> Result<Self> {
-        validate_points(points)?;
-        if points.len() < 2 {
-            return Err(Error::TooFewPoints {
-                got: points.len(),
-                needed: 2,
-                what: "a multilevel B-spline approximation (a domain with extent in x and y)"
-                    .into(),
-            });
-        }
-        let (mut lo, mut hi) = (points[0].coords, points[0].coords);
-        let mut zsum = 0.0;
-        for p in points {
-            lo = lo.inf(&p.coords);
-            hi = hi.sup(&p.coords);
-            zsum += p.z;
-        }
-        let (width, height) = (hi.x - lo.x, hi.y - lo.y);
-        let scale = width.max(height).max(lo.x.abs().max(lo.y.abs()));
-        for (extent, axis) in [(width, "x"), (height, "y")] {
-            if extent <= 1e-12 * scale || extent.is_nan() {
-                return Err(Error::InvalidInput(format!(
-                    "all points have the same {axis} (extent {extent:e}): the data span no rectangle to approximate over; MBA needs 2.5D data z = f(x, y) spread in both x and y"
-                )));
-            }
-        }
-        Ok(Self {
-            x0: lo.x,
-            y0: lo.y,
-            width,
-            height,
-            z0: zsum / points.len() as f64,
-        })
+        let mut sums = FrameSums::default();
+        sums.add(points)?;
+        sums.finish()
     }
 
     /// Unit coordinates `((x - x0) / width, (y - y0) / height)`.
@@ -164,7 +138,7 @@ pub fn mba(points: &[Point3], config: &MbaConfig) -> Result<Mba> {
     let frame = Frame::of(points)?;
     let unit: Vec<[f64; 2]> = points.iter().map(|p| frame.unit(p)).collect();
     let mut residual: Vec<f64> = points.iter().map(|p| p.z - frame.z0).collect();
-    let mut run = MbaRun::new(frame, config)?;
+    let mut run = MbaLevels::new(frame, config)?;
     for _ in 0..config.max_levels.max(1) {
         let done = run.level(&unit, &mut residual)?;
         if done {
@@ -174,20 +148,68 @@ pub fn mba(points: &[Point3], config: &MbaConfig) -> Result<Mba> {
     Ok(run.finish())
 }
 
-/// The level loop, one level at a time (the adjustment driver interleaves
-/// its own steps between levels).
-pub(crate) struct MbaRun {
+/// The level loop of MBA, one level at a time, for drivers that hold the
+/// points themselves or not at all: the in-memory [`mba`], the adjustment
+/// ([`adjust::mba_adjusted`]), a file read in chunks, or a cluster.
+///
+/// Per level: [`accumulator`](Self::accumulator) gives the level's empty BA
+/// sums ([`BaAccumulator`], lattice of `2^k` times the base cells); the
+/// points go in with [`BaAccumulator::add_residuals`] given
+/// [`frame`](Self::frame) and [`levels`](Self::levels) (what a driver
+/// broadcasts), in any number of accumulators merged afterwards; then
+/// [`push`](Self::push) finishes the level and adds it to the combined
+/// lattice (refined, [LWS97] section 5). The residual statistics of a level,
+/// which only a pass over the points after it can measure, are recorded
+/// with [`record_residual`](Self::record_residual) (the next level's
+/// `add_residuals` returns them).
+///
+/// ```
+/// use scanfit::mba::{mba, FrameSums, MbaConfig, MbaLevels};
+/// use scanfit::Point3;
+///
+/// let p: Vec<Point3> = (0..3000)
+///     .map(|k| {
+///         let (x, y) = ((k * 7 % 100) as f64, (k / 30) as f64);
+///         Point3::new(x, y, (x / 9.0).sin() + (y / 13.0).cos())
+///     })
+///     .collect();
+/// let config = MbaConfig { max_levels: 4, ..Default::default() };
+/// // a first pass for the frame, then one pass per level over two "tiles"
+/// let mut f = FrameSums::default();
+/// f.add(&p)?;
+/// let mut run = MbaLevels::new(f.finish()?, &config)?;
+/// for _ in 0..4 {
+///     let mut a = run.accumulator()?;
+///     let mut b = run.accumulator()?;
+///     a.add_residuals(&run.frame(), run.levels(), &p[..1000])?;
+///     b.add_residuals(&run.frame(), run.levels(), &p[1000..])?;
+///     a.merge(b)?;
+///     run.push(a)?;
+/// }
+/// let tiles = run.finish();
+/// let once = mba(&p, &config)?;
+/// let worst = tiles.lattice.phi.iter().zip(&once.lattice.phi).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+/// assert!(worst < 1e-12);
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct MbaLevels {
     frame: Frame,
     base: (usize, usize),
     formula: ControlFormula,
     tolerance: Option<f64>,
+    max_levels: usize,
     total: Option<Lattice>,
     levels: Vec<Lattice>,
     reports: Vec<LevelReport>,
+    started: Instant,
 }
 
-impl MbaRun {
-    pub(crate) fn new(frame: Frame, config: &MbaConfig) -> Result<Self> {
+impl MbaLevels {
+    /// The loop for data in `frame` (from [`Frame::of`] or [`FrameSums`]);
+    /// errors for a zero base lattice, a bad tolerance, or a last level
+    /// beyond [`lattice::MAX_LATTICE_VALUES`].
+    pub fn new(frame: Frame, config: &MbaConfig) -> Result<Self> {
         let base = config.base.unwrap_or_else(|| frame.default_base());
         if base.0 == 0 || base.1 == 0 {
             return Err(Error::InvalidSetting {
@@ -205,15 +227,7 @@ impl MbaRun {
                 });
             }
         }
-        // the last level's lattice must fit (it doubles per level)
-        let last = config.max_levels.max(1) - 1;
-        let fits = u32::try_from(last)
-            .ok()
-            .and_then(|k| 1usize.checked_shl(k))
-            .and_then(|f| base.0.checked_mul(f).zip(base.1.checked_mul(f)))
-            .and_then(|(m, n)| (m.checked_add(3)?).checked_mul(n.checked_add(3)?))
-            .is_some_and(|len| len <= lattice::MAX_LATTICE_VALUES);
-        if !fits {
+        if last_lattice_values(base, config.max_levels).is_none() {
             return Err(Error::InvalidSetting {
                 setting: "max_levels",
                 value: config.max_levels.to_string(),
@@ -231,24 +245,55 @@ impl MbaRun {
             base,
             formula: config.formula,
             tolerance: config.tolerance,
+            max_levels: config.max_levels.max(1),
             total: None,
             levels: Vec::new(),
             reports: Vec::new(),
+            started: Instant::now(),
         })
     }
 
-    /// Fits the next level to `residual` (updated in place); returns whether
-    /// the tolerance is met.
-    pub(crate) fn level(&mut self, unit: &[[f64; 2]], residual: &mut [f64]) -> Result<bool> {
-        let t0 = Instant::now();
+    /// The map between data and lattice coordinates.
+    pub fn frame(&self) -> Frame {
+        self.frame
+    }
+
+    /// The lattices of the levels so far (level `k` has `2^k` times the
+    /// base cells): what the residuals of the next level subtract.
+    pub fn levels(&self) -> &[Lattice] {
+        &self.levels
+    }
+
+    /// Cells `(m, n)` of the next level's lattice.
+    pub fn next_cells(&self) -> (usize, usize) {
         let k = self.levels.len();
-        let (m, n) = (self.base.0 << k, self.base.1 << k);
-        let cells = to_cells(unit, m, n);
-        let phi = Lattice::approximate(m, n, &cells, residual, self.formula)?;
-        residual
-            .par_iter_mut()
-            .zip(cells.par_iter())
-            .for_each(|(r, c)| *r -= phi.eval(c[0], c[1]));
+        (self.base.0 << k, self.base.1 << k)
+    }
+
+    /// Whether all levels of the configuration are done.
+    pub fn done(&self) -> bool {
+        self.levels.len() >= self.max_levels
+    }
+
+    /// Empty BA sums of the next level.
+    pub fn accumulator(&self) -> Result<BaAccumulator> {
+        let (m, n) = self.next_cells();
+        BaAccumulator::new(m, n, self.formula)
+    }
+
+    /// Finishes the next level from its (merged) sums and adds it to the
+    /// combined lattice; its report has no residual statistics until
+    /// [`record_residual`](Self::record_residual).
+    pub fn push(&mut self, sums: BaAccumulator) -> Result<()> {
+        if sums.cells() != self.next_cells() {
+            let (m, n) = sums.cells();
+            let (nm, nn) = self.next_cells();
+            return Err(Error::InvalidInput(format!(
+                "the sums are of a {m} x {n} lattice, but level {} has {nm} x {nn} cells",
+                self.levels.len()
+            )));
+        }
+        let phi = sums.finish();
         self.total = Some(match self.total.take() {
             None => phi.clone(),
             Some(t) => {
@@ -257,16 +302,45 @@ impl MbaRun {
                 t
             }
         });
-        self.levels.push(phi);
-        let abs: Vec<f64> = residual.iter().map(|r| r.abs()).collect();
-        let stats = ErrorStats::of(&abs);
         self.reports.push(LevelReport {
-            level: k,
-            cells: (m, n),
-            residual: stats,
-            seconds: t0.elapsed().as_secs_f64(),
+            level: self.levels.len(),
+            cells: (phi.m, phi.n),
+            residual: ErrorStats::default(),
+            seconds: self.started.elapsed().as_secs_f64(),
         });
-        Ok(self.tolerance.is_some_and(|t| stats.rmse <= t))
+        self.started = Instant::now();
+        self.levels.push(phi);
+        Ok(())
+    }
+
+    /// Records the statistics of the residuals after the last level pushed
+    /// (and the time spent measuring them); returns whether they meet the
+    /// tolerance, i.e. whether the loop should stop.
+    pub fn record_residual(&mut self, stats: ErrorStats) -> bool {
+        if let Some(r) = self.reports.last_mut() {
+            r.residual = stats;
+            r.seconds += self.started.elapsed().as_secs_f64();
+        }
+        self.started = Instant::now();
+        self.tolerance.is_some_and(|t| stats.rmse <= t)
+    }
+
+    /// Fits the next level to `residual` at the unit coordinates `unit`
+    /// (residuals updated in place, the points in memory); returns whether
+    /// the tolerance is met.
+    pub(crate) fn level(&mut self, unit: &[[f64; 2]], residual: &mut [f64]) -> Result<bool> {
+        let (m, n) = self.next_cells();
+        let cells = to_cells(unit, m, n);
+        let mut sums = self.accumulator()?;
+        sums.add(&cells, residual)?;
+        self.push(sums)?;
+        let phi = &self.levels[self.levels.len() - 1];
+        residual
+            .par_iter_mut()
+            .zip(cells.par_iter())
+            .for_each(|(r, c)| *r -= phi.eval(c[0], c[1]));
+        let abs: Vec<f64> = residual.iter().map(|r| r.abs()).collect();
+        Ok(self.record_residual(ErrorStats::of(&abs)))
     }
 
     /// The combined lattice so far (mutable, for the adjustment).
@@ -274,11 +348,9 @@ impl MbaRun {
         self.total.as_mut()
     }
 
-    pub(crate) fn frame(&self) -> Frame {
-        self.frame
-    }
-
-    pub(crate) fn finish(self) -> Mba {
+    /// The approximation: the combined lattice (zero when no level was
+    /// pushed), the level lattices and their reports.
+    pub fn finish(self) -> Mba {
         Mba {
             frame: self.frame,
             lattice: self.total.unwrap_or(Lattice {
@@ -290,6 +362,18 @@ impl MbaRun {
             reports: self.reports,
         }
     }
+}
+
+/// Control values of the last level's lattice of `levels` levels on a
+/// `base` lattice, or `None` beyond [`lattice::MAX_LATTICE_VALUES`].
+pub fn last_lattice_values(base: (usize, usize), levels: usize) -> Option<usize> {
+    let last = levels.max(1) - 1;
+    u32::try_from(last)
+        .ok()
+        .and_then(|k| 1usize.checked_shl(k))
+        .and_then(|f| base.0.checked_mul(f).zip(base.1.checked_mul(f)))
+        .and_then(|(m, n)| (m.checked_add(3)?).checked_mul(n.checked_add(3)?))
+        .filter(|&len| len <= lattice::MAX_LATTICE_VALUES)
 }
 
 impl Mba {

@@ -496,6 +496,28 @@ fn bspline_fit(
     Surface::new(ku, kv, ctrl)
 }
 
+/// The points' parameters: their closest points on the Coons patch (PDE
+/// paper §4.4, by point inversion), clamped to `[0, 1]^2`.
+pub fn coons_uv(
+    coons: &CoonsPatch,
+    points: &[Point3],
+    inversion: InversionConfig,
+) -> Result<Vec<[f64; 2]>> {
+    let par = coons_parameters(
+        &coons.to_bspline()?,
+        points,
+        &CoonsParamConfig {
+            projection: CoonsProjection::Inversion(inversion),
+            outside_tolerance: None,
+        },
+    )?;
+    Ok(par
+        .uv
+        .iter()
+        .map(|t| [t[0].clamp(0.0, 1.0), t[1].clamp(0.0, 1.0)])
+        .collect())
+}
+
 /// Fits one patch inside its side curves (3 or 4, counter-clockwise: `P(u,0)`,
 /// `P(1,v)`, `P(u,1)` run backwards, `P(0,v)` run backwards; a three-sided
 /// patch's apex where the first curve starts). See the module docs.
@@ -510,21 +532,7 @@ pub fn fit_face(
         other => other,
     };
     let coons = CoonsPatch::from_loop(sides).map_err(ctx)?;
-    let base = coons.to_bspline().map_err(ctx)?;
-    let par = coons_parameters(
-        &base,
-        points,
-        &CoonsParamConfig {
-            projection: CoonsProjection::Inversion(cfg.inversion),
-            outside_tolerance: None,
-        },
-    )
-    .map_err(ctx)?;
-    let uv: Vec<[f64; 2]> = par
-        .uv
-        .iter()
-        .map(|t| [t[0].clamp(0.0, 1.0), t[1].clamp(0.0, 1.0)])
-        .collect();
+    let uv = coons_uv(&coons, points, cfg.inversion).map_err(ctx)?;
     let (pde, surface, errors, coons_errors, deviation) = match cfg.fit {
         FaceFit::Pde(pc) => {
             let fit = fit_pde(&coons, points, &uv, &pc).map_err(ctx)?;

@@ -18,17 +18,24 @@
 //!    the side curves, closest-point parameters, the PDE deformation (or a
 //!    least-squares B-spline) inside the fixed boundary.
 //!
+//! The labels of step 1 can also be made here: [`layout`] segments the
+//! cloud or lays patches over a smooth object.
+//!
 //! [`build_network`] runs steps 1-4; the pipeline
 //! [`crate::pipeline::reconstruct`] adds step 5 for every patch in parallel.
 
 pub mod borders;
 pub mod curves;
 pub mod face;
+pub mod folds;
 pub mod junctions;
 pub mod labels;
+pub mod layout;
 
 pub use curves::{fit_edge_curve, EdgeCurve, EdgeCurveConfig};
-pub use face::{fit_face, group_sides, side_curve, side_ranges, FaceConfig, FaceFit, FaceSurface};
+pub use face::{
+    coons_uv, fit_face, group_sides, side_curve, side_ranges, FaceConfig, FaceFit, FaceSurface,
+};
 pub use junctions::{NetEdge, NetUse, NetVertex};
 pub use labels::{read_labels, LabelConfig, Labels, LABEL_NAMES};
 

@@ -15,7 +15,15 @@
 //!   that bulges or overshoots where there are no points is small in the first
 //!   direction and large in the second;
 //! * **parameterization quality**: fold-overs and stretch of the parameters
-//!   ([`ParamQuality`], Sander et al. 2001).
+//!   ([`ParamQuality`], Sander et al. 2001);
+//! * **extent**: how far the surface samples and the control net reach
+//!   outside the points' bounding box ([`Extent`]). A surface whose samples
+//!   leave the box by more than [`AssessConfig::leave_spacings`] point
+//!   spacings and [`AssessConfig::leave_diagonal`] of its diagonal has *left
+//!   the data* ([`Extent::leaves`]): a least-squares fit
+//!   that flew off over a sparsely covered span, which the points-to-surface
+//!   errors never show. The command line refuses to write such a surface
+//!   unless told to (`--allow-extrapolation`).
 //!
 //! [`assess_projected`] does the same for points without parameters (they
 //! get those of their orthogonal projections), as `scanfit report` needs.
@@ -52,6 +60,19 @@ pub struct AssessConfig {
     /// Measure the parameterization's fold-overs and stretch (default true;
     /// costs a Delaunay triangulation of the parameters).
     pub parameterization: bool,
+    /// The surface has *left the data* ([`Extent::leaves`]) when a surface
+    /// sample lies farther outside the points' bounding box than this many
+    /// median point spacings (default 10) *and* than `leave_diagonal` x
+    /// the box's diagonal.
+    pub leave_spacings: f64,
+    /// The share of the diagonal in that rule (default 0.25). A fit that
+    /// covers the empty corners of its parameter rectangle by continuing the
+    /// data's slope leaves the box by a share of the diagonal, not of the
+    /// spacing (measured: 10% on the rounded outline of
+    /// `examples/data/make_nasty.py`, 32 to 60 spacings); one that flew off
+    /// over a sparse span leaves it by orders of magnitude more (there:
+    /// 450 diagonals).
+    pub leave_diagonal: f64,
 }
 
 impl Default for AssessConfig {
@@ -61,6 +82,8 @@ impl Default for AssessConfig {
             samples: None,
             far_spacings: 3.0,
             parameterization: true,
+            leave_spacings: 10.0,
+            leave_diagonal: 0.25,
         }
     }
 }
@@ -81,6 +104,29 @@ pub struct SampleDistances {
     /// Share of samples (0..=1) farther than `far_spacings * spacing` from
     /// every input point: surface where there are no data.
     pub far_share: f64,
+}
+
+/// How far a surface reaches outside the data's extent (the axis-aligned
+/// bounding box of the input points).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[non_exhaustive]
+pub struct Extent {
+    /// Bounding-box diagonal of the points.
+    pub diagonal: f64,
+    /// Largest distance of a surface sample (the grid of
+    /// [`SampleDistances`]) outside the bounding box (0 when all are inside).
+    pub samples_outside: f64,
+    /// Largest distance of a control point outside the bounding box.
+    pub control_outside: f64,
+    /// `samples_outside` in median point spacings (0 for a single point).
+    pub samples_outside_spacings: f64,
+    /// The distance beyond which the surface leaves the data: the larger of
+    /// [`AssessConfig::leave_spacings`] spacings and
+    /// [`AssessConfig::leave_diagonal`] x the diagonal.
+    pub limit: f64,
+    /// The surface has left the data: `samples_outside > limit`, or a
+    /// non-finite sample or control point.
+    pub leaves: bool,
 }
 
 /// The quality record of a surface fitted to points: one for every pipeline.
@@ -104,6 +150,9 @@ pub struct SurfaceQuality {
     /// Fold-overs and stretch of the parameters (all zero when not measured
     /// or when the parameters cannot be triangulated).
     pub parameterization: ParamQuality,
+    /// How far the surface and its control net reach outside the data's
+    /// bounding box, and whether it has left the data.
+    pub extent: Extent,
 }
 
 /// [`SurfaceQuality`] with the per-point values it summarises.
@@ -234,6 +283,18 @@ fn check(config: &AssessConfig) -> Result<()> {
             hint: "give a positive number of point spacings".into(),
         });
     }
+    for (setting, v) in [
+        ("leave_spacings", config.leave_spacings),
+        ("leave_diagonal", config.leave_diagonal),
+    ] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(Error::InvalidSetting {
+                setting,
+                value: v.to_string(),
+                hint: "give a positive multiple".into(),
+            });
+        }
+    }
     if let Some((nu, nv)) = config.samples {
         if !(1..=4096).contains(&nu) || !(1..=4096).contains(&nv) {
             return Err(Error::InvalidSetting {
@@ -260,19 +321,9 @@ fn finish(
     let orthogonal = ErrorStats::of(&dist);
     let unconverged = inversions.iter().filter(|r| !r.converged).count();
     let cloud = PointCloud::new(points.to_vec())?;
-    // eq. 17 at the knot lines (u_i = s_{i+3} in the MBA paper)
-    let knots: Vec<Point3> = {
-        let (us, vs) = (
-            surface.knots_u().breakpoints(),
-            surface.knots_v().breakpoints(),
-        );
-        us.iter()
-            .flat_map(|&u| vs.iter().map(move |&v| (u, v)))
-            .map(|(u, v)| surface.point(u, v))
-            .collect()
-    };
-    let grid_rmse = crate::metrics::rmse_to_cloud(&cloud, &knots)?;
-    let samples_to_points = sample_distances(surface, &cloud, config)?;
+    let grid_rmse = crate::metrics::rmse_to_cloud(&cloud, &knot_line_points(surface))?;
+    let (samples_to_points, samples) = sample_distances(surface, &cloud, config)?;
+    let extent = extent(surface, &cloud, &samples, samples_to_points.spacing, config);
     let parameterization = if config.parameterization {
         // a parameter set that cannot be triangulated (all collinear) has no
         // fold-overs or stretch to report
@@ -289,20 +340,93 @@ fn finish(
             grid_rmse,
             samples_to_points,
             parameterization,
+            extent,
         },
         residuals,
         inversions,
     })
 }
 
-/// The surface-to-points distances over the sample grid of `config`.
-fn sample_distances(
+/// Distance of `p` outside the box `(lo, hi)` (0 inside; infinite for a
+/// non-finite point).
+fn outside_box(p: &Point3, lo: &Point3, hi: &Point3) -> f64 {
+    if !p.coords.iter().all(|c| c.is_finite()) {
+        return f64::INFINITY;
+    }
+    let d = (lo - p).sup(&(p - hi)).sup(&Point3::origin().coords);
+    d.norm()
+}
+
+/// The [`Extent`] of `surface` (its `samples`) against the box of `cloud`.
+fn extent(
     surface: &Surface,
     cloud: &PointCloud,
+    samples: &[Point3],
+    spacing: f64,
     config: &AssessConfig,
-) -> Result<SampleDistances> {
+) -> Extent {
+    match cloud.bounding_box() {
+        Some(b) => extent_in_box(surface, b, samples, spacing, config),
+        None => Extent::default(),
+    }
+}
+
+/// The [`Extent`] of `surface` (its `samples`) against the points' bounding
+/// box `(lo, hi)` (also used by the streamed assessment, which gathers the
+/// box chunk by chunk).
+pub(crate) fn extent_in_box(
+    surface: &Surface,
+    (lo, hi): (Point3, Point3),
+    samples: &[Point3],
+    spacing: f64,
+    config: &AssessConfig,
+) -> Extent {
+    let far = |pts: &[Point3]| {
+        pts.iter()
+            .map(|p| outside_box(p, &lo, &hi))
+            .fold(0.0, f64::max)
+    };
+    let samples_outside = far(samples);
+    let control_outside = far(surface.control_points());
+    let samples_outside_spacings = if spacing > 0.0 {
+        samples_outside / spacing
+    } else {
+        0.0
+    };
+    let diagonal = (hi - lo).norm();
+    let limit = (config.leave_spacings * spacing).max(config.leave_diagonal * diagonal);
+    Extent {
+        diagonal,
+        samples_outside,
+        control_outside,
+        samples_outside_spacings,
+        limit,
+        leaves: samples_outside > limit
+            || !samples_outside.is_finite()
+            || !control_outside.is_finite(),
+    }
+}
+
+/// The surface points at the knot lines (every pair of breakpoints), where
+/// [MBA18] eq. 17 is measured (`u_i = s_{i+3}` in the MBA paper).
+pub(crate) fn knot_line_points(surface: &Surface) -> Vec<Point3> {
+    let (us, vs) = (
+        surface.knots_u().breakpoints(),
+        surface.knots_v().breakpoints(),
+    );
+    us.iter()
+        .flat_map(|&u| vs.iter().map(move |&v| (u, v)))
+        .map(|(u, v)| surface.point(u, v))
+        .collect()
+}
+
+/// The sample grid of `config` (intervals `(nu, nv)`) and its surface points.
+pub(crate) fn sample_grid(
+    surface: &Surface,
+    config: &AssessConfig,
+) -> Result<((usize, usize), Vec<Point3>)> {
+    check(config)?;
     let (cu, cv) = surface.counts();
-    // checked by `check`
     let (nu, nv) = config
         .samples
         .unwrap_or(((cu * 4).clamp(32, 200), (cv * 4).clamp(32, 200)));
@@ -316,6 +440,16 @@ fn sample_distances(
             )
         })
         .collect();
+    Ok(((nu, nv), samples))
+}
+
+/// The surface-to-points distances over the sample grid of `config`.
+fn sample_distances(
+    surface: &Surface,
+    cloud: &PointCloud,
+    config: &AssessConfig,
+) -> Result<(SampleDistances, Vec<Point3>)> {
+    let ((nu, nv), samples) = sample_grid(surface, config)?;
     let d: Vec<f64> = cloud
         .nearest_batch(&samples)?
         .into_iter()
@@ -328,13 +462,14 @@ fn sample_distances(
     };
     let limit = config.far_spacings * spacing;
     let far = d.iter().filter(|&&x| x > limit).count();
-    Ok(SampleDistances {
+    let distances = SampleDistances {
         grid: (nu, nv),
         stats: ErrorStats::of(&d),
         spacing,
         far_spacings: config.far_spacings,
         far_share: far as f64 / d.len().max(1) as f64,
-    })
+    };
+    Ok((distances, samples))
 }
 
 #[cfg(test)]

@@ -25,11 +25,22 @@ pub struct CloudInfoConfig {
     /// Measure the nearest-neighbour spacing (a KD-tree over the cloud;
     /// default true). Skipped anyway for fewer than 2 points.
     pub spacing: bool,
+    /// Above this many points the spacing is measured on a seeded random
+    /// sample of this many points ([`PointCloud::spacing_sample`]; default
+    /// 1,000,000: on 10^7 points measuring all took 100 s, and a sample of
+    /// 10^6 gives the median and mean to well under 1 %).
+    pub spacing_sample: usize,
+    /// Seed of the sample (default 1).
+    pub seed: u64,
 }
 
 impl Default for CloudInfoConfig {
     fn default() -> Self {
-        Self { spacing: true }
+        Self {
+            spacing: true,
+            spacing_sample: 1_000_000,
+            seed: 1,
+        }
     }
 }
 
@@ -59,7 +70,7 @@ pub struct CloudInfo {
     /// Every attribute's range, in the cloud's order.
     pub attributes: Vec<AttributeRange>,
     /// Nearest-neighbour distances (`None` for fewer than 2 points or when
-    /// not asked for).
+    /// not asked for); `measured` below `points` when sampled.
     pub spacing: Option<Spacing>,
 }
 
@@ -116,7 +127,7 @@ pub fn info(
         .collect();
     let spacing = if config.spacing && cloud.len() >= 2 {
         progress.stage("nearest-neighbour spacing", None);
-        Some(cloud.spacing()?)
+        Some(cloud.spacing_sample(config.spacing_sample, config.seed)?)
     } else {
         None
     };
@@ -516,7 +527,15 @@ mod tests {
         let normals = n.cloud.normals().unwrap();
         assert!(normals.iter().all(|v| (v.z - 1.0).abs() < 1e-12));
         assert_eq!(n.mean_variation, 0.0);
-        let i = info(&cloud, &CloudInfoConfig { spacing: false }, &NoProgress).unwrap();
+        let i = info(
+            &cloud,
+            &CloudInfoConfig {
+                spacing: false,
+                ..Default::default()
+            },
+            &NoProgress,
+        )
+        .unwrap();
         assert!(i.spacing.is_none());
         assert_eq!(i.bbox_max, Point3::new(29.0, 19.0, 0.0));
     }

@@ -23,6 +23,7 @@ use crate::base::{
     CoonsParameters, CoonsProjection,
 };
 use crate::bspline::Surface;
+use crate::centring::Centring;
 use crate::fit::surface::{fit_surface, SurfaceFitConfig};
 use crate::metrics::{parametric_distances, ErrorStats};
 use crate::pde::{fit_pde, BsplineConversionConfig, PdeConfig, PdeFit};
@@ -31,6 +32,7 @@ use crate::project::{GridIterationConfig, InversionConfig};
 use crate::{Error, PointCloud, Result};
 
 use super::assess::{assess_surface, AssessConfig, Assessment};
+use super::regularize::{density_ctrl, scaled_smoothing, DEFAULT_RELATIVE_SMOOTHING};
 
 /// Which surface is fitted on the Coons patch's parameters.
 #[derive(Debug, Clone, PartialEq)]
@@ -103,7 +105,7 @@ impl Default for CoonsRoute {
 }
 
 /// Settings of [`run`], with the papers' defaults.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct CoonsConfig {
     /// Boundary (alpha 2.5 x median Delaunay edge), corners (4, smallest
@@ -122,13 +124,75 @@ pub struct CoonsConfig {
     /// The assessment of the resulting surface (orthogonal distances by
     /// point inversion, the sample grid of the surface-to-points direction).
     pub assess: AssessConfig,
+    /// `Some(r)` (default `Some(`[`DEFAULT_RELATIVE_EPSILON`]`)`): the grid
+    /// iteration's convergence threshold epsilon is `r` x the bounding-box
+    /// diagonal of the points, whatever the projection's own epsilon (the
+    /// Coons paper's 0.01 is in data units, which makes the same command
+    /// behave differently in millimetres and metres); `None`: the
+    /// projection's epsilon as given.
+    pub relative_epsilon: Option<f64>,
+    /// B-spline route: choose the control net from the point count
+    /// ([`density_ctrl`]) instead of the route's `ctrl` (default true).
+    pub ctrl_from_density: bool,
+    /// B-spline route: `Some(c)` (default `Some(`[`DEFAULT_RELATIVE_SMOOTHING`]`)`):
+    /// the thin-plate weight is [`scaled_smoothing`]`(c, points, net)`;
+    /// `None`: the route's `smoothing` as given (0 = the bare fit).
+    pub relative_smoothing: Option<f64>,
+}
+
+/// The default relative epsilon of the grid iteration: `1e-3` x the
+/// diagonal (the Coons paper's 0.01 data units on a patch of diagonal 10).
+pub const DEFAULT_RELATIVE_EPSILON: f64 = 1e-3;
+
+impl Default for CoonsConfig {
+    fn default() -> Self {
+        Self {
+            base: CoonsFromCloudConfig::default(),
+            route: CoonsRoute::default(),
+            projection: None,
+            outside_tolerance: None,
+            assess: AssessConfig::default(),
+            relative_epsilon: Some(DEFAULT_RELATIVE_EPSILON),
+            ctrl_from_density: true,
+            relative_smoothing: Some(DEFAULT_RELATIVE_SMOOTHING),
+        }
+    }
 }
 
 impl CoonsConfig {
-    /// The projection [`run`] uses: the configured one, or the route's default.
+    /// The projection [`run`] uses: the configured one, or the route's
+    /// default (before [`CoonsConfig::relative_epsilon`] is applied).
     pub fn projection(&self) -> CoonsProjection {
         self.projection
             .unwrap_or_else(|| self.route.default_projection())
+    }
+
+    /// The projection [`run`] uses on points of bounding-box diagonal
+    /// `diagonal`: [`CoonsConfig::projection`] with the relative epsilon.
+    pub fn scaled_projection(&self, diagonal: f64) -> CoonsProjection {
+        match (self.projection(), self.relative_epsilon) {
+            (CoonsProjection::GridIteration(mut g), Some(r)) => {
+                g.epsilon = r * diagonal;
+                CoonsProjection::GridIteration(g)
+            }
+            (p, _) => p,
+        }
+    }
+
+    /// The least-squares settings of the B-spline route for `points`
+    /// points, after the density and scaling rules.
+    pub fn resolved_fit(&self, fit: &SurfaceFitConfig, points: usize) -> SurfaceFitConfig {
+        let mut f = SurfaceFitConfig {
+            periodic_u: false,
+            ..fit.clone()
+        };
+        if self.ctrl_from_density {
+            f.ctrl = density_ctrl(points, f.degree);
+        }
+        if let Some(c) = self.relative_smoothing {
+            f.smoothing = scaled_smoothing(c, points, f.ctrl);
+        }
+        f
     }
 }
 
@@ -140,8 +204,12 @@ pub struct PdeOutcome {
     pub fit: PdeFit,
     /// The export tolerance used (data units).
     pub export_tolerance: f64,
-    /// Largest deviation of the exported B-spline from the PDE surface.
+    /// Largest deviation of the exported B-spline from the PDE surface: the
+    /// tolerance reached (above `export_tolerance` when `export_capped`).
     pub export_deviation: f64,
+    /// The export stopped at the control-point cap (never more control
+    /// points than input points) before it met `export_tolerance`.
+    pub export_capped: bool,
 }
 
 /// Everything [`run`] produced.
@@ -236,12 +304,24 @@ pub fn run(
     config: &CoonsConfig,
     progress: &dyn Progress,
 ) -> Result<CoonsReport> {
+    // computed relative to the data's centre, moved back exactly (issue 14)
+    let centring = Centring::of(cloud.points());
+    let local = centring.cloud(cloud)?;
+    Ok(centring.restore(run_centred(&local, config, progress)?))
+}
+
+/// [`run`] on data whose centre is at the origin.
+fn run_centred(
+    cloud: &PointCloud,
+    config: &CoonsConfig,
+    progress: &dyn Progress,
+) -> Result<CoonsReport> {
     let pts = cloud.points();
     progress.stage(STAGES[0], None);
     let base = coons_from_cloud(pts, &config.base)?;
     let coons_surface = base.patch.to_bspline()?;
     progress.stage(STAGES[1], None);
-    let projection = config.projection();
+    let projection = config.scaled_projection(cloud.diagonal());
     let parameters = coons_parameters(
         &coons_surface,
         pts,
@@ -255,14 +335,7 @@ pub fn run(
     progress.stage(STAGES[2], None);
     let (surface, pde) = match &config.route {
         CoonsRoute::Bspline(fit) => {
-            let s = fit_surface(
-                pts,
-                &parameters.uv,
-                &SurfaceFitConfig {
-                    periodic_u: false,
-                    ..fit.clone()
-                },
-            )?;
+            let s = fit_surface(pts, &parameters.uv, &config.resolved_fit(fit, pts.len()))?;
             (s, None)
         }
         CoonsRoute::Pde {
@@ -279,13 +352,17 @@ pub fn run(
                 });
             }
             progress.stage(STAGES[3], None);
-            let b = f.surface.to_bspline(&BsplineConversionConfig::new(tol))?;
+            let b = f.surface.to_bspline(&BsplineConversionConfig {
+                max_control_points: Some(pts.len()),
+                ..BsplineConversionConfig::new(tol)
+            })?;
             (
                 b.surface,
                 Some(PdeOutcome {
                     fit: f,
                     export_tolerance: tol,
                     export_deviation: b.max_deviation,
+                    export_capped: b.capped,
                 }),
             )
         }
@@ -297,7 +374,12 @@ pub fn run(
         assessment.quality.at_parameters = p.fit.errors;
     }
     Ok(CoonsReport {
-        route: config.route.describe(),
+        route: match &config.route {
+            CoonsRoute::Bspline(f) => {
+                CoonsRoute::Bspline(config.resolved_fit(f, pts.len())).describe()
+            }
+            r => r.describe(),
+        },
         base,
         coons_surface,
         projection,
@@ -341,8 +423,11 @@ mod tests {
     #[test]
     fn bspline_route_fits_the_panel_on_grid_parameters() {
         let cloud = panel();
+        // the paper's fit: the given net, no smoothing
         let cfg = CoonsConfig {
             route: CoonsRoute::bspline((3, 3), (12, 10)),
+            ctrl_from_density: false,
+            relative_smoothing: None,
             ..Default::default()
         };
         let r = run(&cloud, &cfg, &crate::progress::NoProgress).unwrap();

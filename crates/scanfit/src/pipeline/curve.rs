@@ -8,6 +8,7 @@
 //! * [`compare`]: interpolation with every parameterization method of the
 //!   curve paper side by side, each with its quality or its error.
 
+use crate::centring::Centring;
 use crate::fit::{approximate, interpolate, ApproximationConfig, CurveFit, InterpolationConfig};
 use crate::param::{Method, DEFAULT_EXPONENT};
 use crate::progress::Progress;
@@ -122,6 +123,22 @@ pub struct CurveReport {
 /// # Ok::<(), scanfit::Error>(())
 /// ```
 pub fn run(
+    points: &[Point3],
+    config: &CurveConfig,
+    progress: &dyn Progress,
+) -> Result<CurveReport> {
+    // computed relative to the data's centre, moved back exactly (issue 14)
+    let centring = Centring::of(points);
+    let local = if centring.is_identity() {
+        std::borrow::Cow::Borrowed(points)
+    } else {
+        std::borrow::Cow::Owned(centring.points(points))
+    };
+    Ok(centring.restore(run_centred(&local, config, progress)?))
+}
+
+/// [`run`] on points whose centre is at the origin.
+fn run_centred(
     points: &[Point3],
     config: &CurveConfig,
     progress: &dyn Progress,

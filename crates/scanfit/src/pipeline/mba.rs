@@ -10,6 +10,7 @@
 //! residual the level loop fits; eq. 17 is measured on the lattice's own
 //! knot grid ([`knot_grid`]), as the adjustment measures it.
 
+use crate::centring::Centring;
 use std::time::Instant;
 
 use crate::bspline::Surface;
@@ -116,6 +117,18 @@ pub struct MbaReport {
 /// # Ok::<(), scanfit::Error>(())
 /// ```
 pub fn run(
+    cloud: &PointCloud,
+    config: &MbaRunConfig,
+    progress: &dyn Progress,
+) -> Result<MbaReport> {
+    // computed relative to the data's centre, moved back exactly (issue 14)
+    let centring = Centring::of(cloud.points());
+    let local = centring.cloud(cloud)?;
+    Ok(centring.restore(run_centred(&local, config, progress)?))
+}
+
+/// [`run`] on data whose centre is at the origin.
+fn run_centred(
     cloud: &PointCloud,
     config: &MbaRunConfig,
     progress: &dyn Progress,

@@ -8,6 +8,7 @@
 //! percentile and a histogram.
 
 use crate::bspline::Surface;
+use crate::centring::{Centring, Translate};
 use crate::pipeline::assess::{assess_projected, AssessConfig, Assessment};
 use crate::progress::Progress;
 use crate::{Error, Point3, Result};
@@ -85,7 +86,17 @@ pub fn run(
         });
     }
     progress.stage(&format!("projecting {} points", points.len()), None);
-    let assessment = assess_projected(surface, points, &config.assess)?;
+    // relative to the points' centre (issue 14): surface and points moved
+    // exactly, the foot points moved back
+    let centring = Centring::of(points);
+    let assessment = if centring.is_identity() {
+        assess_projected(surface, points, &config.assess)?
+    } else {
+        let mut local = surface.clone();
+        local.translate(&-centring.centre());
+        let pts = centring.points(points);
+        centring.restore(assess_projected(&local, &pts, &config.assess)?)
+    };
     let max = assessment.quality.orthogonal.max;
     let mut sorted = assessment.distances();
     sorted.sort_by(f64::total_cmp);

@@ -36,8 +36,13 @@
 //!   with the MBA paper's projection adjustment, with its per-level table.
 //! * [`measure`]: what `scanfit report` measures for a surface and points
 //!   (the assessment of their projections, percentiles, histogram).
+//! * [`measure_model`]: what `scanfit report` measures for a multi-patch
+//!   model and points (per patch eq. 15 and orthogonal errors, per edge gap
+//!   and normal angle, totals).
 //! * [`reconstruct`]: a segmented cloud to a whole object, patches that
 //!   share their edge curves (`scanfit reconstruct`, PDE paper section 4).
+//! * [`regularize`]: the safe defaults of the least-squares fits (net from
+//!   the point density, thin-plate weight scaled to the data).
 //! * [`surface_fit`]: least-squares surface through scattered points
 //!   (`scanfit fit`): parameters from the best-fit plane or given
 //!   attributes, optional Hoschek parameter correction.
@@ -49,10 +54,15 @@ pub mod coons;
 pub mod curve;
 pub mod mba;
 pub mod measure;
+pub mod measure_model;
 pub mod reconstruct;
+pub mod regularize;
+pub mod segment;
+pub mod stream;
 pub mod surface_fit;
 pub mod turntable;
 
 pub use assess::{
-    assess_projected, assess_surface, AssessConfig, Assessment, SampleDistances, SurfaceQuality,
+    assess_projected, assess_surface, AssessConfig, Assessment, Extent, SampleDistances,
+    SurfaceQuality,
 };

@@ -11,10 +11,13 @@
 //! curves) and the angle between the two patches' normals (the G1 defect;
 //! the PDE paper makes no attempt at tangent continuity, nor does this).
 
+use crate::centring::Centring;
 use rayon::prelude::*;
 
 use crate::bspline::{BasisWorkspace, Curve, Surface};
 use crate::metrics::ErrorStats;
+use crate::network::folds::fold_overs;
+use crate::network::layout::{generate_labels, LabelSource, GENERATED_LABEL};
 use crate::network::{
     build_network, fit_face, group_sides, side_curve, side_ranges, FaceConfig, FaceFit,
     FaceSurface, NetUse, Network, NetworkConfig,
@@ -28,6 +31,10 @@ use crate::{Error, Point3, PointCloud, Result, Vector3};
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct ReconstructConfig {
+    /// Where the patch ids come from (default: the cloud's label attribute;
+    /// or a segmentation, or a layout, whose ids replace it: see
+    /// [`crate::network::layout`]).
+    pub source: LabelSource,
     /// Labels, borders, junctions and edge curves (see [`NetworkConfig`]).
     pub network: NetworkConfig,
     /// The fit inside each patch's boundary: PDE deformation with 5 x 5
@@ -46,6 +53,7 @@ pub struct ReconstructConfig {
 impl Default for ReconstructConfig {
     fn default() -> Self {
         Self {
+            source: LabelSource::default(),
             network: NetworkConfig::default(),
             fit: FaceFit::default(),
             inversion: InversionConfig::default(),
@@ -74,6 +82,8 @@ pub struct PatchReport {
     pub orthogonal: ErrorStats,
     /// Distance between the PDE surface and its B-spline form.
     pub conversion_deviation: f64,
+    /// Points whose parameters fold over ([`crate::network::folds`]).
+    pub fold_overs: usize,
 }
 
 /// One edge of the result.
@@ -125,11 +135,10 @@ pub struct ReconstructReport {
     pub edges: Vec<EdgeReport>,
     /// Totals.
     pub totals: Totals,
-    /// The model as a [`PatchComplex`] (faces sharing edges), for the CAD
-    /// writers; `Err` says why it cannot be formed: a patch with a side made
-    /// of several edges (more than 4 corners), which the complex's one edge
-    /// per side cannot hold.
-    pub complex: std::result::Result<PatchComplex, String>,
+    /// The model as a [`PatchComplex`] (faces sharing edges, a side of a
+    /// patch with more than four corners a chain of several), for the CAD
+    /// writers.
+    pub complex: PatchComplex,
 }
 
 /// The `(u, v)` of side `s` at side parameter `t` (counter-clockwise: side
@@ -184,7 +193,32 @@ pub fn run(
     cfg: &ReconstructConfig,
     progress: &dyn Progress,
 ) -> Result<ReconstructReport> {
-    let network = build_network(cloud, &cfg.network, progress)?;
+    // computed relative to the data's centre, moved back exactly (issue 14)
+    let centring = Centring::of(cloud.points());
+    let local = centring.cloud(cloud)?;
+    Ok(centring.restore(run_centred(&local, cfg, progress)?))
+}
+
+/// [`run`] on data whose centre is at the origin.
+fn run_centred(
+    cloud: &PointCloud,
+    cfg: &ReconstructConfig,
+    progress: &dyn Progress,
+) -> Result<ReconstructReport> {
+    // generated ids go into the label attribute of a copy, read as hand labels are
+    let labelled;
+    let mut net_cfg = cfg.network.clone();
+    let cloud = match generate_labels(cloud, &cfg.source, progress)? {
+        None => cloud,
+        Some(ids) => {
+            labelled = cloud
+                .clone()
+                .with_attribute(GENERATED_LABEL, ids.iter().map(|&i| i as f64).collect())?;
+            net_cfg.labels.attribute = Some(GENERATED_LABEL.into());
+            &labelled
+        }
+    };
+    let network = build_network(cloud, &net_cfg, progress)?;
     let (lo, hi) = network
         .patches
         .iter()
@@ -256,17 +290,21 @@ pub fn run(
         .iter()
         .zip(&sides)
         .zip(&faces)
-        .map(|((p, s), f)| PatchReport {
-            id: p.id,
-            sides: s.len(),
-            edges: p.cycle.len(),
-            points: p.points.len(),
-            coons_errors: f.coons_errors,
-            errors: f.errors,
-            orthogonal: f.orthogonal,
-            conversion_deviation: f.conversion_deviation,
+        .map(|((p, s), f)| {
+            let pts: Vec<Point3> = p.points.iter().map(|&i| cloud.points()[i]).collect();
+            Ok(PatchReport {
+                id: p.id,
+                sides: s.len(),
+                edges: p.cycle.len(),
+                points: p.points.len(),
+                coons_errors: f.coons_errors,
+                errors: f.errors,
+                orthogonal: f.orthogonal,
+                conversion_deviation: f.conversion_deviation,
+                fold_overs: fold_overs(&pts, &f.uv, &f.surface)?,
+            })
         })
-        .collect();
+        .collect::<Result<_>>()?;
     let totals = Totals {
         errors: pooled(patches.iter().map(|p| &p.errors)),
         orthogonal: pooled(patches.iter().map(|p| &p.orthogonal)),
@@ -289,39 +327,31 @@ pub fn run(
 
 /// The network and the faces as a [`PatchComplex`] (see
 /// [`ReconstructReport::complex`]).
-fn complex(
-    net: &Network,
-    sides: &[Vec<Vec<NetUse>>],
-    faces: &[FaceSurface],
-) -> std::result::Result<PatchComplex, String> {
-    let mut out = Vec::with_capacity(faces.len());
-    for ((p, s), f) in net.patches.iter().zip(sides).zip(faces) {
-        let mut uses: [Option<topology::EdgeUse>; 4] = [None; 4];
-        for (k, side) in s.iter().enumerate() {
-            match side[..] {
-                [u] => {
-                    uses[k] = Some(topology::EdgeUse {
+fn complex(net: &Network, sides: &[Vec<Vec<NetUse>>], faces: &[FaceSurface]) -> PatchComplex {
+    let faces = net
+        .patches
+        .iter()
+        .zip(sides)
+        .zip(faces)
+        .map(|((p, s), f)| {
+            let mut chains: [Vec<topology::EdgeUse>; 4] = Default::default();
+            for (chain, side) in chains.iter_mut().zip(s) {
+                *chain = side
+                    .iter()
+                    .map(|u| topology::EdgeUse {
                         edge: u.edge,
                         reversed: u.reversed,
                     })
-                }
-                _ => {
-                    return Err(format!(
-                        "patch {} has {} corners, so its side {k} is made of {} edges; the model (one edge per side) cannot hold it: relabel so that every patch has 3 or 4 corners",
-                        p.id,
-                        p.cycle.len(),
-                        side.len()
-                    ))
-                }
+                    .collect();
             }
-        }
-        out.push(topology::Face {
-            id: p.id,
-            surface: f.surface.clone(),
-            sides: uses,
-        });
-    }
-    Ok(PatchComplex {
+            topology::Face {
+                id: p.id,
+                surface: f.surface.clone(),
+                sides: chains,
+            }
+        })
+        .collect();
+    PatchComplex {
         vertices: net
             .vertices
             .iter()
@@ -336,12 +366,12 @@ fn complex(
                 curve: e.curve.clone(),
             })
             .collect(),
-        faces: out,
-    })
+        faces,
+    }
 }
 
 /// The statistics of the union of several point sets from theirs.
-fn pooled<'a>(stats: impl Iterator<Item = &'a ErrorStats>) -> ErrorStats {
+pub(crate) fn pooled<'a>(stats: impl Iterator<Item = &'a ErrorStats>) -> ErrorStats {
     let (mut count, mut sum, mut sq, mut max) = (0usize, 0.0, 0.0, 0.0f64);
     for s in stats {
         count += s.count;

@@ -9,12 +9,19 @@
 //! thin-plate smoothing), optionally followed by Hoschek's parameter
 //! correction ([`correct_parameters`]); the result is assessed by
 //! [`assess_surface`].
+//!
+//! By default the net follows the point density and the thin-plate weight
+//! is scaled to the data ([`super::regularize`]), so sparsely covered spans
+//! stay tame; `relative_smoothing = None` with `fit.smoothing = 0` and
+//! `ctrl_from_density = false` is the bare fit of the paper.
 
 use crate::base::plane_parameters;
 use crate::bspline::Surface;
+use crate::centring::Centring;
 use crate::fit::correction::{correct_parameters, CorrectionConfig, CorrectionRound};
 use crate::fit::surface::{fit_surface, SurfaceFitConfig};
 use crate::pipeline::assess::{assess_surface, AssessConfig, Assessment};
+use crate::pipeline::regularize::{density_ctrl, scaled_smoothing, DEFAULT_RELATIVE_SMOOTHING};
 use crate::progress::Progress;
 use crate::{Error, PointCloud, Result};
 
@@ -46,15 +53,24 @@ impl ParameterSource {
 }
 
 /// Settings of [`run`].
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct FitConfig {
     /// Where the parameters come from (default: the best-fit plane).
     pub params: ParameterSource,
     /// The least-squares fit (default [`SurfaceFitConfig::default`]: bicubic,
     /// 16 x 16 control points, knots from the parameter distribution (NURBS
-    /// Book eq. 9.69), no smoothing, not periodic).
+    /// Book eq. 9.69), no smoothing, not periodic). Its `ctrl` is replaced
+    /// when `ctrl_from_density` is set, its `smoothing` when
+    /// `relative_smoothing` is.
     pub fit: SurfaceFitConfig,
+    /// Choose the control net from the point count
+    /// ([`density_ctrl`]) instead of `fit.ctrl` (default true).
+    pub ctrl_from_density: bool,
+    /// `Some(c)`: the thin-plate weight is [`scaled_smoothing`]`(c, points,
+    /// net)` (default `Some(`[`DEFAULT_RELATIVE_SMOOTHING`]`)`); `None`:
+    /// `fit.smoothing` as given (0 = the bare least-squares fit).
+    pub relative_smoothing: Option<f64>,
     /// Rounds of Hoschek's parameter correction: re-project the points onto
     /// the surface and refit while the RMSE improves (default 0 = none).
     pub correction_rounds: usize,
@@ -63,6 +79,48 @@ pub struct FitConfig {
     pub correction: CorrectionConfig,
     /// The assessment of the result (default [`AssessConfig::default`]).
     pub assess: AssessConfig,
+}
+
+impl Default for FitConfig {
+    fn default() -> Self {
+        Self {
+            params: ParameterSource::default(),
+            fit: SurfaceFitConfig::default(),
+            ctrl_from_density: true,
+            relative_smoothing: Some(DEFAULT_RELATIVE_SMOOTHING),
+            correction_rounds: 0,
+            correction: CorrectionConfig::default(),
+            assess: AssessConfig::default(),
+        }
+    }
+}
+
+impl FitConfig {
+    /// The bare least-squares fit of the paper on a given `nu x nv` net: no
+    /// smoothing, no density rule.
+    pub fn bare(ctrl: (usize, usize)) -> Self {
+        let mut c = Self {
+            ctrl_from_density: false,
+            relative_smoothing: None,
+            ..Self::default()
+        };
+        c.fit.ctrl = ctrl;
+        c.fit.smoothing = 0.0;
+        c
+    }
+
+    /// The least-squares settings [`run`] uses for `points` points: the net
+    /// and thin-plate weight after the density and scaling rules.
+    pub fn resolved_fit(&self, points: usize) -> SurfaceFitConfig {
+        let mut f = self.fit.clone();
+        if self.ctrl_from_density {
+            f.ctrl = density_ctrl(points, f.degree);
+        }
+        if let Some(c) = self.relative_smoothing {
+            f.smoothing = scaled_smoothing(c, points, f.ctrl);
+        }
+        f
+    }
 }
 
 /// What [`run`] returns.
@@ -78,6 +136,8 @@ pub struct FitReport {
     pub rounds: Vec<CorrectionRound>,
     /// The assessment of `surface` against the points at `uv`.
     pub assessment: Assessment,
+    /// The thin-plate weight `lambda` used (0 for the bare fit).
+    pub smoothing: f64,
 }
 
 /// Fits a least-squares B-spline surface to `cloud` (see the module
@@ -99,8 +159,7 @@ pub struct FitReport {
 ///         Point3::new(x, y, 0.2 * (x - 0.5) * (y - 0.5))
 ///     })
 ///     .collect();
-/// let mut cfg = FitConfig::default();
-/// cfg.fit.ctrl = (6, 6);
+/// let cfg = FitConfig::bare((6, 6));
 /// let r = run(&PointCloud::new(pts)?, &cfg, &NoProgress)?;
 /// assert_eq!(r.surface.counts(), (6, 6));
 /// // a bicubic net reproduces the bilinear saddle
@@ -108,6 +167,18 @@ pub struct FitReport {
 /// # Ok::<(), scanfit::Error>(())
 /// ```
 pub fn run(cloud: &PointCloud, config: &FitConfig, progress: &dyn Progress) -> Result<FitReport> {
+    // computed relative to the data's centre, moved back exactly (issue 14)
+    let centring = Centring::of(cloud.points());
+    let local = centring.cloud(cloud)?;
+    Ok(centring.restore(run_centred(&local, config, progress)?))
+}
+
+/// [`run`] on data whose centre is at the origin.
+fn run_centred(
+    cloud: &PointCloud,
+    config: &FitConfig,
+    progress: &dyn Progress,
+) -> Result<FitReport> {
     let pts = cloud.points();
     progress.stage("parameterizing", None);
     let mut uv: Vec<[f64; 2]> = match &config.params {
@@ -136,12 +207,13 @@ pub fn run(cloud: &PointCloud, config: &FitConfig, progress: &dyn Progress) -> R
             us.iter().zip(vs).map(|(&u, &v)| [u, v]).collect()
         }
     };
-    let (cu, cv) = config.fit.ctrl;
+    let fit_config = config.resolved_fit(pts.len());
+    let (cu, cv) = fit_config.ctrl;
     progress.stage(
         &format!("fitting {cu} x {cv} control points to {} points", pts.len()),
         None,
     );
-    let fit = |t: &[[f64; 2]]| fit_surface(pts, t, &config.fit);
+    let fit = |t: &[[f64; 2]]| fit_surface(pts, t, &fit_config);
     let (surface, rounds) = if config.correction_rounds > 0 {
         let cc = CorrectionConfig {
             max_rounds: config.correction_rounds,
@@ -158,6 +230,7 @@ pub fn run(cloud: &PointCloud, config: &FitConfig, progress: &dyn Progress) -> R
         uv,
         rounds,
         assessment,
+        smoothing: fit_config.smoothing,
     })
 }
 
@@ -182,8 +255,7 @@ mod tests {
     #[test]
     fn correction_lowers_the_error_and_attributes_give_the_parameters() {
         let cloud = PointCloud::new(wave(40)).unwrap();
-        let mut cfg = FitConfig::default();
-        cfg.fit.ctrl = (5, 5);
+        let mut cfg = FitConfig::bare((5, 5));
         let plain = run(&cloud, &cfg, &NoProgress).unwrap();
         assert!(plain.rounds.is_empty());
         cfg.correction_rounds = 3;
@@ -204,8 +276,7 @@ mod tests {
             .unwrap()
             .with_attribute("v", v)
             .unwrap();
-        let mut cfg = FitConfig::default();
-        cfg.fit.ctrl = (5, 5);
+        let mut cfg = FitConfig::bare((5, 5));
         cfg.params = ParameterSource::uv_attributes();
         let given = run(&with, &cfg, &NoProgress).unwrap();
         assert_eq!(given.surface, plain.surface);
@@ -233,7 +304,7 @@ mod tests {
         };
         let e = run(&cloud, &cfg, &NoProgress).unwrap_err();
         assert!(e.to_string().contains("no attributes named u and v"), "{e}");
-        let cfg = FitConfig::default(); // 16 x 16 > 100 points
+        let cfg = FitConfig::bare((16, 16)); // 16 x 16 > 100 points
         let e = run(&cloud, &cfg, &NoProgress).unwrap_err();
         assert!(
             matches!(

@@ -8,6 +8,7 @@
 //! over the points that entered the fit.
 
 use crate::base::turntable::{compare_weights, turntable, Turntable, STAGES};
+use crate::centring::Centring;
 use crate::metrics::{grid_rmse, ErrorStats};
 use crate::progress::Progress;
 use crate::project::WeightFactor;
@@ -147,6 +148,18 @@ fn fitted_subset(cloud: &PointCloud, t: &Turntable) -> (Vec<Point3>, Vec<[f64; 2
 /// # Ok::<(), scanfit::Error>(())
 /// ```
 pub fn run(
+    cloud: &PointCloud,
+    config: &TurntableConfig,
+    progress: &dyn Progress,
+) -> Result<TurntableReport> {
+    // computed relative to the data's centre, moved back exactly (issue 14)
+    let centring = Centring::of(cloud.points());
+    let local = centring.cloud(cloud)?;
+    Ok(centring.restore(run_centred(&local, config, progress)?))
+}
+
+/// [`run`] on data whose centre is at the origin.
+fn run_centred(
     cloud: &PointCloud,
     config: &TurntableConfig,
     progress: &dyn Progress,

@@ -14,9 +14,9 @@
 //! (zero for a tangent-continuous, G1, join), at points matched by closest
 //! point on the neighbour's side.
 
-use super::{PatchComplex, SideRef};
+use super::{EdgeUse, PatchComplex, SideRef};
 use crate::bspline::{BasisWorkspace, Curve};
-use crate::{Point3, Result, Vector3};
+use crate::{Error, Point3, Result, Vector3};
 
 /// Measured gaps along one edge.
 #[derive(Debug, Clone, PartialEq)]
@@ -50,7 +50,11 @@ fn spans(c: &Curve) -> usize {
 
 impl<'c> Probe<'c> {
     fn new(curve: &'c Curve, n: usize) -> Self {
-        let (a, b) = curve.domain();
+        Self::on(curve, curve.domain(), n)
+    }
+
+    /// Samples of the piece `[a, b]` of the curve's domain only.
+    fn on(curve: &'c Curve, (a, b): (f64, f64), n: usize) -> Self {
         let ts: Vec<f64> = (0..n)
             .map(|i| a + (b - a) * i as f64 / (n - 1) as f64)
             .collect();
@@ -114,11 +118,12 @@ fn sample_count(a: &Curve, b: &Curve) -> usize {
     (8 * (spans(a) + spans(b)) + 1).clamp(33, 4097)
 }
 
-/// Two-sided Hausdorff distance of two curves, from samples.
-pub(super) fn hausdorff(a: &Curve, b: &Curve) -> f64 {
+/// Two-sided Hausdorff distance of the pieces `ra` of `a` and `rb` of `b`
+/// (parameter ranges), from samples.
+fn hausdorff_on(a: &Curve, ra: (f64, f64), b: &Curve, rb: (f64, f64)) -> f64 {
     let n = sample_count(a, b);
-    let mut pa = Probe::new(a, n);
-    let mut pb = Probe::new(b, n);
+    let mut pa = Probe::on(a, ra, n);
+    let mut pb = Probe::on(b, rb, n);
     let ab = pa
         .pts
         .clone()
@@ -151,7 +156,112 @@ pub fn distance_to_curve(curve: &Curve, p: &Point3) -> (f64, f64) {
     Probe::new(curve, n).closest(p)
 }
 
+/// Where the edges of a side's `chain` meet on the side's curve `side`: the
+/// parameters of the inner junction vertices (closest points, in order) and
+/// their largest distance from the side. Errors when the junctions do not
+/// follow each other strictly along the side.
+pub(super) fn chain_junctions(
+    side: &Curve,
+    chain: &[EdgeUse],
+    model: &PatchComplex,
+    fi: usize,
+    k: usize,
+) -> Result<(Vec<f64>, f64)> {
+    let (a, b) = side.domain();
+    let mut probe = Probe::new(side, sample_count(side, side).max(16 * chain.len() + 1));
+    let mut ts = Vec::with_capacity(chain.len().saturating_sub(1));
+    let mut worst = 0.0f64;
+    let mut last = a;
+    for u in &chain[..chain.len().saturating_sub(1)] {
+        let Some((_, v)) = u.oriented_vertices(&model.edges) else {
+            return Err(Error::InvalidInput(format!(
+                "face {fi} side {k} uses edge {}, which does not exist",
+                u.edge
+            )));
+        };
+        let p = model
+            .vertices
+            .get(v)
+            .map(|v| v.point)
+            .ok_or_else(|| Error::InvalidInput(format!("vertex {v} does not exist")))?;
+        let (t, d) = probe.closest(&p);
+        if !(t > last && t < b) {
+            return Err(Error::InvalidInput(format!(
+                "face {fi} side {k}: vertex {v}, where its edges {} and the next meet, lies at parameter {t} of the side, not after the previous junction ({last}) and before its end ({b}); list the side's edges in order along it",
+                u.edge
+            )));
+        }
+        worst = worst.max(d);
+        last = t;
+        ts.push(t);
+    }
+    Ok((ts, worst))
+}
+
+/// The parameter range on the side curve of every edge of its chain.
+fn chain_params(side: &Curve, junctions: &[f64]) -> Vec<(f64, f64)> {
+    let (a, b) = side.domain();
+    let mut cuts = vec![a];
+    cuts.extend_from_slice(junctions);
+    cuts.push(b);
+    cuts.windows(2).map(|w| (w[0], w[1])).collect()
+}
+
+/// Every non-degenerate side of every face: its curve and the parameter
+/// range of each edge of its chain.
+type SidePieces = Vec<[Option<(Curve, Vec<(f64, f64)>)>; 4]>;
+
 impl PatchComplex {
+    /// The fractions `[s0, s1]` of side `k` of face `fi` (0 at the side's
+    /// start, 1 at its end, see [`super::Face::side_parameters`]) that each
+    /// edge of the side's chain covers: cut where the chain's inner vertices
+    /// are closest to the side. `[(0, 1)]` for a one-edge side, empty for a
+    /// degenerate one.
+    pub fn chain_ranges(&self, fi: usize, k: usize) -> Result<Vec<(f64, f64)>> {
+        let f = self
+            .faces
+            .get(fi)
+            .ok_or_else(|| Error::InvalidInput(format!("face {fi} does not exist")))?;
+        let chain = &f.sides[k % 4];
+        match chain.len() {
+            0 => Ok(Vec::new()),
+            1 => Ok(vec![(0.0, 1.0)]),
+            _ => {
+                let c = f.side_curve(k)?;
+                let (a, b) = c.domain();
+                let (ts, _) = chain_junctions(&c, chain, self, fi, k)?;
+                Ok(chain_params(&c, &ts)
+                    .iter()
+                    .map(|&(s, t)| ((s - a) / (b - a), (t - a) / (b - a)))
+                    .collect())
+            }
+        }
+    }
+
+    /// [`SidePieces`] of the whole model.
+    fn side_pieces(&self) -> Result<SidePieces> {
+        self.faces
+            .iter()
+            .enumerate()
+            .map(|(fi, f)| {
+                let mut out: [Option<(Curve, Vec<(f64, f64)>)>; 4] = Default::default();
+                for (k, chain) in f.sides.iter().enumerate() {
+                    if chain.is_empty() {
+                        continue;
+                    }
+                    let c = f.side_curve(k)?;
+                    let ranges = if chain.len() == 1 {
+                        vec![c.domain()]
+                    } else {
+                        chain_params(&c, &chain_junctions(&c, chain, self, fi, k)?.0)
+                    };
+                    out[k] = Some((c, ranges));
+                }
+                Ok(out)
+            })
+            .collect()
+    }
+
     /// Measured gaps of every edge: for each face side that uses it, the
     /// two-sided Hausdorff distance between the side (the surface's boundary
     /// iso-curve, [`super::Face::side_curve`]) and the edge's curve, and
@@ -162,26 +272,30 @@ impl PatchComplex {
     /// to hold for the indices; an out-of-range use is skipped.
     pub fn boundary_gaps(&self) -> Result<Vec<EdgeGap>> {
         let users = self.edge_faces();
+        let pieces = self.side_pieces()?;
         let mut out = Vec::with_capacity(self.edges.len());
         for (ei, e) in self.edges.iter().enumerate() {
             let uses = users.get(ei).cloned().unwrap_or_default();
             let mut sides = Vec::with_capacity(uses.len());
             for u in &uses {
-                if let Some(f) = self.faces.get(u.face) {
-                    sides.push((*u, f.side_curve(u.side)?));
+                let piece = pieces.get(u.face).and_then(|p| p[u.side].as_ref());
+                if let Some((c, r)) = piece {
+                    if let Some(&range) = r.get(u.index) {
+                        sides.push((*u, c, range));
+                    }
                 }
             }
             let mut curve_gap = 0.0f64;
             let mut worst_side = None;
-            for (u, c) in &sides {
-                let g = hausdorff(c, &e.curve);
+            for &(u, c, r) in &sides {
+                let g = hausdorff_on(c, r, &e.curve, e.curve.domain());
                 if worst_side.is_none() || g > curve_gap || g.is_nan() {
                     curve_gap = g;
-                    worst_side = Some(*u);
+                    worst_side = Some(u);
                 }
             }
             let face_gap = match sides.as_slice() {
-                [(_, a), (_, b)] => hausdorff(a, b),
+                [(_, a, ra), (_, b, rb)] => hausdorff_on(a, *ra, b, *rb),
                 _ => 0.0,
             };
             out.push(EdgeGap {
@@ -205,6 +319,13 @@ impl PatchComplex {
     pub fn normal_angles(&self, samples: usize) -> Result<Vec<Option<f64>>> {
         let n = samples.max(1);
         let users = self.edge_faces();
+        let pieces = self.side_pieces()?;
+        let piece = |s: &SideRef| {
+            pieces
+                .get(s.face)
+                .and_then(|p| p[s.side].as_ref())
+                .and_then(|(c, r)| r.get(s.index).map(|&r| (c, r)))
+        };
         let mut out = Vec::with_capacity(self.edges.len());
         for uses in users.iter() {
             let [a, b] = uses.as_slice() else {
@@ -215,16 +336,21 @@ impl PatchComplex {
                 out.push(None);
                 continue;
             };
-            let cb = fb.side_curve(b.side)?;
+            let (Some((ca, ra)), Some((cb, rb))) = (piece(a), piece(b)) else {
+                out.push(None);
+                continue;
+            };
             let (t0, t1) = cb.domain();
-            let mut probe = Probe::new(&cb, sample_count(&cb, &cb));
+            let (a0, a1) = ca.domain();
+            let mut probe = Probe::on(cb, rb, sample_count(cb, cb));
             let (pa, qa) = fa.surface.degrees();
             let (pb, qb) = fb.surface.degrees();
             let mut wa = (BasisWorkspace::new(pa, 1), BasisWorkspace::new(qa, 1));
             let mut wb = (BasisWorkspace::new(pb, 1), BasisWorkspace::new(qb, 1));
             let mut worst: Option<f64> = None;
             for i in 0..n {
-                let s = (i as f64 + 0.5) / n as f64;
+                let t = ra.0 + (ra.1 - ra.0) * (i as f64 + 0.5) / n as f64;
+                let s = (t - a0) / (a1 - a0);
                 let (ua, va) = fa.side_parameters(a.side, s);
                 let p = fa.surface.point(ua, va);
                 let (t, _) = probe.closest(&p);

@@ -20,12 +20,17 @@
 //!   `[0]` `S(u, v0)` with `u: u0 -> u1`, `[1]` `S(u1, v)` with `v: v0 -> v1`,
 //!   `[2]` `S(u, v1)` with `u: u1 -> u0`, `[3]` `S(u0, v)` with `v: v1 -> v0`.
 //!   Side `k` starts at corner `k`: `S(u0,v0)`, `S(u1,v0)`, `S(u1,v1)`, `S(u0,v1)`.
-//! * `sides[k] = Some(EdgeUse { edge, reversed })` says that side `k`, run in
-//!   the direction above, is the edge's curve run forwards (`reversed ==
-//!   false`, from `start` to `end`) or backwards. `None` is a degenerate side
-//!   collapsed to one vertex (the three-sided patch of the PDE paper §5.2, the
-//!   Coons apex of [`crate::base::CoonsPatch`] with `P(0, v)` a point, which is
-//!   side `[3]` here). At most one side of a face is degenerate.
+//! * `sides[k]` is the chain of edges that side `k`, run in the direction
+//!   above, lies on, in order: usually one [`EdgeUse`] `{ edge, reversed }`
+//!   (the edge's curve run forwards, `reversed == false`, from `start` to
+//!   `end`, or backwards), several where a patch has more than four corners
+//!   and a side runs over some of them (each edge then covers a piece of the
+//!   side between the vertices where the chain's edges meet, found by closest
+//!   point on the side, [`PatchComplex::chain_ranges`]). An empty chain is a
+//!   degenerate side collapsed to one vertex (the three-sided patch of the
+//!   PDE paper §5.2, the Coons apex of [`crate::base::CoonsPatch`] with
+//!   `P(0, v)` a point, which is side `[3]` here). At most one side of a face
+//!   is degenerate.
 //! * Orientation: the face normal is `S_u x S_v`. Two faces that share an
 //!   edge must traverse it in opposite directions, which is exactly the
 //!   condition for their normals to point to the same side of the shell.
@@ -86,7 +91,7 @@ pub struct EdgeUse {
     pub reversed: bool,
 }
 
-/// One patch: its surface and the edges on its four parameter sides.
+/// One patch: its surface and the edge chains on its four parameter sides.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Face {
     /// The patch label.
@@ -95,19 +100,23 @@ pub struct Face {
     pub surface: Surface,
     /// The four parameter sides in counter-clockwise order:
     /// `[0]` `S(u,0)` u:0->1, `[1]` `S(1,v)` v:0->1, `[2]` `S(u,1)` u:1->0,
-    /// `[3]` `S(0,v)` v:1->0. `None` = a degenerate side collapsed to a vertex
+    /// `[3]` `S(0,v)` v:1->0, each the chain of edges it lies on, in the
+    /// side's direction (one edge, or several when the patch has more than
+    /// four corners). Empty = a degenerate side collapsed to a vertex
     /// (three-sided patch, PDE paper §5.2 / Coons apex).
-    pub sides: [Option<EdgeUse>; 4],
+    pub sides: [Vec<EdgeUse>; 4],
 }
 
-/// A face side that uses an edge: which face, which of its four sides, and in
-/// which direction.
+/// A face side that uses an edge: which face, which of its four sides, the
+/// position in the side's chain, and in which direction.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SideRef {
     /// Index of the face.
     pub face: usize,
     /// Which side (0..4, see [`Face::sides`]).
     pub side: usize,
+    /// Position of the edge in the side's chain (0 for a one-edge side).
+    pub index: usize,
     /// True when the side runs from the edge's `end` to its `start`.
     pub reversed: bool,
 }
@@ -250,7 +259,20 @@ impl Face {
 
     /// Number of non-degenerate sides (3 or 4 in a valid complex).
     pub fn side_count(&self) -> usize {
-        self.sides.iter().filter(|s| s.is_some()).count()
+        self.sides.iter().filter(|s| !s.is_empty()).count()
+    }
+
+    /// Number of edge uses around the face (the edges of its loop).
+    pub fn use_count(&self) -> usize {
+        self.sides.iter().map(Vec::len).sum()
+    }
+
+    /// The edge uses around the face in loop order, with their side.
+    pub fn uses(&self) -> impl Iterator<Item = (usize, EdgeUse)> + '_ {
+        self.sides
+            .iter()
+            .enumerate()
+            .flat_map(|(k, c)| c.iter().map(move |&u| (k, u)))
     }
 }
 
@@ -313,9 +335,9 @@ impl PatchComplex {
             let face = Face {
                 id: fc.id,
                 surface: fc.surface,
-                sides: [None; 4],
+                sides: Default::default(),
             };
-            let mut sides = [None; 4];
+            let mut sides: [Vec<EdgeUse>; 4] = Default::default();
             for k in 0..4 {
                 let (a, b) = (fc.corners[k], fc.corners[(k + 1) % 4]);
                 if a == b {
@@ -336,10 +358,10 @@ impl PatchComplex {
                         model.edges.len() - 1
                     }
                 };
-                sides[k] = Some(EdgeUse {
+                sides[k] = vec![EdgeUse {
                     edge,
                     reversed: a > b,
-                });
+                }];
             }
             model.faces.push(Face { sides, ..face });
         }
@@ -378,12 +400,13 @@ impl PatchComplex {
     pub fn edge_faces(&self) -> Vec<Vec<SideRef>> {
         let mut out = vec![Vec::new(); self.edges.len()];
         for (fi, f) in self.faces.iter().enumerate() {
-            for (k, s) in f.sides.iter().enumerate() {
-                if let Some(u) = s {
+            for (k, chain) in f.sides.iter().enumerate() {
+                for (index, u) in chain.iter().enumerate() {
                     if let Some(list) = out.get_mut(u.edge) {
                         list.push(SideRef {
                             face: fi,
                             side: k,
+                            index,
                             reversed: u.reversed,
                         });
                     }
@@ -433,14 +456,13 @@ impl PatchComplex {
         ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt()
     }
 
-    /// The vertex cycle of face `fi`: for each non-degenerate side in order,
-    /// the vertex it starts at. `None` for an out-of-range face or edge.
+    /// The vertex cycle of face `fi`: for each edge use around it in order
+    /// (every edge of every side's chain), the vertex it starts at. `None`
+    /// for an out-of-range face or edge.
     pub fn face_vertices(&self, fi: usize) -> Option<Vec<usize>> {
         let f = self.faces.get(fi)?;
-        f.sides
-            .iter()
-            .flatten()
-            .map(|u| u.oriented_vertices(&self.edges).map(|(a, _)| a))
+        f.uses()
+            .map(|(_, u)| u.oriented_vertices(&self.edges).map(|(a, _)| a))
             .collect()
     }
 
@@ -449,12 +471,12 @@ impl PatchComplex {
     /// degenerate or the face is out of range.
     pub fn degenerate_vertex(&self, fi: usize, k: usize) -> Option<usize> {
         let f = self.faces.get(fi)?;
-        if f.sides.get(k)?.is_some() {
+        if !f.sides.get(k)?.is_empty() {
             return None;
         }
         (1..4)
             .map(|d| (k + 4 - d) % 4)
-            .find_map(|j| f.sides[j])
+            .find_map(|j| f.sides[j].last())
             .and_then(|u| u.oriented_vertices(&self.edges).map(|(_, b)| b))
     }
 
@@ -481,17 +503,12 @@ impl PatchComplex {
             }
         }
         for (fi, f) in self.faces.iter().enumerate() {
-            let uses: Vec<(usize, EdgeUse)> = f
-                .sides
-                .iter()
-                .enumerate()
-                .filter_map(|(k, s)| s.map(|u| (k, u)))
-                .collect();
-            if uses.len() < 3 {
+            let uses: Vec<(usize, EdgeUse)> = f.uses().collect();
+            if f.side_count() < 3 {
                 return Err(Error::InvalidInput(format!(
                     "face {fi} (patch {}) has {} non-degenerate sides; a patch needs 3 or 4",
                     f.id,
-                    uses.len()
+                    f.side_count()
                 )));
             }
             for &(k, u) in &uses {
@@ -511,8 +528,8 @@ impl PatchComplex {
                 let (b_start, _) = b.oriented_vertices(&self.edges).unwrap_or((0, 0));
                 if a_end != b_start {
                     return Err(Error::InvalidInput(format!(
-                        "face {fi} (patch {}): side {k} ends at vertex {a_end} but the next side {k2} starts at vertex {b_start}; the sides must form a closed cycle (check the edges' directions and `reversed` flags)",
-                        f.id
+                        "face {fi} (patch {}): edge {} on side {k} ends at vertex {a_end} but the next edge {} on side {k2} starts at vertex {b_start}; the sides' edges must form a closed cycle (check the edges' directions and `reversed` flags)",
+                        f.id, a.edge, b.edge
                     )));
                 }
             }
@@ -570,7 +587,7 @@ impl PatchComplex {
     ///     edges: (0..4).map(|i| Edge { start: i, end: (i + 1) % 4,
     ///                                  curve: line(c[i], c[(i + 1) % 4]) }).collect(),
     ///     faces: vec![Face { id: 7, surface,
-    ///         sides: [0, 1, 2, 3].map(|e| Some(EdgeUse { edge: e, reversed: false })) }],
+    ///         sides: [0, 1, 2, 3].map(|e| vec![EdgeUse { edge: e, reversed: false }]) }],
     /// };
     /// model.validate().unwrap();
     /// assert!(!model.is_closed());
@@ -606,13 +623,28 @@ impl PatchComplex {
                 }
             }
         }
+        for (fi, f) in self.faces.iter().enumerate() {
+            for (k, chain) in f.sides.iter().enumerate() {
+                if chain.len() < 2 {
+                    continue;
+                }
+                let c = f.side_curve(k)?;
+                let (_, d) = gaps::chain_junctions(&c, chain, self, fi, k)?;
+                if d.is_nan() || d > tol {
+                    return Err(Error::InvalidInput(format!(
+                        "face {fi} (patch {}) side {k}: a vertex where its edges meet is {d:e} from the side (tolerance {tol:e}); the surface's boundary must run through every vertex of the side's chain",
+                        f.id
+                    )));
+                }
+            }
+        }
         for g in self.boundary_gaps()? {
             if let Some(side) = g.worst_side {
                 if g.curve_gap.is_nan() || g.curve_gap > tol {
                     let f = &self.faces[side.face];
                     return Err(Error::InvalidInput(format!(
-                        "face {} (patch {}) side {} is {:e} away from edge {}'s curve (tolerance {tol:e} = {relative_tolerance:e} x model size {scale:e}); the surface's boundary must coincide with the shared edge curve",
-                        side.face, f.id, side.side, g.curve_gap, g.edge
+                        "face {} (patch {}) side {} (its edge {} of {}) is {:e} away from edge {}'s curve (tolerance {tol:e} = {relative_tolerance:e} x model size {scale:e}); the surface's boundary must coincide with the shared edge curve",
+                        side.face, f.id, side.side, side.index + 1, f.sides[side.side].len(), g.curve_gap, g.edge
                     )));
                 }
             }

@@ -78,7 +78,7 @@ fn moved_side_is_reported_with_its_gap() {
         ctrl[2].z -= d;
         m.faces[0].surface = Surface::new(lin(), lin(), ctrl).unwrap();
         let gaps = m.boundary_gaps().unwrap();
-        let e0 = m.faces[0].sides[0].unwrap().edge;
+        let e0 = m.faces[0].sides[0][0].edge;
         let g = &gaps[e0];
         assert!((g.curve_gap - d).abs() < 1e-9 * s, "{}", g.curve_gap);
         assert!((g.face_gap - d).abs() < 1e-9 * s, "{}", g.face_gap);
@@ -130,10 +130,10 @@ fn flipped_face_is_an_orientation_error() {
 fn structural_errors_name_what_is_wrong() {
     let m = cube(1.0);
     let mut bad = m.clone();
-    bad.faces[3].sides[1] = Some(EdgeUse {
+    bad.faces[3].sides[1] = vec![EdgeUse {
         edge: 99,
         reversed: false,
-    });
+    }];
     let err = bad.validate().unwrap_err().to_string();
     assert!(
         err.contains("face 3 (patch 13) side 1 uses edge 99"),
@@ -141,11 +141,11 @@ fn structural_errors_name_what_is_wrong() {
     );
 
     let mut bad = m.clone();
-    let u = bad.faces[1].sides[2].unwrap();
-    bad.faces[1].sides[2] = Some(EdgeUse {
+    let u = bad.faces[1].sides[2][0];
+    bad.faces[1].sides[2] = vec![EdgeUse {
         reversed: !u.reversed,
         ..u
-    });
+    }];
     let err = bad.validate().unwrap_err().to_string();
     assert!(err.contains("closed cycle"), "{err}");
 
@@ -165,8 +165,8 @@ fn structural_errors_name_what_is_wrong() {
     assert!(err.contains("from vertex 7"), "{err}");
 
     let mut bad = m;
-    bad.faces[0].sides[1] = None;
-    bad.faces[0].sides[2] = None;
+    bad.faces[0].sides[1].clear();
+    bad.faces[0].sides[2].clear();
     let err = bad.validate().unwrap_err().to_string();
     assert!(err.contains("2 non-degenerate sides"), "{err}");
 
@@ -204,7 +204,7 @@ fn three_sided_faces_with_a_collapsed_side() {
     assert!(m
         .faces
         .iter()
-        .all(|f| f.side_count() == 3 && f.sides[3].is_none()));
+        .all(|f| f.side_count() == 3 && f.sides[3].is_empty()));
     assert_eq!(m.degenerate_vertex(3, 3), Some(1));
     assert_eq!(m.degenerate_vertex(3, 0), None);
     assert!((m.signed_volume() - 1.0 / 6.0).abs() < 1e-14);
@@ -235,7 +235,7 @@ fn side_curves_match_the_surface_sides_for_unclamped_rational_surfaces() {
     let f = Face {
         id: 0,
         surface: s,
-        sides: [None; 4],
+        sides: Default::default(),
     };
     for k in 0..4 {
         let c = f.side_curve(k).unwrap();
@@ -364,4 +364,114 @@ fn normal_angles_measure_the_g1_defect() {
     assert_eq!(shared.len(), 1, "{a:?}");
     assert!((shared[0] - 30.0).abs() < 1e-9, "{}", shared[0]);
     assert_eq!(a.iter().filter(|x| x.is_none()).count(), 6);
+}
+
+/// A 2 x 1 face A with two unit squares B, C on its top side: A has five
+/// corners and its top side is a chain of the two edges it shares with B
+/// and C.
+fn chain_model() -> PatchComplex {
+    let p = |x: f64, y: f64| Point3::new(x, y, 0.0);
+    let v = vec![
+        p(0., 0.),
+        p(2., 0.),
+        p(2., 1.),
+        p(1., 1.),
+        p(0., 1.),
+        p(0., 2.),
+        p(1., 2.),
+        p(2., 2.),
+    ];
+    let sq = |c: [usize; 4]| FaceCorners {
+        id: c[0] as i64,
+        surface: quad(c.map(|k| v[k])),
+        corners: c,
+    };
+    let mut m =
+        PatchComplex::assemble(v.clone(), vec![sq([4, 3, 6, 5]), sq([3, 2, 7, 6])]).unwrap();
+    let find = |m: &PatchComplex, a: usize, b: usize| {
+        let e = m
+            .edges
+            .iter()
+            .position(|e| (e.start, e.end) == (a.min(b), a.max(b)))
+            .unwrap();
+        EdgeUse {
+            edge: e,
+            reversed: a > b,
+        }
+    };
+    for (a, b) in [(0, 1), (1, 2), (0, 4)] {
+        m.edges.push(Edge {
+            start: a,
+            end: b,
+            curve: Curve::new(lin(), vec![v[a], v[b]]).unwrap(),
+        });
+    }
+    let sides = [
+        vec![find(&m, 0, 1)],
+        vec![find(&m, 1, 2)],
+        vec![find(&m, 2, 3), find(&m, 3, 4)],
+        vec![find(&m, 4, 0)],
+    ];
+    m.faces.push(Face {
+        id: 99,
+        surface: quad([p(0., 0.), p(2., 0.), p(2., 1.), p(0., 1.)]),
+        sides,
+    });
+    m
+}
+
+#[test]
+fn a_side_made_of_two_edges_is_cut_at_their_vertex() {
+    let m = chain_model();
+    m.validate().unwrap();
+    assert_eq!(m.faces[2].side_count(), 4);
+    assert_eq!(m.faces[2].use_count(), 5);
+    assert_eq!(m.face_vertices(2).unwrap(), vec![0, 1, 2, 3, 4]);
+    let r = m.chain_ranges(2, 2).unwrap();
+    assert_eq!(r.len(), 2);
+    assert!(
+        (r[0].0).abs() < 1e-15 && (r[0].1 - 0.5).abs() < 1e-12,
+        "{r:?}"
+    );
+    assert!(
+        (r[1].0 - 0.5).abs() < 1e-12 && (r[1].1 - 1.0).abs() < 1e-15,
+        "{r:?}"
+    );
+    assert_eq!(m.chain_ranges(2, 0).unwrap(), vec![(0.0, 1.0)]);
+    // both halves of the chain side are shared, each with one square, gap 0
+    let users = m.edge_faces();
+    let gaps = m.boundary_gaps().unwrap();
+    for u in &m.faces[2].sides[2] {
+        assert_eq!(users[u.edge].len(), 2);
+        assert!(gaps[u.edge].face_gap < 1e-14 && gaps[u.edge].curve_gap < 1e-14);
+    }
+    assert_eq!(users[m.faces[2].sides[2][1].edge][1].index, 1);
+    // flat: no normal angle along the two shared edges
+    let angles = m.normal_angles(9).unwrap();
+    for u in &m.faces[2].sides[2] {
+        assert!(angles[u.edge].unwrap() < 1e-6, "{:?}", angles[u.edge]);
+    }
+    // the chain's edges listed out of order: not a cycle
+    let mut bad = m.clone();
+    bad.faces[2].sides[2].swap(0, 1);
+    let err = bad.validate().unwrap_err().to_string();
+    assert!(err.contains("closed cycle"), "{err}");
+    // the junction vertex off the face's side: named with its distance
+    let mut bad = m.clone();
+    let off = 0.25;
+    bad.vertices[3].point.y += off;
+    for e in bad.edges.iter_mut() {
+        for (end, k) in [(e.start, 0), (e.end, 1)] {
+            if end == 3 {
+                let mut c = e.curve.control_points().to_vec();
+                c[k].y += off;
+                e.curve = Curve::new(lin(), c).unwrap();
+            }
+        }
+    }
+    let err = bad.validate().unwrap_err().to_string();
+    assert!(
+        err.contains("side 2: a vertex where its edges meet is 2.5e-1"),
+        "{err}"
+    );
 }

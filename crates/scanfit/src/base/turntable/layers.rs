@@ -116,10 +116,20 @@ impl LayerConfig {
 
 /// Heights of the layers relative to the frame's centre.
 pub fn layer_heights(frame: &CylinderFrame, cfg: &LayerConfig) -> Result<Vec<f64>> {
+    layer_heights_between(frame, cfg, (cfg.margin, cfg.margin))
+}
+
+/// Heights of the layers with their own margin at the low and high end
+/// (fractions of the height; 0 at an open end, [`super::ends`]).
+pub fn layer_heights_between(
+    frame: &CylinderFrame,
+    cfg: &LayerConfig,
+    margins: (f64, f64),
+) -> Result<Vec<f64>> {
     cfg.validate()?;
     let (lo, hi) = frame.height;
     let span = hi - lo;
-    let (a, b) = (lo + cfg.margin * span, hi - cfg.margin * span);
+    let (a, b) = (lo + margins.0 * span, hi - margins.1 * span);
     Ok((0..cfg.layers)
         .map(|l| a + (b - a) * l as f64 / (cfg.layers - 1) as f64)
         .collect())

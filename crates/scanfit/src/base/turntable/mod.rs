@@ -18,14 +18,16 @@
 
 pub mod axis;
 pub mod base_surface;
+pub mod ends;
 pub mod layers;
 pub mod views;
 
 pub use axis::{principal_axis, AxisChoice, CylinderFrame};
 pub use base_surface::{aligned_samples, initial_base_surface, refine_round, RefineConfig};
+pub use ends::{end_shapes, EndShape};
 pub use layers::{
-    closed_curve, compare_weights, layer_heights, layer_loops, project_layers, uniform_samples,
-    LayerConfig, LayerCurves, Rounds,
+    closed_curve, compare_weights, layer_heights, layer_heights_between, layer_loops,
+    project_layers, uniform_samples, LayerConfig, LayerCurves, Rounds,
 };
 pub use views::{layer_polygon, turntable_views, View, ViewConfig};
 
@@ -53,6 +55,11 @@ pub struct TurntableConfig {
     pub inversion: InversionConfig,
     /// What happens to the points beyond the end layers (default: left out of the fit).
     pub ends: Ends,
+    /// Decide from the data whether each end is open (a rim: the layers run
+    /// to it, no margin) or closed (a bottom or a pole: the layer margin
+    /// applies), [`ends::end_shapes`] (default true); false: the margin at
+    /// both ends.
+    pub detect_open_ends: bool,
 }
 
 /// The points beyond the first and last layer (the ends of the cloud: the
@@ -88,6 +95,7 @@ impl Default for TurntableConfig {
             },
             inversion: InversionConfig::default(),
             ends: Ends::Exclude,
+            detect_open_ends: true,
         }
     }
 }
@@ -106,6 +114,9 @@ pub const STAGES: [&str; 7] = [
 /// What the pipeline produced.
 #[derive(Debug, Clone)]
 pub struct Turntable {
+    /// The low and high end (along the axis): open (fitted to the rim) or
+    /// closed (left out by the layer margin), [`ends::end_shapes`].
+    pub end_shapes: [EndShape; 2],
     /// The turntable frame (axis, centre, extent).
     pub frame: CylinderFrame,
     /// The views with their visible sets and MBA surfaces.
@@ -188,7 +199,19 @@ pub fn turntable(
     stage(1);
     let views = turntable_views(points, &frame, &cfg.views)?;
     stage(2);
-    let heights = layer_heights(&frame, &cfg.layers)?;
+    let end_shape = end_shapes(points, &frame, cfg.layers.margin);
+    let margin_at = |e: &EndShape| {
+        if cfg.detect_open_ends && e.open {
+            0.0
+        } else {
+            cfg.layers.margin
+        }
+    };
+    let heights = layer_heights_between(
+        &frame,
+        &cfg.layers,
+        (margin_at(&end_shape[0]), margin_at(&end_shape[1])),
+    )?;
     let loops = layer_loops(
         cloud,
         &frame,
@@ -329,6 +352,7 @@ pub fn turntable(
         uv_fitted,
         quality_fitted,
         surface_to_cloud,
+        end_shapes: end_shape,
     })
 }
 

@@ -1,0 +1,119 @@
+//! `--chunk-points`: the streamed `fit` and `mba` write the in-memory
+//! command's surface (the same JSON control points and knots).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn scanfit(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_scanfit"))
+        .args(args)
+        .output()
+        .expect("scanfit runs")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("scanfit-stream-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn surface(path: &Path) -> serde_json::Value {
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    serde_json::json!([doc["control_points"], doc["knots_u"], doc["knots_v"]])
+}
+
+fn ok(out: &std::process::Output) {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn streamed_mba_writes_the_in_memory_surface() {
+    let d = tmp("mba");
+    let sample = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/data/terrain_50k.xyz"
+    );
+    let (a, b) = (d.join("a.json"), d.join("b.json"));
+    let base = ["mba", sample, "--levels", "5", "--quiet", "-o"];
+    ok(&scanfit(&[&base[..], &[a.to_str().unwrap()]].concat()));
+    for chunk in ["7000", "50000"] {
+        let out = scanfit(
+            &[
+                &base[..],
+                &[b.to_str().unwrap(), "--chunk-points", chunk, "--json"],
+            ]
+            .concat(),
+        );
+        ok(&out);
+        assert_eq!(surface(&a), surface(&b), "chunk {chunk}");
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(report["streamed"]["passes"], 7);
+        assert_eq!(report["point_count"], 50_000);
+    }
+    let e = scanfit(&["mba", sample, "--adjust", "--chunk-points", "1000"]);
+    assert!(!e.status.success());
+    assert!(String::from_utf8_lossy(&e.stderr).contains("--adjust"));
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn streamed_fit_writes_the_in_memory_surface_and_refuses_whole_cloud_options() {
+    let d = tmp("fit");
+    let input = d.join("patch.csv");
+    let mut text = String::from("x,y,z,u,v\n");
+    for k in 0..20_000 {
+        let (u, v) = ((k % 157) as f64 / 156.0, (k / 157) as f64 / 127.0);
+        text.push_str(&format!(
+            "{},{},{},{u},{v}\n",
+            30.0 * u,
+            20.0 * v,
+            (3.0 * u).sin() * (2.0 * v).cos()
+        ));
+    }
+    std::fs::write(&input, text).unwrap();
+    let (a, b) = (d.join("a.json"), d.join("b.json"));
+    let input = input.to_str().unwrap();
+    let base = [
+        "fit",
+        input,
+        "--params",
+        "uv-columns",
+        "--knots",
+        "uniform",
+        "--ctrl",
+        "12x9",
+        "--quiet",
+        "-o",
+    ];
+    ok(&scanfit(&[&base[..], &[a.to_str().unwrap()]].concat()));
+    ok(&scanfit(
+        &[&base[..], &[b.to_str().unwrap(), "--chunk-points", "3000"]].concat(),
+    ));
+    assert_eq!(surface(&a), surface(&b));
+    for (extra, says) in [
+        (&["--params", "plane", "--knots", "uniform"][..], "--params"),
+        (&["--params", "uv-columns"][..], "--knots"),
+        (
+            &[
+                "--params",
+                "uv-columns",
+                "--knots",
+                "uniform",
+                "--correct",
+                "2",
+            ][..],
+            "--correct",
+        ),
+    ] {
+        let e = scanfit(&[&["fit", input, "--chunk-points", "1000"][..], extra].concat());
+        assert!(!e.status.success());
+        let msg = String::from_utf8_lossy(&e.stderr);
+        assert!(msg.contains(says) && msg.contains("chunks"), "{msg}");
+    }
+    std::fs::remove_dir_all(&d).unwrap();
+}

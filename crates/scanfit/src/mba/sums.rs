@@ -1,0 +1,564 @@
+//! The sums over points behind a multilevel B-spline approximation, as
+//! accumulators that can be built in pieces (chunks of a file, tiles on
+//! other machines) and merged: the data's frame ([`FrameSums`]: bounding
+//! box and mean height), the BA step of one level ([`BaAccumulator`]: the
+//! numerator and denominator of [LWS97] eq. 4, [MBA18] eqs. 3-4, per control
+//! value) and the statistics of the residuals ([`ResidualSums`]).
+//!
+//! A distributed level loop ([`super::MbaLevels`]) runs, per level: the
+//! driver sends the frame and the level lattices so far to every worker;
+//! each worker creates the level's accumulator
+//! ([`super::MbaLevels::accumulator`]), adds its points
+//! ([`BaAccumulator::add_residuals`], which evaluates the levels so far at
+//! the points) and returns it; the driver merges them and finishes the
+//! level ([`super::MbaLevels::push`]). Only lattices travel, never points.
+//!
+//! Points are summed in blocks counted from the first point added (of at
+//! least 16384 points, and at least as many as the lattice has control
+//! values; constants of the lattice, never of the thread count), so adding
+//! a file's points in chunks of any size, in file order, gives the same
+//! lattice bit for bit as one call with all of them. Merging accumulators
+//! summed separately gives the one-pass lattice up to the rounding of the
+//! additions (floating-point addition is not associative).
+
+use crate::metrics::ErrorStats;
+use crate::par::BlockSum;
+use crate::{validate_points, Error, Point3, Result};
+
+use super::lattice::{locate, uniform_cubic_basis, ControlFormula, Lattice};
+use super::Frame;
+
+/// Fewest points per block of the BA sums.
+const BA_BLOCK: usize = 16_384;
+
+/// Bytes of partial sums that may exist at a time while a chunk is summed.
+const PARTIAL_BUDGET: usize = 256 << 20;
+
+/// The BA sums of one lattice ([LWS97] eq. 4, [MBA18] eqs. 3-4): for every
+/// control value the numerator `sum_c w_c^2 phi_c` and the denominator
+/// `sum_c w_c^2` over the points `c` in its 4 x 4 neighbourhood (weights
+/// `w_c` instead of `w_c^2` for [`ControlFormula::Hjelle`]), with the
+/// candidate `phi_c = w_c z_c / sum_ab w_ab^2` of eq. 3.
+/// [`finish`](Self::finish) divides them into the lattice.
+///
+/// ```
+/// use scanfit::mba::{BaAccumulator, ControlFormula, Lattice};
+///
+/// let xy: Vec<[f64; 2]> = (0..5000).map(|k| [(k % 71) as f64 / 70.0 * 4.0, (k / 71) as f64 / 70.0 * 3.0]).collect();
+/// let z: Vec<f64> = xy.iter().map(|p| (p[0] - 2.0) * p[1]).collect();
+/// let once = Lattice::approximate(4, 3, &xy, &z, ControlFormula::LeeWolbergShin)?;
+/// // in chunks of 999, in order: the same lattice, bit for bit
+/// let mut acc = BaAccumulator::new(4, 3, ControlFormula::LeeWolbergShin)?;
+/// for (a, b) in xy.chunks(999).zip(z.chunks(999)) {
+///     acc.add(a, b)?;
+/// }
+/// assert_eq!(acc.finish(), once);
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct BaAccumulator {
+    m: usize,
+    n: usize,
+    formula: ControlFormula,
+    sums: BlockSum<(Vec<f64>, Vec<f64>)>,
+}
+
+impl BaAccumulator {
+    /// Empty sums for a lattice of `m x n` cells (control net `(m + 3) x
+    /// (n + 3)`); errors like [`Lattice::zeros`].
+    pub fn new(m: usize, n: usize, formula: ControlFormula) -> Result<Self> {
+        let len = Lattice::zeros(m, n)?.phi.len();
+        Ok(Self {
+            m,
+            n,
+            formula,
+            sums: BlockSum::new((vec![0.0; len], vec![0.0; len]), BA_BLOCK.max(len)),
+        })
+    }
+
+    /// Cells `(m, n)` of the lattice.
+    pub fn cells(&self) -> (usize, usize) {
+        (self.m, self.n)
+    }
+
+    /// Points added so far (over all merged accumulators).
+    pub fn points(&self) -> u64 {
+        self.sums.items()
+    }
+
+    /// Bytes of one set of sums (numerator and denominator per control value).
+    pub fn bytes(&self) -> usize {
+        2 * (self.m + 3) * (self.n + 3) * std::mem::size_of::<f64>()
+    }
+
+    /// Adds the values `z` at lattice coordinates `xy` (in `[0, m] x [0, n]`;
+    /// points outside are clamped to it). Errors when the lengths differ or
+    /// a value is not finite.
+    pub fn add(&mut self, xy: &[[f64; 2]], z: &[f64]) -> Result<()> {
+        if xy.len() != z.len() {
+            return Err(Error::LengthMismatch {
+                what: "values",
+                expected: xy.len(),
+                got: z.len(),
+            });
+        }
+        if let Some(i) = (0..z.len())
+            .find(|&i| !(z[i].is_finite() && xy[i][0].is_finite() && xy[i][1].is_finite()))
+        {
+            return Err(Error::BadPoint {
+                index: i,
+                problem: format!(
+                    "has lattice coordinates ({}, {}) and value {}; all must be finite",
+                    xy[i][0], xy[i][1], z[i]
+                ),
+            });
+        }
+        let (m, n, formula) = (self.m, self.n, self.formula);
+        let len = (m + 3) * (n + 3);
+        let partials = (PARTIAL_BUDGET / self.bytes()).clamp(1, 16);
+        self.sums.add(
+            xy.len(),
+            partials,
+            || (vec![0.0; len], vec![0.0; len]),
+            |(num, den), range| {
+                for (p, &zc) in xy[range.clone()].iter().zip(&z[range]) {
+                    add_point(num, den, m, n, formula, *p, zc);
+                }
+            },
+            merge_sums,
+        );
+        Ok(())
+    }
+
+    /// Adds the residuals of `points` after the `levels` fitted so far
+    /// (`z - z0 - sum_k f_k(x, y)`, each level evaluated at the point's
+    /// unit coordinates in `frame`, subtracted in level order exactly as the
+    /// in-memory level loop does), and returns their statistics (the
+    /// residuals of the previous level, for its report). Point indices in
+    /// the statistics count from 0 within `points`.
+    pub fn add_residuals(
+        &mut self,
+        frame: &Frame,
+        levels: &[Lattice],
+        points: &[Point3],
+    ) -> Result<ResidualSums> {
+        validate_points(points)?;
+        let mut stats = ResidualSums::default();
+        let mut xy = Vec::with_capacity(points.len());
+        let mut z = Vec::with_capacity(points.len());
+        for p in points {
+            let u = frame.unit(p);
+            let r = residual(frame, levels, p, u);
+            stats.push(r.abs());
+            xy.push([u[0] * self.m as f64, u[1] * self.n as f64]);
+            z.push(r);
+        }
+        self.add(&xy, &z)?;
+        Ok(stats)
+    }
+
+    /// Adds the sums of another accumulator of the same lattice (points
+    /// summed separately).
+    pub fn merge(&mut self, other: Self) -> Result<()> {
+        if (self.m, self.n, self.formula) != (other.m, other.n, other.formula) {
+            return Err(Error::InvalidInput(format!(
+                "cannot merge the BA sums of a {} x {} lattice into those of a {} x {} lattice (or of another control formula); every chunk of a level must use that level's lattice",
+                other.m, other.n, self.m, self.n
+            )));
+        }
+        self.sums.merge(other.sums, merge_sums);
+        Ok(())
+    }
+
+    /// The lattice: each control value the ratio of its sums (eq. 4), 0
+    /// where no point reached it.
+    pub fn finish(self) -> Lattice {
+        let (num, den) = self.sums.finish(merge_sums);
+        let phi = num
+            .iter()
+            .zip(&den)
+            .map(|(nu, de)| if *de > 0.0 { nu / de } else { 0.0 })
+            .collect();
+        Lattice {
+            m: self.m,
+            n: self.n,
+            phi,
+        }
+    }
+}
+
+/// The residual `z - z0 - sum_k f_k` of `p` (unit coordinates `u`) after
+/// `levels`, subtracted level by level.
+pub(crate) fn residual(frame: &Frame, levels: &[Lattice], p: &Point3, u: [f64; 2]) -> f64 {
+    let mut r = p.z - frame.z0;
+    for l in levels {
+        r -= l.eval(u[0] * l.m as f64, u[1] * l.n as f64);
+    }
+    r
+}
+
+/// Eqs. 3-4 for one point: its candidates and weights added to the sums.
+#[inline]
+fn add_point(
+    num: &mut [f64],
+    den: &mut [f64],
+    m: usize,
+    n: usize,
+    formula: ControlFormula,
+    p: [f64; 2],
+    zc: f64,
+) {
+    let st = n + 3;
+    let (i, s) = locate(p[0].clamp(0.0, m as f64), m);
+    let (j, t) = locate(p[1].clamp(0.0, n as f64), n);
+    let (bs, bt) = (uniform_cubic_basis(s), uniform_cubic_basis(t));
+    let mut sum2 = 0.0;
+    for bk in bs {
+        for bl in bt {
+            sum2 += (bk * bl) * (bk * bl);
+        }
+    }
+    for k in 0..4 {
+        for l in 0..4 {
+            let w = bs[k] * bt[l];
+            let phi_c = w * zc / sum2; // eq. 3
+            let at = (i + k) * st + j + l;
+            let weight = match formula {
+                ControlFormula::LeeWolbergShin => w * w,
+                ControlFormula::Hjelle => w,
+            };
+            num[at] += weight * phi_c; // eq. 4 numerator
+            den[at] += weight;
+        }
+    }
+}
+
+/// Adds partial BA sums to a total.
+fn merge_sums(total: &mut (Vec<f64>, Vec<f64>), part: (Vec<f64>, Vec<f64>)) {
+    total.0.iter_mut().zip(&part.0).for_each(|(x, y)| *x += y);
+    total.1.iter_mut().zip(&part.1).for_each(|(x, y)| *x += y);
+}
+
+/// Mergeable statistics of absolute residuals (count, sum, sum of squares,
+/// maximum and its index): [`ErrorStats`] of a stream. Summed in order they
+/// equal [`ErrorStats::of`] on all values bit for bit.
+///
+/// ```
+/// use scanfit::mba::ResidualSums;
+/// use scanfit::metrics::ErrorStats;
+/// let d = [0.5, 2.0, 1.0, 0.25];
+/// let mut a = ResidualSums::default();
+/// for x in d {
+///     a.push(x);
+/// }
+/// assert_eq!(a.stats(), ErrorStats::of(&d));
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ResidualSums {
+    /// Values added.
+    pub count: u64,
+    /// Their sum.
+    pub sum: f64,
+    /// The sum of their squares.
+    pub sum2: f64,
+    /// The largest (0 when empty).
+    pub max: f64,
+    /// Index of the largest, counted over all values added (and merged).
+    pub max_index: u64,
+}
+
+impl ResidualSums {
+    /// Adds one value.
+    pub fn push(&mut self, x: f64) {
+        self.sum += x;
+        self.sum2 += x * x;
+        if x > self.max {
+            self.max = x;
+            self.max_index = self.count;
+        }
+        self.count += 1;
+    }
+
+    /// Adds the values of `other`, which come after this one's (their
+    /// indices are shifted by this one's count).
+    pub fn merge(&mut self, other: &Self) {
+        if other.max > self.max {
+            self.max = other.max;
+            self.max_index = self.count + other.max_index;
+        }
+        self.sum += other.sum;
+        self.sum2 += other.sum2;
+        self.count += other.count;
+    }
+
+    /// Mean, maximum and RMSE.
+    pub fn stats(&self) -> ErrorStats {
+        let n = self.count.max(1) as f64;
+        ErrorStats {
+            count: usize::try_from(self.count).unwrap_or(usize::MAX),
+            mean: self.sum / n,
+            max: self.max,
+            max_index: usize::try_from(self.max_index).unwrap_or(usize::MAX),
+            rmse: (self.sum2 / n).sqrt(),
+        }
+    }
+}
+
+/// The sums behind a [`Frame`]: bounding box in x and y and the sum of the
+/// heights. Summed in order, [`finish`](Self::finish) equals
+/// [`Frame::of`] on all points bit for bit ([`Frame::of`] goes through it).
+///
+/// ```
+/// use scanfit::mba::{Frame, FrameSums};
+/// use scanfit::Point3;
+/// let p: Vec<Point3> = (0..100).map(|k| Point3::new(k as f64, (k % 7) as f64, 0.1 * k as f64)).collect();
+/// let mut s = FrameSums::default();
+/// for c in p.chunks(30) {
+///     s.add(c)?;
+/// }
+/// assert_eq!(s.finish()?, Frame::of(&p)?);
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FrameSums {
+    lo: Option<[f64; 2]>,
+    hi: [f64; 2],
+    zsum: f64,
+    count: u64,
+}
+
+impl FrameSums {
+    /// Adds a chunk of points (errors for a non-finite coordinate).
+    pub fn add(&mut self, points: &[Point3]) -> Result<()> {
+        validate_points(points)?;
+        for p in points {
+            let lo = self.lo.get_or_insert([p.x, p.y]);
+            if self.count == 0 {
+                self.hi = [p.x, p.y];
+            }
+            *lo = [lo[0].min(p.x), lo[1].min(p.y)];
+            self.hi = [self.hi[0].max(p.x), self.hi[1].max(p.y)];
+            self.zsum += p.z;
+            self.count += 1;
+        }
+        Ok(())
+    }
+
+    /// Adds the sums of points summed separately.
+    pub fn merge(&mut self, other: &Self) {
+        if let Some(olo) = other.lo {
+            let lo = self.lo.get_or_insert(olo);
+            *lo = [lo[0].min(olo[0]), lo[1].min(olo[1])];
+            self.hi = if self.count == 0 {
+                other.hi
+            } else {
+                [self.hi[0].max(other.hi[0]), self.hi[1].max(other.hi[1])]
+            };
+        }
+        self.zsum += other.zsum;
+        self.count += other.count;
+    }
+
+    /// Points added.
+    pub fn points(&self) -> u64 {
+        self.count
+    }
+
+    /// The frame; errors for fewer than 2 points or data without extent in
+    /// x or y.
+    pub fn finish(&self) -> Result<Frame> {
+        let lo = match self.lo {
+            Some(lo) if self.count >= 2 => lo,
+            _ => {
+                return Err(Error::TooFewPoints {
+                    got: usize::try_from(self.count).unwrap_or(usize::MAX),
+                    needed: 2,
+                    what: "a multilevel B-spline approximation (a domain with extent in x and y)"
+                        .into(),
+                })
+            }
+        };
+        let (width, height) = (self.hi[0] - lo[0], self.hi[1] - lo[1]);
+        let scale = width.max(height).max(lo[0].abs().max(lo[1].abs()));
+        for (extent, axis) in [(width, "x"), (height, "y")] {
+            if extent <= 1e-12 * scale || extent.is_nan() {
+                return Err(Error::InvalidInput(format!(
+                    "all points have the same {axis} (extent {extent:e}): the data span no rectangle to approximate over; MBA needs 2.5D data z = f(x, y) spread in both x and y"
+                )));
+            }
+        }
+        Ok(Frame {
+            x0: lo[0],
+            y0: lo[1],
+            width,
+            height,
+            z0: self.zsum / self.count as f64,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mba::{mba, MbaConfig, MbaLevels};
+    use crate::testdata::franke;
+
+    fn cloud(n: usize) -> Vec<Point3> {
+        let mut rng = crate::testdata::Lcg::new(17);
+        (0..n)
+            .map(|_| {
+                let (x, y) = (rng.next_f64(), rng.next_f64());
+                Point3::new(300.0 * x + 4.0e5, 200.0 * y - 7.0e5, 40.0 * franke(x, y))
+            })
+            .collect()
+    }
+
+    /// The MBA of `points` run the distributed way: a frame pass, then per
+    /// level the chunks' accumulators, merged by `tree`.
+    fn chunked_mba(
+        points: &[Point3],
+        config: &MbaConfig,
+        chunk: usize,
+        tree: fn(Vec<BaAccumulator>) -> BaAccumulator,
+    ) -> crate::mba::Mba {
+        let mut fs = FrameSums::default();
+        for c in points.chunks(chunk) {
+            fs.add(c).unwrap();
+        }
+        let mut run = MbaLevels::new(fs.finish().unwrap(), config).unwrap();
+        for _ in 0..config.max_levels {
+            let parts: Vec<BaAccumulator> = points
+                .chunks(chunk)
+                .map(|c| {
+                    let mut a = run.accumulator().unwrap();
+                    a.add_residuals(&run.frame(), run.levels(), c).unwrap();
+                    a
+                })
+                .collect();
+            run.push(tree(parts)).unwrap();
+        }
+        run.finish()
+    }
+
+    fn left_fold(parts: Vec<BaAccumulator>) -> BaAccumulator {
+        let mut it = parts.into_iter();
+        let mut a = it.next().unwrap();
+        for b in it {
+            a.merge(b).unwrap();
+        }
+        a
+    }
+
+    fn balanced(mut parts: Vec<BaAccumulator>) -> BaAccumulator {
+        while parts.len() > 1 {
+            let mut next = Vec::new();
+            let mut it = parts.into_iter();
+            while let Some(mut a) = it.next() {
+                if let Some(b) = it.next() {
+                    a.merge(b).unwrap();
+                }
+                next.push(a);
+            }
+            parts = next;
+        }
+        parts.pop().unwrap()
+    }
+
+    fn right_fold(parts: Vec<BaAccumulator>) -> BaAccumulator {
+        let mut it = parts.into_iter().rev();
+        let mut a = it.next().unwrap();
+        for mut b in it {
+            b.merge(a).unwrap();
+            a = b;
+        }
+        a
+    }
+
+    #[test]
+    fn streamed_chunks_in_order_give_the_one_call_lattice_bit_for_bit() {
+        let p = cloud(40_000);
+        let config = MbaConfig {
+            max_levels: 6,
+            ..Default::default()
+        };
+        let once = mba(&p, &config).unwrap();
+        for chunk in [1, 777, 16_384, 25_000, 40_000] {
+            let mut fs = FrameSums::default();
+            for c in p.chunks(chunk) {
+                fs.add(c).unwrap();
+            }
+            let mut run = MbaLevels::new(fs.finish().unwrap(), &config).unwrap();
+            for _ in 0..config.max_levels {
+                // one accumulator fed chunk after chunk (a file read in chunks)
+                let mut a = run.accumulator().unwrap();
+                for c in p.chunks(chunk) {
+                    a.add_residuals(&run.frame(), run.levels(), c).unwrap();
+                }
+                run.push(a).unwrap();
+            }
+            let streamed = run.finish();
+            assert_eq!(streamed.frame, once.frame, "chunk {chunk}");
+            assert_eq!(streamed.lattice, once.lattice, "chunk {chunk}");
+        }
+    }
+
+    #[test]
+    fn merged_trees_give_the_one_call_lattice_to_1e12() {
+        let p = cloud(30_000);
+        let config = MbaConfig {
+            max_levels: 5,
+            ..Default::default()
+        };
+        let once = mba(&p, &config).unwrap();
+        let scale = once.lattice.phi.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        assert!(scale > 1.0);
+        for chunk in [997, 5000, 16_384] {
+            for tree in [left_fold, balanced, right_fold] {
+                let got = chunked_mba(&p, &config, chunk, tree);
+                let worst = got
+                    .lattice
+                    .phi
+                    .iter()
+                    .zip(&once.lattice.phi)
+                    .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+                assert!(
+                    worst <= 1e-12 * scale,
+                    "chunk {chunk}: {worst:e} of {scale}"
+                );
+                // and the levels too
+                assert_eq!(got.levels.len(), once.levels.len());
+            }
+        }
+    }
+
+    #[test]
+    fn mismatches_are_errors() {
+        let mut a = BaAccumulator::new(2, 2, ControlFormula::LeeWolbergShin).unwrap();
+        let b = BaAccumulator::new(4, 2, ControlFormula::LeeWolbergShin).unwrap();
+        assert!(a.merge(b).unwrap_err().to_string().contains("4 x 2"));
+        assert!(a.add(&[[0.0, 0.0]], &[]).is_err());
+        assert!(a.add(&[[0.0, f64::NAN]], &[1.0]).is_err());
+        let mut f = FrameSums::default();
+        f.add(&[Point3::new(1.0, 1.0, 1.0)]).unwrap();
+        assert!(f.finish().is_err());
+        // an empty chunk changes nothing
+        a.add(&[], &[]).unwrap();
+        assert_eq!(a.points(), 0);
+    }
+
+    #[test]
+    fn residual_sums_merge_like_one_stream() {
+        let d: Vec<f64> = (0..1000).map(|k| ((k * 37) % 101) as f64 / 7.0).collect();
+        let (mut a, mut b) = (ResidualSums::default(), ResidualSums::default());
+        d[..400].iter().for_each(|&x| a.push(x));
+        d[400..].iter().for_each(|&x| b.push(x));
+        a.merge(&b);
+        let want = ErrorStats::of(&d);
+        let got = a.stats();
+        assert_eq!(
+            (got.count, got.max, got.max_index),
+            (want.count, want.max, want.max_index)
+        );
+        assert!((got.rmse - want.rmse).abs() <= 1e-14 * want.rmse);
+    }
+}

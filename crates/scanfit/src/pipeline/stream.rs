@@ -1,0 +1,636 @@
+//! `scanfit fit` and `scanfit mba` over points read in chunks
+//! (`--chunk-points`): memory depends on the model (lattice, normal
+//! equations), not on the point count.
+//!
+//! The points come from a [`PointSource`], which reads them in passes of
+//! chunks, always in the same order. The fits go through the same
+//! accumulators as the in-memory pipelines ([`crate::mba::BaAccumulator`],
+//! [`crate::fit::surface::NormalEquations`]), fed chunk after chunk in file order, so the surface
+//! is the in-memory one **bit for bit**:
+//!
+//! * [`mba`]: one pass for the frame ([`FrameSums`]), one per level
+//!   (residuals after the levels so far, [LWS97] eqs. 3-4), one to measure.
+//! * [`fit`]: parameters per point from two attributes (`u`, `v`); one pass
+//!   for the normal equations ([NURBS97] eq. 9.63 with uniform knots), one to
+//!   measure. Settings that need all points at once are refused with the
+//!   reason: knots from the parameter distribution (eq. 9.69 sorts all
+//!   parameters), parameters from the best-fit plane (the plane's minimum-area
+//!   rectangle is not implemented as a streamed pass yet), parameter correction
+//!   (re-projects every point per round).
+//!
+//! The report is measured by streaming too ([`StreamAssessor`]): errors at
+//! the parameters and orthogonal distances over every point; [MBA18] eq. 17
+//! and the sample-grid distances exactly (the nearest point over all chunks
+//! is the nearest of the chunks' nearest); the point spacing behind the
+//! "far" share is the median nearest-neighbour distance **within the first
+//! chunk** (a sample), and the parameterization's fold-overs and stretch are
+//! not measured (they need a triangulation of all parameters).
+
+use std::time::Instant;
+
+use crate::bspline::Surface;
+use crate::mba::{
+    lattice_surface, sums::residual, FrameSums, Lattice, MbaConfig, MbaLevels, ResidualSums,
+};
+use crate::metrics::ParamQuality;
+use crate::pipeline::assess::{AssessConfig, Extent, SampleDistances, SurfaceQuality};
+use crate::pipeline::mba::LevelRow;
+use crate::pipeline::surface_fit::{FitConfig, ParameterSource};
+use crate::progress::Progress;
+use crate::project::SurfaceInverter;
+use crate::spatial::KdTree;
+use crate::{Error, Point3, PointCloud, Result};
+
+/// A chunk of points: positions and, when the source was asked for them,
+/// parameters.
+#[derive(Debug, Clone, Copy)]
+pub struct Chunk<'a> {
+    /// The positions.
+    pub points: &'a [Point3],
+    /// Parameters `(u, v)` per point (from two attributes), if any.
+    pub uv: Option<&'a [[f64; 2]]>,
+}
+
+/// Points read in passes of chunks, in the same order every pass.
+pub trait PointSource {
+    /// One pass over all points: `f` is called with each chunk in order.
+    fn pass(&mut self, f: &mut dyn FnMut(Chunk<'_>) -> Result<()>) -> Result<()>;
+}
+
+/// Points in memory served in chunks of `chunk` (for tests and for callers
+/// that hold the points but want the streamed arithmetic).
+#[derive(Debug, Clone)]
+pub struct SliceSource<'a> {
+    /// The positions.
+    pub points: &'a [Point3],
+    /// Their parameters, if any.
+    pub uv: Option<&'a [[f64; 2]]>,
+    /// Points per chunk (at least 1).
+    pub chunk: usize,
+}
+
+impl PointSource for SliceSource<'_> {
+    fn pass(&mut self, f: &mut dyn FnMut(Chunk<'_>) -> Result<()>) -> Result<()> {
+        let c = self.chunk.max(1);
+        for s in (0..self.points.len()).step_by(c) {
+            let e = (s + c).min(self.points.len());
+            f(Chunk {
+                points: &self.points[s..e],
+                uv: self.uv.map(|u| &u[s..e]),
+            })?;
+        }
+        Ok(())
+    }
+}
+
+/// What [`mba`] returns.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct StreamedMba {
+    /// The final surface (as the in-memory pipeline's).
+    pub surface: Surface,
+    /// Cells `(m, n)` of the final lattice.
+    pub cells: (usize, usize),
+    /// One row per level: vertical residuals (streamed) and eq. 17 of the
+    /// level's combined lattice.
+    pub levels: Vec<LevelRow>,
+    /// Passes made over the points.
+    pub passes: usize,
+    /// Wall time of the approximation (without the measuring pass), seconds.
+    pub seconds: f64,
+    /// The streamed measures (see the module documentation); its
+    /// `at_parameters` are the vertical residuals.
+    pub quality: SurfaceQuality,
+}
+
+/// Multilevel B-spline approximation of the points of `source` by passes
+/// (see the module documentation); the surface equals
+/// [`crate::pipeline::mba::run`]'s. The projection adjustment needs the
+/// whole cloud and is not offered here.
+///
+/// ```
+/// use scanfit::mba::{mba as mba_in_memory, lattice_surface, MbaConfig};
+/// use scanfit::pipeline::assess::AssessConfig;
+/// use scanfit::pipeline::stream::{mba, SliceSource};
+/// use scanfit::progress::NoProgress;
+/// use scanfit::Point3;
+///
+/// let p: Vec<Point3> = (0..4000)
+///     .map(|k| {
+///         let (x, y) = ((k * 37 % 200) as f64 * 0.5, (k / 40) as f64);
+///         Point3::new(x, y, (x / 10.0).sin() * (y / 7.0).cos())
+///     })
+///     .collect();
+/// let config = MbaConfig { max_levels: 4, ..Default::default() };
+/// let mut source = SliceSource { points: &p, uv: None, chunk: 333 };
+/// let r = mba(&mut source, &config, &AssessConfig::default(), &NoProgress)?;
+/// let once = mba_in_memory(&p, &config)?;
+/// assert_eq!(r.surface, lattice_surface(&once.frame, &once.lattice)?);
+/// assert_eq!(r.passes, 6); // frame, 4 levels, measures
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+pub fn mba(
+    source: &mut dyn PointSource,
+    config: &MbaConfig,
+    assess: &AssessConfig,
+    progress: &dyn Progress,
+) -> Result<StreamedMba> {
+    let t0 = Instant::now();
+    progress.stage("pass 1: the bounding box", None);
+    let mut frame_sums = FrameSums::default();
+    source.pass(&mut |c| frame_sums.add(c.points))?;
+    let frame = frame_sums.finish()?;
+    let mut run = MbaLevels::new(frame, config)?;
+    let mut passes = 1;
+    let mut grid_rmse = Vec::new();
+    // the residual statistics of a level come from the pass after it
+    let mut recorded = true;
+    while !run.done() {
+        progress.stage(
+            &format!(
+                "pass {}: level {} ({} x {} cells)",
+                passes + 1,
+                run.levels().len(),
+                run.next_cells().0,
+                run.next_cells().1
+            ),
+            None,
+        );
+        let mut acc = run.accumulator()?;
+        let mut stats = ResidualSums::default();
+        let mut grid = run
+            .levels()
+            .last()
+            .map(|_| NearestSums::new(level_grid(&run)));
+        source.pass(&mut |c| {
+            stats.merge(&acc.add_residuals(&frame, run.levels(), c.points)?);
+            if let Some(g) = grid.as_mut() {
+                g.add(c.points)?;
+            }
+            Ok(())
+        })?;
+        passes += 1;
+        if let Some(g) = grid {
+            grid_rmse.push(g.rmse());
+            recorded = true;
+            if run.record_residual(stats.stats()) {
+                break;
+            }
+        }
+        run.push(acc)?;
+        recorded = false;
+    }
+    let result = run.finish();
+    let surface = lattice_surface(&result.frame, &result.lattice)?;
+    let seconds = t0.elapsed().as_secs_f64();
+    progress.stage(&format!("pass {}: measuring", passes + 1), None);
+    let mut assessor = StreamAssessor::new(&surface, assess)?;
+    let mut vertical = ResidualSums::default();
+    let mut last = ResidualSums::default();
+    let mut grid = NearestSums::new(crate::mba::adjust::knot_grid(&frame, &result.lattice));
+    source.pass(&mut |c| {
+        let uv: Vec<[f64; 2]> = c.points.iter().map(|p| frame.unit(p)).collect();
+        for (p, t) in c.points.iter().zip(&uv) {
+            vertical.push((p.z - surface.point(t[0], t[1]).z).abs());
+            last.push(residual(&frame, &result.levels, p, *t).abs());
+        }
+        grid.add(c.points)?;
+        assessor.add(c.points, &uv)
+    })?;
+    passes += 1;
+    let mut reports = result.reports;
+    if !recorded {
+        if let Some(r) = reports.last_mut() {
+            r.residual = last.stats();
+        }
+        grid_rmse.push(grid.rmse());
+    }
+    let mut quality = assessor.finish();
+    quality.at_parameters = vertical.stats();
+    quality.grid_rmse = grid.rmse();
+    let levels = reports
+        .iter()
+        .zip(&grid_rmse)
+        .map(|(rep, &g)| LevelRow {
+            level: rep.level,
+            control_points: (rep.cells.0 + 3, rep.cells.1 + 3),
+            vertical: rep.residual,
+            grid_rmse: g,
+            adjusted: None,
+            seconds: rep.seconds,
+        })
+        .collect();
+    Ok(StreamedMba {
+        surface,
+        cells: (result.lattice.m, result.lattice.n),
+        levels,
+        passes,
+        seconds,
+        quality,
+    })
+}
+
+/// The knot grid of the combined lattice of the levels of `run` so far.
+fn level_grid(run: &MbaLevels) -> Vec<Point3> {
+    let mut total: Option<Lattice> = None;
+    for l in run.levels() {
+        total = Some(match total {
+            None => l.clone(),
+            Some(t) => {
+                let mut t = t.refine().unwrap_or_else(|_| l.clone());
+                if t.add(l).is_err() {
+                    t = l.clone();
+                }
+                t
+            }
+        });
+    }
+    total.map_or_else(Vec::new, |t| {
+        crate::mba::adjust::knot_grid(&run.frame(), &t)
+    })
+}
+
+/// What [`fit`] returns.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct StreamedFit {
+    /// The fitted surface (as the in-memory pipeline's).
+    pub surface: Surface,
+    /// Passes made over the points.
+    pub passes: usize,
+    /// The streamed measures (see the module documentation).
+    pub quality: SurfaceQuality,
+    /// The thin-plate weight used (scaled to the point count unless
+    /// [`FitConfig::relative_smoothing`] is `None`).
+    pub smoothing: f64,
+}
+
+/// The least-squares surface of the points of `source` (parameters from
+/// attributes, uniform knots; see the module documentation for what is
+/// refused); the surface equals [`crate::pipeline::surface_fit::run`]'s.
+///
+/// ```
+/// use scanfit::fit::surface::KnotPlacement;
+/// use scanfit::pipeline::stream::{fit, SliceSource};
+/// use scanfit::pipeline::surface_fit::{FitConfig, ParameterSource};
+/// use scanfit::progress::NoProgress;
+/// use scanfit::Point3;
+///
+/// let (mut p, mut uv) = (Vec::new(), Vec::new());
+/// for k in 0..3000 {
+///     let (u, v) = ((k % 60) as f64 / 59.0, (k / 60) as f64 / 49.0);
+///     p.push(Point3::new(u, v, (2.0 * u).sin() * v));
+///     uv.push([u, v]);
+/// }
+/// let mut cfg = FitConfig::default();
+/// cfg.params = ParameterSource::uv_attributes();
+/// cfg.fit.knots = KnotPlacement::Uniform;
+/// cfg.fit.ctrl = (8, 8);
+/// cfg.ctrl_from_density = false;
+/// cfg.relative_smoothing = None;
+/// let mut source = SliceSource { points: &p, uv: Some(&uv), chunk: 1000 };
+/// let r = fit(&mut source, &cfg, &NoProgress)?;
+/// let once = scanfit::fit::surface::fit_surface(&p, &uv, &cfg.fit)?;
+/// assert_eq!(r.surface, once);
+/// assert!(r.quality.at_parameters.max < 1e-3);
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+pub fn fit(
+    source: &mut dyn PointSource,
+    config: &FitConfig,
+    progress: &dyn Progress,
+) -> Result<StreamedFit> {
+    let refuse = |setting: &'static str, value: String, why: &str| Error::InvalidSetting {
+        setting,
+        value,
+        hint: format!("{why}; points read in chunks need settings computable per point"),
+    };
+    if config.params == ParameterSource::Plane {
+        return Err(refuse(
+            "params",
+            "plane".into(),
+            "parameters from the best-fit plane need the whole cloud (its minimum-area rectangle); give the parameters as u and v columns",
+        ));
+    }
+    if config.correction_rounds > 0 {
+        return Err(refuse(
+            "correction_rounds",
+            config.correction_rounds.to_string(),
+            "parameter correction re-projects every point in each round and keeps their parameters; leave it out",
+        ));
+    }
+    // the net from the point density needs the count first: one more pass
+    let mut passes = 2;
+    let fit = if config.ctrl_from_density {
+        progress.stage("pass 0: counting the points", None);
+        let mut n = 0usize;
+        source.pass(&mut |c| {
+            n += c.points.len();
+            Ok(())
+        })?;
+        passes += 1;
+        config.resolved_fit(n)
+    } else {
+        config.fit.clone()
+    };
+    let mut eq = fit.uniform_equations()?;
+    let (cu, cv) = fit.ctrl;
+    progress.stage(
+        &format!("pass 1: normal equations of {cu} x {cv} control points"),
+        None,
+    );
+    let mut n = 0usize;
+    source.pass(&mut |c| {
+        let uv = chunk_uv(&c)?;
+        n += c.points.len();
+        eq.add(c.points, uv, None)
+    })?;
+    // the thin-plate weight scaled to the count, as the in-memory pipeline
+    let smoothing = config.resolved_fit(n).smoothing;
+    let surface = eq.finish(smoothing)?;
+    progress.stage("pass 2: measuring", None);
+    let mut assessor = StreamAssessor::new(&surface, &config.assess)?;
+    source.pass(&mut |c| assessor.add(c.points, chunk_uv(&c)?))?;
+    Ok(StreamedFit {
+        quality: assessor.finish(),
+        surface,
+        passes,
+        smoothing,
+    })
+}
+
+/// The parameters of a chunk, an error when the source gave none.
+fn chunk_uv<'a>(c: &Chunk<'a>) -> Result<&'a [[f64; 2]]> {
+    c.uv.ok_or_else(|| {
+        Error::InvalidInput("the point source gives no parameters (u, v) for the chunks".into())
+    })
+}
+
+/// The smallest distance from each of a fixed set of query points to the
+/// points of all chunks seen (exact: the minimum over chunks).
+#[derive(Debug, Clone)]
+pub struct NearestSums {
+    queries: Vec<Point3>,
+    best: Vec<f64>,
+}
+
+impl NearestSums {
+    /// No chunk seen yet: every distance infinite.
+    pub fn new(queries: Vec<Point3>) -> Self {
+        let best = vec![f64::INFINITY; queries.len()];
+        Self { queries, best }
+    }
+
+    /// Takes the chunk's points into account.
+    pub fn add(&mut self, points: &[Point3]) -> Result<()> {
+        if points.is_empty() || self.queries.is_empty() {
+            return Ok(());
+        }
+        let tree = KdTree::new(points, "the chunk's points")?;
+        for (b, q) in self.best.iter_mut().zip(&self.queries) {
+            *b = b.min(tree.nearest(q).distance);
+        }
+        Ok(())
+    }
+
+    /// The query points.
+    pub fn queries(&self) -> &[Point3] {
+        &self.queries
+    }
+
+    /// The distances so far.
+    pub fn distances(&self) -> &[f64] {
+        &self.best
+    }
+
+    /// Their root mean square (0 without queries).
+    pub fn rmse(&self) -> f64 {
+        let n = self.best.len().max(1) as f64;
+        (self.best.iter().map(|d| d * d).sum::<f64>() / n).sqrt()
+    }
+}
+
+/// The assessment of a surface against points that arrive in chunks (see
+/// the module documentation for what is exact and what is sampled).
+pub struct StreamAssessor<'s> {
+    surface: &'s Surface,
+    inverter: SurfaceInverter<'s>,
+    at_parameters: ResidualSums,
+    orthogonal: ResidualSums,
+    unconverged: usize,
+    knots: NearestSums,
+    samples: NearestSums,
+    grid: (usize, usize),
+    far_spacings: f64,
+    spacing: Option<f64>,
+    config: AssessConfig,
+    bounds: Option<(Point3, Point3)>,
+}
+
+impl<'s> StreamAssessor<'s> {
+    /// An assessor of `surface` with the settings of `config`.
+    pub fn new(surface: &'s Surface, config: &AssessConfig) -> Result<Self> {
+        let (grid, samples) = crate::pipeline::assess::sample_grid(surface, config)?;
+        Ok(Self {
+            surface,
+            inverter: SurfaceInverter::new(surface, config.inversion)?,
+            at_parameters: ResidualSums::default(),
+            orthogonal: ResidualSums::default(),
+            unconverged: 0,
+            knots: NearestSums::new(crate::pipeline::assess::knot_line_points(surface)),
+            samples: NearestSums::new(samples),
+            grid,
+            far_spacings: config.far_spacings,
+            spacing: None,
+            config: *config,
+            bounds: None,
+        })
+    }
+
+    /// Adds a chunk of points with their parameters.
+    pub fn add(&mut self, points: &[Point3], uv: &[[f64; 2]]) -> Result<()> {
+        if points.len() != uv.len() {
+            return Err(Error::LengthMismatch {
+                what: "parameter pairs",
+                expected: points.len(),
+                got: uv.len(),
+            });
+        }
+        for (p, t) in points.iter().zip(uv) {
+            self.at_parameters
+                .push((p - self.surface.point(t[0], t[1])).norm());
+        }
+        for r in self.inverter.invert_all(points) {
+            self.orthogonal.push(r.distance);
+            self.unconverged += usize::from(!r.converged);
+        }
+        self.knots.add(points)?;
+        self.samples.add(points)?;
+        for p in points {
+            let (lo, hi) = self.bounds.get_or_insert((*p, *p));
+            *lo = lo.inf(p);
+            *hi = hi.sup(p);
+        }
+        if self.spacing.is_none() && points.len() >= 2 {
+            self.spacing = Some(PointCloud::new(points.to_vec())?.spacing()?.median);
+        }
+        Ok(())
+    }
+
+    /// The measures.
+    pub fn finish(self) -> SurfaceQuality {
+        let spacing = self.spacing.unwrap_or(0.0);
+        let d = self.samples.distances();
+        let limit = self.far_spacings * spacing;
+        let far = d.iter().filter(|&&x| x > limit).count();
+        let extent = match self.bounds {
+            Some(b) => crate::pipeline::assess::extent_in_box(
+                self.surface,
+                b,
+                self.samples.queries(),
+                spacing,
+                &self.config,
+            ),
+            None => Extent::default(),
+        };
+        SurfaceQuality {
+            points: usize::try_from(self.at_parameters.count).unwrap_or(usize::MAX),
+            at_parameters: self.at_parameters.stats(),
+            orthogonal: self.orthogonal.stats(),
+            unconverged: self.unconverged,
+            grid_rmse: self.knots.rmse(),
+            samples_to_points: SampleDistances {
+                grid: self.grid,
+                stats: crate::metrics::ErrorStats::of(d),
+                spacing,
+                far_spacings: self.far_spacings,
+                far_share: far as f64 / d.len().max(1) as f64,
+            },
+            parameterization: ParamQuality::default(),
+            extent,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::surface::KnotPlacement;
+    use crate::pipeline::{mba as mba_pipeline, surface_fit};
+    use crate::progress::NoProgress;
+
+    fn terrain(n: usize) -> Vec<Point3> {
+        let mut rng = crate::testdata::Lcg::new(11);
+        (0..n)
+            .map(|_| {
+                let (x, y) = (rng.next_f64() * 80.0, rng.next_f64() * 50.0);
+                Point3::new(
+                    x + 6.0e5,
+                    y + 5.2e6,
+                    3.0 * (x / 9.0).sin() + (y / 6.0).cos(),
+                )
+            })
+            .collect()
+    }
+
+    #[test]
+    fn streamed_mba_equals_the_in_memory_pipeline_and_its_report() {
+        let p = terrain(20_000);
+        let cloud = PointCloud::new(p.clone()).unwrap();
+        let mut cfg = mba_pipeline::MbaRunConfig::default();
+        cfg.mba.max_levels = 5;
+        let once = mba_pipeline::run(&cloud, &cfg, &NoProgress).unwrap();
+        for chunk in [1000, 7777, 20_000] {
+            let mut s = SliceSource {
+                points: &p,
+                uv: None,
+                chunk,
+            };
+            let r = mba(&mut s, &cfg.mba, &cfg.assess, &NoProgress).unwrap();
+            assert_eq!(r.surface, once.surface, "chunk {chunk}");
+            assert_eq!(r.passes, 7);
+            let (a, b) = (r.quality, once.assessment.quality);
+            let close = |x: f64, y: f64| (x - y).abs() <= 1e-12 * y.abs().max(1e-300);
+            assert!(
+                close(a.at_parameters.rmse, b.at_parameters.rmse),
+                "{a:?} {b:?}"
+            );
+            assert_eq!(a.at_parameters.max, b.at_parameters.max);
+            assert!(close(a.orthogonal.rmse, b.orthogonal.rmse));
+            assert_eq!(a.grid_rmse, b.grid_rmse);
+            assert_eq!(a.samples_to_points.stats.max, b.samples_to_points.stats.max);
+            for (x, y) in r.levels.iter().zip(&once.levels) {
+                assert_eq!((x.level, x.control_points), (y.level, y.control_points));
+                assert!(close(x.vertical.rmse, y.vertical.rmse), "{x:?} {y:?}");
+                assert_eq!(x.grid_rmse, y.grid_rmse);
+            }
+        }
+    }
+
+    #[test]
+    fn streamed_fit_equals_the_in_memory_pipeline_and_refuses_what_needs_all_points() {
+        let p = terrain(12_000);
+        let uv: Vec<[f64; 2]> = p
+            .iter()
+            .map(|q| [(q.x - 6.0e5) / 80.0, (q.y - 5.2e6) / 50.0])
+            .map(|t| [t[0].clamp(0.0, 1.0), t[1].clamp(0.0, 1.0)])
+            .collect();
+        let cloud = PointCloud::new(p.clone())
+            .unwrap()
+            .with_attribute("u", uv.iter().map(|t| t[0]).collect())
+            .unwrap()
+            .with_attribute("v", uv.iter().map(|t| t[1]).collect())
+            .unwrap();
+        let mut cfg = FitConfig::default();
+        cfg.params = ParameterSource::uv_attributes();
+        cfg.fit.knots = KnotPlacement::Uniform;
+        cfg.fit.ctrl = (20, 14);
+        cfg.ctrl_from_density = false;
+        cfg.relative_smoothing = None;
+        cfg.fit.smoothing = 1e-9;
+        let once = surface_fit::run(&cloud, &cfg, &NoProgress).unwrap();
+        let mut s = SliceSource {
+            points: &p,
+            uv: Some(&uv),
+            chunk: 5000,
+        };
+        let r = fit(&mut s, &cfg, &NoProgress).unwrap();
+        assert_eq!(r.surface, once.surface);
+        // the safe defaults (net from the density, weight scaled to the
+        // count) give the in-memory surface too, after a counting pass
+        let mut dflt = FitConfig::default();
+        dflt.params = ParameterSource::uv_attributes();
+        dflt.fit.knots = KnotPlacement::Uniform;
+        let once_default = surface_fit::run(&cloud, &dflt, &NoProgress).unwrap();
+        let streamed_default = fit(&mut s, &dflt, &NoProgress).unwrap();
+        assert_eq!(streamed_default.passes, 3);
+        assert_eq!(streamed_default.surface, once_default.surface);
+        assert!(streamed_default.smoothing > 0.0);
+        let (a, b) = (r.quality, once.assessment.quality);
+        assert!(
+            (a.at_parameters.rmse - b.at_parameters.rmse).abs() <= 1e-12 * b.at_parameters.rmse
+        );
+        assert_eq!(a.at_parameters.max, b.at_parameters.max);
+        assert_eq!(a.grid_rmse, b.grid_rmse);
+        // refused, with the setting named
+        for bad in [
+            FitConfig {
+                params: ParameterSource::Plane,
+                ..cfg.clone()
+            },
+            FitConfig {
+                correction_rounds: 2,
+                ..cfg.clone()
+            },
+        ] {
+            assert!(matches!(
+                fit(&mut s, &bad, &NoProgress).unwrap_err(),
+                Error::InvalidSetting { .. }
+            ));
+        }
+        let mut bad = cfg.clone();
+        bad.fit.knots = KnotPlacement::Distribution;
+        let e = fit(&mut s, &bad, &NoProgress).unwrap_err().to_string();
+        assert!(e.contains("9.69"), "{e}");
+    }
+}
