@@ -91,8 +91,16 @@ impl TrimArgs {
         let t = match boundary {
             Some(b) => trim_surface(surface, uv, b, &cfg),
             None => trim_to_points(surface, points, uv, &cfg),
-        }
-        .map_err(|e| anyhow::anyhow!("trimming the surface: {e} (or give --no-trim)"))?;
+        };
+        let t = match t {
+            Ok(t) => t,
+            Err(e) if !self.trim => {
+                // the default: say why and keep the rectangle
+                eprintln!("note: the surface is not trimmed: {e}");
+                return Ok(None);
+            }
+            Err(e) => anyhow::bail!("trimming the surface: {e} (or give --no-trim)"),
+        };
         // a boundary that is the rectangle's own, without holes, trims nothing
         Ok((t.outer.is_some() || !t.holes.is_empty()).then_some(t))
     }

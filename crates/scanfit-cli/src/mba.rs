@@ -212,6 +212,9 @@ pub fn run(a: MbaArgs) -> Result<()> {
         anyhow::bail!("--levels must be at least 1");
     }
     if let Some(n) = a.chunk_points {
+        if a.trim.trim {
+            anyhow::bail!("--trim finds the outline from all points at once; leave it out with --chunk-points (the surface is then the untrimmed rectangle)");
+        }
         return crate::stream::mba(&a, n);
     }
     let progress = Progress::spinner(a.quiet || a.json);

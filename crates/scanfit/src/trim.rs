@@ -37,6 +37,10 @@ use crate::fit::{lsq_values, LeastSquaresOptions};
 use crate::param::knots::periodic_least_squares;
 use crate::{Error, Point3, Result, Vector3};
 
+/// Smallest share of the points' parameter rectangle the outer loop must
+/// enclose (a disc encloses 79%, most outlines more than half).
+pub const MIN_OUTER_SHARE: f64 = 0.25;
+
 /// Parameters of [`trim_surface`].
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
@@ -173,6 +177,23 @@ pub fn trim_surface(
     let diag = net_diagonal(&surface);
     let tol = cfg.space_tolerance * diag;
     let outer_uv = loop_uv(boundary.outer_loop())?;
+    // an alpha shape that breaks the cloud into pieces (too few points,
+    // points on separate lines) has an outer loop round one piece only
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in uv {
+        for k in 0..2 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let covered = signed_area(&outer_uv).abs() / ((hi[0] - lo[0]) * (hi[1] - lo[1]));
+    if !(covered >= MIN_OUTER_SHARE) {
+        return Err(Error::InvalidInput(format!(
+            "the outer boundary loop encloses only {:.1}% of the points' parameter rectangle ({} loops): the alpha shape does not hold the cloud together",
+            100.0 * covered,
+            boundary.loops.len()
+        )));
+    }
     let outer = if on_domain_edges(&outer_uv, domain, cfg) {
         None
     } else {
