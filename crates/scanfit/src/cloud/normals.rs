@@ -162,7 +162,7 @@ pub fn estimate_normals_on(
     let mut normals: Vec<Vector3> = per_point.iter().map(|t| t.0).collect();
     let variation = per_point.iter().map(|t| t.1).collect();
     let degenerate = (0..points.len()).filter(|&i| per_point[i].2).collect();
-    let adj = Adjacency::of(&graph);
+    let adj = Adjacency::of(graph);
     let mut components = 0;
     match config.orientation {
         Orientation::None => {}
@@ -187,7 +187,7 @@ pub fn estimate_normals_on(
     }
     let disagreement = match config.orientation {
         Orientation::None => None,
-        _ => disagreement(points, &graph, &normals),
+        _ => disagreement(points, graph, &normals),
     };
     Ok(Normals {
         normals,
