@@ -187,7 +187,7 @@ pub fn estimate_normals_on(
     }
     let disagreement = match config.orientation {
         Orientation::None => None,
-        _ => disagreement(points, &graph, &normals),
+        _ => disagreement(points, graph, &normals),
     };
     Ok(Normals {
         normals,
