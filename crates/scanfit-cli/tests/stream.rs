@@ -1,6 +1,8 @@
 //! `--chunk-points`: the streamed `fit` and `mba` write the in-memory
 //! command's surface (the same JSON control points and knots).
 
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
