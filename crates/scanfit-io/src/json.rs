@@ -48,6 +48,17 @@ use crate::{Error, Result};
 /// assert!(bad.to_string().contains("the value at [1] is not a finite number"), "{bad}");
 /// ```
 pub fn finite_json<T: Serialize + ?Sized>(value: &T, what: &str) -> Result<String> {
+    finite_json_except(value, what, |_| false)
+}
+
+/// [`finite_json`] for a document whose format has `null`s of its own at
+/// the paths `allowed` accepts (the model document's degenerate side of a
+/// three-sided patch, `.patches[i].sides[k]`).
+pub fn finite_json_except<T: Serialize + ?Sized>(
+    value: &T,
+    what: &str,
+    allowed: fn(&str) -> bool,
+) -> Result<String> {
     let invalid = |message: String| Error::Invalid {
         path: what.into(),
         message,
@@ -55,7 +66,7 @@ pub fn finite_json<T: Serialize + ?Sized>(value: &T, what: &str) -> Result<Strin
     let text = serde_json::to_string_pretty(value).map_err(|e| invalid(e.to_string()))?;
     // read back (the text keeps the writer's key order; the value is only searched)
     let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| invalid(e.to_string()))?;
-    if let Some(at) = first_null(&v) {
+    if let Some(at) = first_null(&v, allowed) {
         return Err(Error::NonFinite {
             what: what.into(),
             at: if at.is_empty() {
@@ -69,17 +80,43 @@ pub fn finite_json<T: Serialize + ?Sized>(value: &T, what: &str) -> Result<Strin
 }
 
 /// The path (`.a.b[3]`) of the first `null` in `v`, depth first.
-fn first_null(v: &serde_json::Value) -> Option<String> {
+fn first_null(v: &serde_json::Value, allowed: fn(&str) -> bool) -> Option<String> {
+    use serde_json::Value;
+    let found = first_null_in(v)?;
+    if !allowed(&found) {
+        return Some(found);
+    }
+    // an allowed null: look for another one elsewhere
+    fn all_nulls(v: &Value, at: String, out: &mut Vec<String>) {
+        match v {
+            Value::Null => out.push(at),
+            Value::Array(a) => a
+                .iter()
+                .enumerate()
+                .for_each(|(k, x)| all_nulls(x, format!("{at}[{k}]"), out)),
+            Value::Object(m) => m
+                .iter()
+                .for_each(|(k, x)| all_nulls(x, format!("{at}.{k}"), out)),
+            _ => {}
+        }
+    }
+    let mut out = Vec::new();
+    all_nulls(v, String::new(), &mut out);
+    out.into_iter().find(|p| !allowed(p))
+}
+
+/// The path of the first `null` in `v`, depth first.
+fn first_null_in(v: &serde_json::Value) -> Option<String> {
     use serde_json::Value;
     match v {
         Value::Null => Some(String::new()),
         Value::Array(items) => items
             .iter()
             .enumerate()
-            .find_map(|(k, x)| first_null(x).map(|rest| format!("[{k}]{rest}"))),
+            .find_map(|(k, x)| first_null_in(x).map(|rest| format!("[{k}]{rest}"))),
         Value::Object(map) => map
             .iter()
-            .find_map(|(key, x)| first_null(x).map(|rest| format!(".{key}{rest}"))),
+            .find_map(|(key, x)| first_null_in(x).map(|rest| format!(".{key}{rest}"))),
         _ => None,
     }
 }
