@@ -187,7 +187,7 @@ pub fn trim_surface(
         }
     }
     let covered = signed_area(&outer_uv).abs() / ((hi[0] - lo[0]) * (hi[1] - lo[1]));
-    if !(covered >= MIN_OUTER_SHARE) {
+    if covered.is_nan() || covered < MIN_OUTER_SHARE {
         return Err(Error::InvalidInput(format!(
             "the outer boundary loop encloses only {:.1}% of the points' parameter rectangle ({} loops): the alpha shape does not hold the cloud together",
             100.0 * covered,
