@@ -252,12 +252,11 @@ pub fn parameterization_quality(
                 let (aa, bb, cc) = (ss.dot(&ss), ss.dot(&st), st.dot(&st));
                 let root = ((aa - cc) * (aa - cc) + 4.0 * bb * bb).sqrt();
                 let smax = (0.5 * (aa + cc + root)).sqrt();
-                let smin = (0.5 * (aa + cc - root)).max(0.0).sqrt();
-                let aniso = if smin > 0.0 {
-                    smax / smin
-                } else {
-                    f64::INFINITY
-                };
+                // smax * smin is the area ratio area3 / area_uv (both > 0
+                // here), which gives smin without the cancellation of
+                // (aa + cc - root): a sliver is a large but finite ratio
+                let smin = area3 / area_uv / smax;
+                let aniso = (smax / smin).max(1.0);
                 (folded, area3, area_uv, 0.5 * (aa + cc), aniso)
             },
         )
