@@ -128,16 +128,24 @@ pub fn trim_line(t: &TrimmedSurface) -> String {
     )
 }
 
-/// The trimmed face for `--json` reports (`null` when not trimmed).
+/// The trimmed face for `--json` reports (`{"trimmed": false}` when not
+/// trimmed).
 pub fn trim_json(t: Option<&TrimmedSurface>) -> serde_json::Value {
-    t.map_or(serde_json::Value::Null, |t| {
-        serde_json::json!({
-            "outer": t.outer.as_ref().map(|o| o.points),
-            "holes": t.holes.iter().map(|h| h.points).collect::<Vec<_>>(),
-            "skipped_holes": t.skipped_holes,
-            "max_curve_deviation": t.curves().map(|c| c.deviation).fold(0.0, f64::max),
-        })
-    })
+    // JSON output holds no null: an untrimmed face says so, and a face that
+    // keeps its rectangle has no "outer"
+    let Some(t) = t else {
+        return serde_json::json!({ "trimmed": false });
+    };
+    let mut v = serde_json::json!({
+        "trimmed": true,
+        "holes": t.holes.iter().map(|h| h.points).collect::<Vec<_>>(),
+        "skipped_holes": t.skipped_holes,
+        "max_curve_deviation": t.curves().map(|c| c.deviation).fold(0.0, f64::max),
+    });
+    if let Some(o) = &t.outer {
+        v["outer"] = o.points.into();
+    }
+    v
 }
 
 /// Prints [`trim_line`] for a trimmed face.

@@ -419,6 +419,8 @@ fn surface_fit_from_uv_columns_is_exact_for_representable_data() {
         "uv-columns",
         "--ctrl",
         "6",
+        "--smooth",
+        "0",
         "--json",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
@@ -517,6 +519,8 @@ fn surface_fit_bad_input() {
             "uv-columns",
             "--ctrl",
             "4",
+            "--smooth",
+            "0",
         ],
         "only 1 distinct u parameters",
     );
