@@ -466,7 +466,7 @@ fn json_report(
             "bspline_deviation": p.conversion_deviation, "fold_overs": p.fold_overs,
         })).collect::<Vec<_>>(),
         "edges": r.edges.iter().map(|e| serde_json::json!({
-            "vertices": e.vertices, "patches": e.patches, "max_gap": e.max_gap,
+            "vertices": e.vertices, "patches": e.patches.iter().flatten().collect::<Vec<_>>(), "max_gap": e.max_gap,
             "max_normal_angle_deg": e.max_angle.to_degrees(), "curve_error": e.curve_error,
         })).collect::<Vec<_>>(),
         "corners": r.network.vertices.iter().map(|v| [v.x, v.y, v.z]).collect::<Vec<_>>(),

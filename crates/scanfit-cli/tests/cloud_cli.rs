@@ -295,7 +295,7 @@ fn cloud_commands_reject_bad_input_without_writing() {
             "unknown --criterion",
         ),
         (
-            vec!["info", blob.to_str().unwrap(), "--format", "stl"],
+            vec!["info", blob.to_str().unwrap(), "--format", "e57"],
             "unknown --format",
         ),
     ];

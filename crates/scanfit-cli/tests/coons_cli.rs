@@ -168,7 +168,7 @@ fn clear_errors_and_no_output() {
     assert!(!o.status.success());
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(
-        e.contains("corner(s) sharper than") && e.contains("4 were asked"),
+        e.contains("not clearly corners") && e.contains("--force-corners"),
         "{e}"
     );
     assert!(!json.exists());

@@ -181,10 +181,11 @@ fn fit_takes_the_shared_input_group() {
         "{err}"
     );
     assert!(out.contains("899 points"), "{out}");
-    let o = run(&["fit", n, "--format", "stl"]);
+    let o = run(&["fit", n, "--format", "e57"]);
     assert_eq!(o.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&o.stderr)
-        .contains("unknown --format 'stl'; use ply, pcd, las or text"));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("unknown --format 'e57'; use ply, pcd, las")
+    );
 }
 
 #[test]
