@@ -237,7 +237,8 @@ by its normal: wrongly oriented normals show as dark speckles.";
 pub struct NormalsArgs {
     #[command(flatten)]
     pub input: InputArgs,
-    /// Neighbours per point.
+    /// Neighbours per point, the point itself not counted (Open3D's knn and
+    /// PCL's k count it: --k 16 here is their 17).
     #[arg(long, default_value_t = 16)]
     pub k: usize,
     /// Orientation: `mst`, `view:X,Y,Z` or `none`.

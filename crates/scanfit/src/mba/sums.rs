@@ -29,10 +29,10 @@ use super::lattice::{locate, uniform_cubic_basis, ControlFormula, Lattice};
 use super::Frame;
 
 /// Fewest points per block of the BA sums.
-const BA_BLOCK: usize = 16_384;
+pub(super) const BA_BLOCK: usize = 16_384;
 
 /// Bytes of partial sums that may exist at a time while a chunk is summed.
-const PARTIAL_BUDGET: usize = 256 << 20;
+pub(super) const PARTIAL_BUDGET: usize = 256 << 20;
 
 /// The BA sums of one lattice ([LWS97] eq. 4, [MBA18] eqs. 3-4): for every
 /// control value the numerator `sum_c w_c^2 phi_c` and the denominator
@@ -115,7 +115,7 @@ impl BaAccumulator {
         }
         let (m, n, formula) = (self.m, self.n, self.formula);
         let len = (m + 3) * (n + 3);
-        let partials = (PARTIAL_BUDGET / self.bytes()).clamp(1, 16);
+        let partials = self.partials();
         self.sums.add(
             xy.len(),
             partials,
@@ -174,17 +174,35 @@ impl BaAccumulator {
     /// where no point reached it.
     pub fn finish(self) -> Lattice {
         let (num, den) = self.sums.finish(merge_sums);
-        let phi = num
-            .iter()
-            .zip(&den)
-            .map(|(nu, de)| if *de > 0.0 { nu / de } else { 0.0 })
-            .collect();
-        Lattice {
-            m: self.m,
-            n: self.n,
-            phi,
-        }
+        ratio_lattice(self.m, self.n, &num, &den)
     }
+
+    /// The number of partial sums alive at a time while a chunk is summed
+    /// (bounded by memory, never by the thread count).
+    pub(super) fn partials(&self) -> usize {
+        (PARTIAL_BUDGET / self.bytes()).clamp(1, 16)
+    }
+
+    /// Points per block of the sums.
+    pub(super) fn block(&self) -> usize {
+        BA_BLOCK.max((self.m + 3) * (self.n + 3))
+    }
+
+    /// The control formula.
+    pub(super) fn formula(&self) -> ControlFormula {
+        self.formula
+    }
+}
+
+/// The lattice of `m x n` cells from BA sums: each control value the ratio
+/// of its sums (eq. 4), 0 where no point reached it.
+pub(super) fn ratio_lattice(m: usize, n: usize, num: &[f64], den: &[f64]) -> Lattice {
+    let phi = num
+        .iter()
+        .zip(den)
+        .map(|(nu, de)| if *de > 0.0 { nu / de } else { 0.0 })
+        .collect();
+    Lattice { m, n, phi }
 }
 
 /// The residual `z - z0 - sum_k f_k` of `p` (unit coordinates `u`) after
@@ -199,7 +217,7 @@ pub(crate) fn residual(frame: &Frame, levels: &[Lattice], p: &Point3, u: [f64; 2
 
 /// Eqs. 3-4 for one point: its candidates and weights added to the sums.
 #[inline]
-fn add_point(
+pub(super) fn add_point(
     num: &mut [f64],
     den: &mut [f64],
     m: usize,
@@ -208,27 +226,84 @@ fn add_point(
     p: [f64; 2],
     zc: f64,
 ) {
+    add_point_values(&mut [num], den, m, n, formula, p, [zc]);
+}
+
+/// Eqs. 3-4 of one point in factored form. With `w_kl = B_k(s) B_l(t)`,
+/// `sum_kl w_kl^2 = (sum_k B_k(s)^2)(sum_l B_l(t)^2)`, and eq. 3's candidate
+/// `phi_c = w z / sum w^2` times eq. 4's weight `w^2` is
+/// `(z / sum w^2) fs_k ft_l` with `fs_k = B_k(s)^3`, `ft_l = B_l(t)^3`,
+/// the weight itself `ds_k dt_l` with `ds_k = B_k(s)^2` (Hjelle's weight
+/// `w`: `fs = B^2`, `ds = B`): one division per value instead of 16.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct BaFactors {
+    /// Factors along x of the numerator terms.
+    pub(super) fs: [f64; 4],
+    /// Factors along y of the numerator terms.
+    pub(super) ft: [f64; 4],
+    /// Factors along x of the weights.
+    pub(super) ds: [f64; 4],
+    /// Factors along y of the weights.
+    pub(super) dt: [f64; 4],
+    /// `sum_kl w_kl^2`.
+    pub(super) sum2: f64,
+}
+
+impl BaFactors {
+    /// The factors at local coordinates `(s, t)` of a cell.
+    #[inline]
+    pub(super) fn new(s: f64, t: f64, formula: ControlFormula) -> Self {
+        let (bs, bt) = (uniform_cubic_basis(s), uniform_cubic_basis(t));
+        let (s2, t2) = (bs.map(|b| b * b), bt.map(|b| b * b));
+        let sum2 = s2.iter().sum::<f64>() * t2.iter().sum::<f64>();
+        match formula {
+            ControlFormula::LeeWolbergShin => Self {
+                fs: std::array::from_fn(|k| s2[k] * bs[k]),
+                ft: std::array::from_fn(|l| t2[l] * bt[l]),
+                ds: s2,
+                dt: t2,
+                sum2,
+            },
+            ControlFormula::Hjelle => Self {
+                fs: s2,
+                ft: t2,
+                ds: bs,
+                dt: bt,
+                sum2,
+            },
+        }
+    }
+}
+
+/// [`add_point`] for `K` value sets at once (one numerator each, the
+/// denominator shared: it depends on the point's position only).
+#[inline]
+pub(super) fn add_point_values<const K: usize>(
+    num: &mut [&mut [f64]; K],
+    den: &mut [f64],
+    m: usize,
+    n: usize,
+    formula: ControlFormula,
+    p: [f64; 2],
+    zc: [f64; K],
+) {
     let st = n + 3;
     let (i, s) = locate(p[0].clamp(0.0, m as f64), m);
     let (j, t) = locate(p[1].clamp(0.0, n as f64), n);
-    let (bs, bt) = (uniform_cubic_basis(s), uniform_cubic_basis(t));
-    let mut sum2 = 0.0;
-    for bk in bs {
-        for bl in bt {
-            sum2 += (bk * bl) * (bk * bl);
-        }
-    }
+    let f = BaFactors::new(s, t, formula);
+    let q = zc.map(|z| z / f.sum2);
     for k in 0..4 {
-        for l in 0..4 {
-            let w = bs[k] * bt[l];
-            let phi_c = w * zc / sum2; // eq. 3
-            let at = (i + k) * st + j + l;
-            let weight = match formula {
-                ControlFormula::LeeWolbergShin => w * w,
-                ControlFormula::Hjelle => w,
-            };
-            num[at] += weight * phi_c; // eq. 4 numerator
-            den[at] += weight;
+        // the 4 values of row i + k (one bounds check per row)
+        let row = (i + k) * st + j..(i + k) * st + j + 4;
+        for (nu, q) in num.iter_mut().zip(q) {
+            let a = q * f.fs[k];
+            for (nu, ft) in nu[row.clone()].iter_mut().zip(f.ft) {
+                *nu += a * ft; // eqs. 3-4 numerator
+            }
+        }
+        let d = f.ds[k];
+        for (de, dt) in den[row].iter_mut().zip(f.dt) {
+            *de += d * dt;
         }
     }
 }
