@@ -318,7 +318,11 @@ mod tests {
         let row = 3 * 4 + 4 + 8 + 4 + 4;
         for (i, p) in pts.iter().enumerate() {
             let at = end + i * row;
-            let f = |o: usize| f64::from(f32::from_le_bytes(bytes[at + o..at + o + 4].try_into().unwrap()));
+            let f = |o: usize| {
+                f64::from(f32::from_le_bytes(
+                    bytes[at + o..at + o + 4].try_into().unwrap(),
+                ))
+            };
             assert_eq!([f(0), f(4), f(8)], [p.x, p.y, p.z]);
             let k = i32::from_le_bytes(bytes[at + 12..at + 16].try_into().unwrap());
             assert_eq!(f64::from(k), index[i]);
@@ -329,6 +333,10 @@ mod tests {
         }
         let ascii = String::from_utf8(points_ply(&pts, &attrs, PlyFormat::Ascii)).unwrap();
         let data = &ascii[ascii.find("end_header\n").unwrap() + 11..];
-        assert_eq!(data.lines().nth(1), Some("0.1 1.3 -0.0027 998 0.2 0.0 1.0"), "{ascii}");
+        assert_eq!(
+            data.lines().nth(1),
+            Some("0.1 1.3 -0.0027 998 0.2 0.0 1.0"),
+            "{ascii}"
+        );
     }
 }

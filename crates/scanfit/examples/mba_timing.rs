@@ -78,7 +78,11 @@ fn main() {
         })
         .sum();
     let last = r.reports.last().expect("a level");
-    let per_level: Vec<String> = r.reports.iter().map(|l| format!("{:.4}", l.seconds)).collect();
+    let per_level: Vec<String> = r
+        .reports
+        .iter()
+        .map(|l| format!("{:.4}", l.seconds))
+        .collect();
     println!(
         "{{\"points\": {}, \"read_s\": {read:.4}, \"fit_s\": {fit:.4}, \"level_s\": [{}], \"control_points\": [{}, {}], \"rmse\": {:.6e}, \"heldout_rmse\": {:.6e}}}",
         points.len(),

@@ -136,9 +136,12 @@ impl Measured {
         if self.bad.is_none() {
             self.bad = part.bad.map(|i| i + offset);
         }
-        for (t, p) in self.num.iter_mut().chain([&mut self.den]).zip(
-            part.num.iter().chain([&part.den]),
-        ) {
+        for (t, p) in self
+            .num
+            .iter_mut()
+            .chain([&mut self.den])
+            .zip(part.num.iter().chain([&part.den]))
+        {
             t.iter_mut().zip(p).for_each(|(x, y)| *x += y);
         }
         for (a, b) in self.quad.iter_mut().zip(part.quad) {

@@ -19,8 +19,8 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
-use super::lattice::Lattice;
 use super::cells::{level_loop, Sorted};
+use super::lattice::Lattice;
 use super::sums::{add_point_values, ratio_lattice, ResidualSums, BA_BLOCK};
 use super::{Frame, Mba, MbaConfig, MbaLevels, Start};
 use crate::{Error, Point3, Result};
@@ -44,7 +44,10 @@ impl<const K: usize> Sums<K> {
         for (t, p) in self.num.iter_mut().zip(&part.num) {
             t.iter_mut().zip(p).for_each(|(x, y)| *x += y);
         }
-        self.den.iter_mut().zip(&part.den).for_each(|(x, y)| *x += y);
+        self.den
+            .iter_mut()
+            .zip(&part.den)
+            .for_each(|(x, y)| *x += y);
     }
 
     /// The lattice of value set `k` (eq. 4's ratios).
@@ -232,7 +235,15 @@ fn block_pass<const K: usize>(
                 continue;
             }
             let mut num = s.num.each_mut().map(|x| x.as_mut_slice());
-            add_point_values(&mut num, &mut s.den, t.m, t.n, t.formula, [u[0] * m, u[1] * n], *v);
+            add_point_values(
+                &mut num,
+                &mut s.den,
+                t.m,
+                t.n,
+                t.formula,
+                [u[0] * m, u[1] * n],
+                *v,
+            );
         }
     }
     out
@@ -285,7 +296,10 @@ mod tests {
             }
             for (x, y) in a.reports.iter().zip(&b.reports) {
                 assert_eq!(x.cells, y.cells);
-                assert_eq!((x.residual.max, x.residual.max_index), (y.residual.max, y.residual.max_index));
+                assert_eq!(
+                    (x.residual.max, x.residual.max_index),
+                    (y.residual.max, y.residual.max_index)
+                );
                 assert!((x.residual.rmse - y.residual.rmse).abs() <= 1e-13 * y.residual.rmse);
                 assert!((x.residual.mean - y.residual.mean).abs() <= 1e-13 * y.residual.mean);
             }
@@ -294,7 +308,11 @@ mod tests {
 
     /// RMSE of `z - f(x, y)` at the points, evaluated from the lattice.
     fn rmse(r: &Mba, p: &[Point3]) -> f64 {
-        (p.iter().map(|q| (q.z - r.eval(q.x, q.y)).powi(2)).sum::<f64>() / p.len() as f64).sqrt()
+        (p.iter()
+            .map(|q| (q.z - r.eval(q.x, q.y)).powi(2))
+            .sum::<f64>()
+            / p.len() as f64)
+            .sqrt()
     }
 
     #[test]
@@ -321,7 +339,10 @@ mod tests {
         // row k is what k + 1 levels give (each with its own fitted start)
         for levels in [1, 3] {
             let short = mba(&p, &config(levels, Start::Fitted)).unwrap();
-            let (a, b) = (short.reports.last().unwrap().residual, fit.reports[levels - 1].residual);
+            let (a, b) = (
+                short.reports.last().unwrap().residual,
+                fit.reports[levels - 1].residual,
+            );
             assert_eq!(a.max_index, b.max_index);
             for (x, y) in [(a.rmse, b.rmse), (a.mean, b.mean), (a.max, b.max)] {
                 assert!((x - y).abs() <= 1e-12 * y, "{levels}: {a:?} {b:?}");
@@ -329,7 +350,10 @@ mod tests {
             assert!((rmse(&short, &p) - a.rmse).abs() <= 1e-9 * a.rmse);
         }
         // independent of the heights' origin (the mean start is too; zero is not)
-        let raised: Vec<Point3> = p.iter().map(|q| Point3::new(q.x, q.y, q.z + 1000.0)).collect();
+        let raised: Vec<Point3> = p
+            .iter()
+            .map(|q| Point3::new(q.x, q.y, q.z + 1000.0))
+            .collect();
         let up = mba(&raised, &config(6, Start::Fitted)).unwrap();
         assert!((rmse(&up, &raised) - ef).abs() < 1e-3 * ef);
         // a tolerance stops it where the fitted RMSE meets it
@@ -348,6 +372,15 @@ mod tests {
             ..Default::default()
         };
         let e = MbaLevels::new(Frame::of(&p).unwrap(), &config).unwrap_err();
-        assert!(matches!(e, Error::InvalidSetting { setting: "start", .. }), "{e}");
+        assert!(
+            matches!(
+                e,
+                Error::InvalidSetting {
+                    setting: "start",
+                    ..
+                }
+            ),
+            "{e}"
+        );
     }
 }

@@ -55,7 +55,7 @@ pub struct MbaConfig {
 /// it. BA does not reproduce constants (a lattice fitted to constant data
 /// is not that constant), so the start shows in the final fit: measured on
 /// Franke's function (10^6 points, 131 x 131 values, BENCHMARKS.md), the
-/// held-out RMSE is 8.14e-5 from the mean, 7.25e-5 from zero (ddemidov/mba's
+/// held-out RMSE is 8.14e-5 from the mean, 6.41e-5 fitted, 7.25e-5 from zero (ddemidov/mba's
 /// default, [LWS97]'s level 0 on the raw heights) and 1.10e-4 from a
 /// least-squares plane; from zero it also depends on where the heights'
 /// origin lies (4.6 times worse with the data raised by 10), so zero is no
@@ -72,7 +72,8 @@ pub enum Start {
     /// start `z0 + delta` with `delta = sum r c / sum c^2` (`r`, `c` the
     /// final residuals of the heights and of the constant) leaves the
     /// smallest residual at the points among all constant starts. In memory
-    /// only ([`mba`]); about 1.3 times the work of [`Start::Mean`].
+    /// only ([`mba`]); about 1.25 times the CPU time of [`Start::Mean`]
+    /// (the points are also sorted by lattice cell once).
     Fitted,
 }
 
