@@ -298,9 +298,12 @@ fn pass(
     Ok(total)
 }
 
+/// 4 x 4 control values (or sums) of one cell's support.
+type Block4 = [[f64; 4]; 4];
+
 /// The 4 x 4 control values of `lattice` from cell `(i, j)`.
 #[inline]
-fn block4(lattice: &Lattice, i: usize, j: usize) -> [[f64; 4]; 4] {
+fn block4(lattice: &Lattice, i: usize, j: usize) -> Block4 {
     let st = lattice.n + 3;
     std::array::from_fn(|k| {
         let row = &lattice.phi[(i + k) * st + j..(i + k) * st + j + 4];
@@ -310,7 +313,7 @@ fn block4(lattice: &Lattice, i: usize, j: usize) -> [[f64; 4]; 4] {
 
 /// Eq. 1 with the basis values and a 4 x 4 block of control values.
 #[inline]
-fn eval4(bs: &[f64; 4], bt: &[f64; 4], c: &[[f64; 4]; 4]) -> f64 {
+fn eval4(bs: &[f64; 4], bt: &[f64; 4], c: &Block4) -> f64 {
     let mut f = 0.0;
     for k in 0..4 {
         let mut r = 0.0;
@@ -364,7 +367,7 @@ fn block_pass(
     };
     let halve = usize::from(target.is_some());
     let mut run: Option<RunSums> = None;
-    let mut prev_block: Option<([[f64; 4]; 4], [[f64; 4]; 4])> = None;
+    let mut prev_block: Option<(Block4, Block4)> = None;
     let mut run_cell = (usize::MAX, usize::MAX);
     for (q, (u, v)) in unit.iter().zip(values.iter_mut()).enumerate() {
         let c = (cell(u[0] * rm as f64, rm), cell(u[1] * rn as f64, rn));
