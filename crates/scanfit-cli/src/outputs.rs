@@ -121,6 +121,10 @@ pub struct Picture {
     pub markers: Vec<Marker>,
     /// Legend lines of `--png` (the deviation picture has its own).
     pub legend: Vec<String>,
+    /// The points whose deviations set the colour scale (its 99th
+    /// percentile and maximum), one flag per point [default: all]; e.g. the
+    /// fitted points of `turntable`, whose caps are left out of the fit.
+    pub scale_points: Option<Vec<bool>>,
 }
 
 /// How far the input points are from the surface, as the pictures and the
@@ -323,11 +327,20 @@ impl Scene<'_> {
     /// The colour scale of the local fit error: 0 to the 99th percentile of
     /// the points' deviations, the maximum on the bar.
     fn deviation_scale(&self, units: &str) -> ColourScale {
-        ColourScale::deviation(
-            format!("{} [{units}]", self.deviation.name),
-            self.deviation.per_point,
-            DEVIATION_PERCENTILE,
-        )
+        let name = format!("{} [{units}]", self.deviation.name);
+        let all = self.deviation.per_point;
+        match &self.picture.scale_points {
+            Some(mask) => {
+                let some: Vec<f64> = all
+                    .iter()
+                    .zip(mask)
+                    .filter(|(_, &m)| m)
+                    .map(|(&d, _)| d)
+                    .collect();
+                ColourScale::deviation(name, &some, DEVIATION_PERCENTILE)
+            }
+            None => ColourScale::deviation(name, all, DEVIATION_PERCENTILE),
+        }
     }
 
     /// The legend of a picture coloured by the local fit error.
