@@ -38,7 +38,8 @@ pub struct SurfaceOutputArgs {
     pub iges: Option<PathBuf>,
     /// Write a triangle mesh of the surface (.obj, .ply or .glb; PLY and glb
     /// carry the local fit error, the deviation of each vertex's nearest
-    /// input point, as a colour, PLY also as the property `deviation`).
+    /// input point, as a colour from 0 to its 99th percentile, PLY also as
+    /// the property `deviation`).
     #[arg(long, value_name = "OUT")]
     pub mesh: Option<PathBuf>,
     /// Write a shaded, height-coloured picture with the input points.
@@ -223,10 +224,6 @@ impl SurfaceOutputArgs {
         } else {
             None
         };
-        if let Some(m) = &self.mesh {
-            let bytes = mesh_file(m, &mesh, vertex_dev.as_deref(), deviation.stats.max, input);
-            files.push((m.clone(), bytes));
-        }
         let scene = Scene {
             mesh: &mesh,
             points,
@@ -235,6 +232,12 @@ impl SurfaceOutputArgs {
             input,
             picture,
         };
+        if let Some(m) = &self.mesh {
+            // the mesh colours on the pictures' scale (0 to the 99th percentile)
+            let top = scene.deviation_scale(self.units.label()).range.1;
+            let bytes = mesh_file(m, &mesh, vertex_dev.as_deref(), top, input);
+            files.push((m.clone(), bytes));
+        }
         if let (Some(dp), Some(_)) = (&self.deviation_png, &vertex_dev) {
             files.push((dp.clone(), self.deviation_picture(&scene)?));
         }
@@ -373,7 +376,8 @@ impl Scene<'_> {
 }
 
 /// The bytes of `--mesh` by its extension: OBJ, glb or PLY (the last two
-/// coloured by the local fit error `vertex_dev` on the scale `[0, dmax]`).
+/// coloured by the local fit error `vertex_dev` on the scale `[0, dmax]`,
+/// larger values at the top colour).
 fn mesh_file(
     path: &Path,
     mesh: &scanfit::bspline::Mesh,

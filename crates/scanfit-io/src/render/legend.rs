@@ -117,9 +117,10 @@ impl ColourScale {
     /// ```
     /// use scanfit_io::render::ColourScale;
     /// let mut v: Vec<f64> = (1..=1000).map(f64::from).collect();
-    /// v[3] = 1e6; // one stray value
+    /// v.push(1e6); // one stray value
     /// let s = ColourScale::deviation("deviation [mm]", &v, 99.0);
-    /// assert_eq!(s.range, (0.0, 990.0));
+    /// // 1001 values: the 99th percentile is the one at index round(1000 x 0.99)
+    /// assert_eq!(s.range, (0.0, 991.0));
     /// assert_eq!(s.high.unwrap().extreme, 1e6);
     /// ```
     pub fn deviation(name: impl Into<String>, values: &[f64], percentile_: f64) -> Self {
