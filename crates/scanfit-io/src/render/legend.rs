@@ -151,7 +151,7 @@ impl ColourScale {
         let q = percentile_ / 100.0;
         let lo = percentile(&v, 1.0 - q).unwrap_or(0.0);
         let hi = percentile(&v, q).unwrap_or(0.0);
-        if !(hi > lo) {
+        if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
             return Self::new(name, (min.min(0.0), max.max(0.0)));
         }
         let mut s = Self::new(name, (lo, hi));

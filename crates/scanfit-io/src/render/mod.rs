@@ -729,8 +729,14 @@ mod tests {
                 values: &values,
                 scale: &scale,
             };
-            let (img, layout, depth) =
-                render_rgb_with(&mesh, None, colouring, &[], &[marker.clone()], &opts);
+            let (img, layout, depth) = render_rgb_with(
+                &mesh,
+                None,
+                colouring,
+                &[],
+                std::slice::from_ref(&marker),
+                &opts,
+            );
             let bar = layout.bar.as_ref().unwrap();
             let (bx0, bx1) = bar.columns;
             let w = w as usize;
@@ -855,20 +861,7 @@ mod tests {
 
     #[test]
     fn a_rendered_surface_fills_the_frame_and_is_not_blank() {
-        let ku = KnotVector::uniform_clamped(3, 5).unwrap();
-        let kv = KnotVector::uniform_clamped(3, 5).unwrap();
-        let mut c = Vec::new();
-        for i in 0..5 {
-            for j in 0..5 {
-                c.push(Point3::new(
-                    i as f64,
-                    j as f64,
-                    ((i + j) as f64 * 0.8).sin(),
-                ));
-            }
-        }
-        let s = Surface::new(ku, kv, c).unwrap();
-        let mesh = tessellate(&s, 40, 40);
+        let mesh = bumpy(4.0);
         let opts = RenderOptions {
             width: 200,
             height: 150,
