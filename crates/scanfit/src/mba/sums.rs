@@ -232,6 +232,29 @@ impl BaAccumulator {
     }
 }
 
+/// The statistics of the absolute residuals `|z - z0 - sum_k f_k(x, y)|`
+/// of `points` after `levels` (evaluated as [`BaAccumulator::add_residuals`]
+/// does): the vertical errors of the approximation so far, for a measuring
+/// pass after the last level. Errors for a non-finite coordinate.
+///
+/// ```
+/// use scanfit::mba::sums::residuals;
+/// use scanfit::mba::Frame;
+/// use scanfit::Point3;
+/// let p = [Point3::new(0.0, 0.0, 1.0), Point3::new(1.0, 1.0, 3.0)];
+/// let r = residuals(&Frame::of(&p)?, &[], &p)?; // no level: |z - mean z|
+/// assert_eq!((r.count, r.max), (2, 1.0));
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+pub fn residuals(frame: &Frame, levels: &[Lattice], points: &[Point3]) -> Result<ResidualSums> {
+    validate_points(points)?;
+    let mut stats = ResidualSums::default();
+    for p in points {
+        stats.push(residual(frame, levels, p, frame.unit(p)).abs());
+    }
+    Ok(stats)
+}
+
 /// The residual `z - z0 - sum_k f_k` of `p` (unit coordinates `u`) after
 /// `levels`, subtracted level by level.
 pub(crate) fn residual(frame: &Frame, levels: &[Lattice], p: &Point3, u: [f64; 2]) -> f64 {
@@ -476,6 +499,13 @@ impl FrameSums {
             zsum,
             count,
         })
+    }
+
+    /// The mean height of the points added (`None` without points): the
+    /// frame's `z0`, for a frame over a given domain instead of the data's
+    /// bounding box.
+    pub fn mean_z(&self) -> Option<f64> {
+        (self.count > 0).then(|| self.zsum / self.count as f64)
     }
 
     /// The frame; errors for fewer than 2 points or data without extent in
