@@ -88,14 +88,15 @@ pub fn mba_config(
     tolerance: Option<f64>,
     hjelle: bool,
 ) -> PyResult<MbaConfig> {
-    let mut c = MbaConfig::default();
-    c.base = base.map(|b| pair(b, "base")).transpose()?;
-    c.max_levels = levels;
-    c.tolerance = tolerance;
-    c.formula = if hjelle {
-        ControlFormula::Hjelle
-    } else {
-        ControlFormula::LeeWolbergShin
+    let c = MbaConfig {
+        base: base.map(|b| pair(b, "base")).transpose()?,
+        max_levels: levels,
+        tolerance,
+        formula: if hjelle {
+            ControlFormula::Hjelle
+        } else {
+            ControlFormula::LeeWolbergShin
+        },
     };
     Ok(c)
 }

@@ -213,7 +213,7 @@ def _centring(client, parts, domain):
     if b is None:
         raise ScanfitError("the points are empty: no chunk or tile holds a point")
     lo, hi, n = b
-    return Centring(lo, hi), n
+    return Centring(tuple(map(float, lo)), tuple(map(float, hi))), n
 
 
 # ---- the fits (run on the client) ----------------------------------------------
