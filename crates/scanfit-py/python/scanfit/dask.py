@@ -86,13 +86,28 @@ def _read_tile(path, uv):
     return pts, np.column_stack([a["u"], a["v"]])
 
 
+class _Tile:
+    """A tile read inside the task that sums it (its points never leave that task)."""
+
+    def __init__(self, path, uv):
+        self.path, self.uv = path, uv
+
+    def load(self):
+        return _read_tile(self.path, self.uv)
+
+
+def _load(part):
+    return part.load() if isinstance(part, _Tile) else part
+
+
 def _block(pts, uv):
     """A block of a Dask array (and its parameters) as the accumulators take it."""
     return np.ascontiguousarray(pts, dtype=np.float64), uv
 
 
 def _parts(points, uv, params):
-    """One Delayed ``(points, uv)`` per chunk or tile, in a fixed order."""
+    """One part per chunk or tile, in a fixed order: a Delayed ``(points, uv)`` per
+    chunk of a Dask array, a ``_Tile`` (read by the task that sums it) per file."""
     import dask.array as da
     from dask import delayed
 
@@ -104,8 +119,7 @@ def _parts(points, uv, params):
                 "uv= goes with a Dask array of points; tiles carry their parameters as u and v "
                 "columns (params='uv')"
             )
-        read = delayed(_read_tile, pure=True)
-        return [read(str(p), params == "uv") for p in points]
+        return [_Tile(str(p), params == "uv") for p in points]
     if not isinstance(points, da.Array):
         raise ScanfitError(
             f"points must be a Dask array of shape (N, 3) or a list of point files; got {type(points).__name__}"
@@ -136,7 +150,7 @@ def _parts(points, uv, params):
 
 
 def _bounds(part):
-    pts, _ = part
+    pts, _ = _load(part)
     if len(pts) == 0:
         return None
     return pts.min(axis=0), pts.max(axis=0), len(pts)
@@ -153,22 +167,22 @@ def _merge_bounds(*bs):
 
 def _frame(part, centring):
     f = FrameSums()
-    f.add(part[0], centring)
+    f.add(_load(part)[0], centring)
     return f
 
 
 def _level(part, state):
     acc = state.accumulator()
-    stats = acc.add(state, part[0])
+    stats = acc.add(state, _load(part)[0])
     return acc, stats
 
 
 def _vertical(part, state):
-    return state.residuals(part[0])
+    return state.residuals(_load(part)[0])
 
 
 def _equations(part, empty):
-    pts, uv = part
+    pts, uv = _load(part)
     eq = empty.copy()
     if len(pts):
         eq.add(pts, uv)
@@ -176,7 +190,7 @@ def _equations(part, empty):
 
 
 def _errors(part, surface_json):
-    pts, uv = part
+    pts, uv = _load(part)
     return surface_errors(Surface.from_json(surface_json), pts, uv)
 
 
