@@ -9,15 +9,14 @@ use anyhow::Result;
 use clap::{Args, ValueEnum};
 use scanfit::mba::adjust::AdjustConfig;
 use scanfit::mba::{ControlFormula, Start};
-use scanfit::pipeline::mba::{run as mba, MbaReport, MbaRunConfig};
+use scanfit::pipeline::mba::{run as mba, LevelRow, MbaReport, MbaRunConfig};
 use scanfit::project::{DirectedConfig, WeightFactor};
 use scanfit_io::json::SurfaceDoc;
 use scanfit_io::write_all_atomic;
 
 use crate::args::{choice, option_note, InputArgs, NXM};
 use crate::outputs::{
-    print_written, provenance, quality_doc, quality_rows, samples_json, Deviation, Picture,
-    SurfaceOutputArgs,
+    print_written, provenance, quality_doc, samples_json, Deviation, Picture, SurfaceOutputArgs,
 };
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -194,7 +193,7 @@ impl MbaArgs {
 
 /// One row of the level table, as `--json` prints it.
 #[derive(Debug, Clone, serde::Serialize)]
-struct Row {
+pub(crate) struct Row {
     level: usize,
     control_points: [usize; 2],
     vertical_mean: f64,
@@ -210,8 +209,9 @@ struct Row {
     seconds: f64,
 }
 
-fn rows(r: &MbaReport) -> Vec<Row> {
-    r.levels
+/// The per-level rows of the JSON report (in memory and streamed).
+pub(crate) fn rows(levels: &[LevelRow]) -> Vec<Row> {
+    levels
         .iter()
         .map(|l| Row {
             level: l.level,
@@ -298,7 +298,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
             "input": input.display().to_string(),
             "point_count": pts.len(),
             "control_points": [m + 3, n + 3],
-            "levels": rows(&r),
+            "levels": rows(&r.levels),
             "quality": doc.quality,
             "samples_to_points": samples_json(q),
             "trim": crate::cad::trim_json(trimmed.as_ref()),
@@ -340,6 +340,41 @@ fn note_lattice(a: &MbaArgs, points: &[scanfit::Point3]) {
     }
 }
 
+/// The per-level table (in memory and streamed).
+pub(crate) fn levels_table(levels: &[LevelRow], adjust: bool) -> String {
+    let mut head = vec![
+        "level",
+        "control net",
+        "vertical mean",
+        "vertical max",
+        "vertical RMSE",
+        "eq. 17 RMSE",
+    ];
+    if adjust {
+        head.extend(["adjusted vertical RMSE", "adjusted eq. 17 RMSE", "steps"]);
+    }
+    head.push("time (s)");
+    let mut t = Table::new(&head, &[false, true]);
+    for l in levels {
+        let mut cells = vec![
+            l.level.to_string(),
+            format!("{} x {}", l.control_points.0, l.control_points.1),
+            num(l.vertical.mean),
+            num(l.vertical.max),
+            num(l.vertical.rmse),
+            num(l.grid_rmse),
+        ];
+        if adjust {
+            cells.push(l.adjusted.map_or("-".into(), |x| num(x.vertical_rmse)));
+            cells.push(l.adjusted.map_or("-".into(), |x| num(x.grid_rmse)));
+            cells.push(l.adjusted.map_or("-".into(), |x| x.steps.to_string()));
+        }
+        cells.push(format!("{:.3}", l.seconds));
+        t.row(cells);
+    }
+    t.render()
+}
+
 fn print_report(a: &MbaArgs, r: &MbaReport) -> Result<()> {
     let (m, n) = r.cells;
     outln!(
@@ -352,52 +387,16 @@ fn print_report(a: &MbaArgs, r: &MbaReport) -> Result<()> {
         if a.adjust { ", adjusted" } else { "" },
         r.seconds
     );
-    let mut head = vec![
-        "level",
-        "control net",
-        "vertical mean",
-        "vertical max",
-        "vertical RMSE",
-        "eq. 17 RMSE",
-    ];
-    if a.adjust {
-        head.extend(["adjusted vertical RMSE", "adjusted eq. 17 RMSE", "steps"]);
-    }
-    head.push("time (s)");
-    let mut t = Table::new(&head, &[false, true]);
-    for l in &r.levels {
-        let mut cells = vec![
-            l.level.to_string(),
-            format!("{} x {}", l.control_points.0, l.control_points.1),
-            num(l.vertical.mean),
-            num(l.vertical.max),
-            num(l.vertical.rmse),
-            num(l.grid_rmse),
-        ];
-        if a.adjust {
-            cells.push(l.adjusted.map_or("-".into(), |x| num(x.vertical_rmse)));
-            cells.push(l.adjusted.map_or("-".into(), |x| num(x.grid_rmse)));
-            cells.push(l.adjusted.map_or("-".into(), |x| x.steps.to_string()));
-        }
-        cells.push(format!("{:.3}", l.seconds));
-        t.row(cells);
-    }
-    out!("{}", t.render());
+    out!("{}", levels_table(&r.levels, a.adjust));
     outln!("(errors in data units)\n");
-    let q = &r.assessment.quality;
-    let mut t = Table::new(
-        &["final surface", "mean", "max", "RMSE", "unit"],
-        &[true, false, false, false, true],
+    out!(
+        "{}",
+        crate::surface::quality_table(
+            "final surface",
+            "vertical distance |z - f(x, y)|",
+            &r.assessment.quality,
+            "grid points to nearest point (eq. 17)"
+        )
     );
-    let v = &q.at_parameters;
-    t.row(vec![
-        "vertical distance |z - f(x, y)|".into(),
-        num(v.mean),
-        num(v.max),
-        num(v.rmse),
-        "data units".into(),
-    ]);
-    quality_rows(&mut t, q, "grid points to nearest point (eq. 17)");
-    out!("{}", t.render());
     Ok(())
 }

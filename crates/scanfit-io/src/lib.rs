@@ -25,6 +25,7 @@ mod pcd;
 pub mod ply;
 mod ply_read;
 pub mod render;
+pub mod source;
 pub mod step;
 pub mod step_shell;
 mod stl;

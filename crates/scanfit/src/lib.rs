@@ -64,6 +64,7 @@ pub mod surface;
 pub mod testdata;
 pub mod topology;
 pub mod trim;
+pub mod wire;
 
 pub use cloud::PointCloud;
 pub use error::{Error, Result};

@@ -23,6 +23,7 @@
 
 use crate::metrics::ErrorStats;
 use crate::par::BlockSum;
+use crate::wire::{read_pair_sums, write_pair_sums, Reader, Writer};
 use crate::{validate_points, Error, Point3, Result};
 
 use super::lattice::{locate, uniform_cubic_basis, ControlFormula, Lattice};
@@ -30,6 +31,11 @@ use super::Frame;
 
 /// Fewest points per block of the BA sums.
 pub(super) const BA_BLOCK: usize = 16_384;
+
+/// Tags of the byte records ([`crate::wire`]).
+const BA_TAG: &[u8; 8] = b"SFBASUM1";
+const FRAME_TAG: &[u8; 8] = b"SFFRAME1";
+const RESIDUAL_TAG: &[u8; 8] = b"SFRESID1";
 
 /// Bytes of partial sums that may exist at a time while a chunk is summed.
 pub(super) const PARTIAL_BUDGET: usize = 256 << 20;
@@ -170,6 +176,45 @@ impl BaAccumulator {
         Ok(())
     }
 
+    /// The sums as bytes ([`crate::wire`]), exact: an accumulator read back
+    /// with [`from_bytes`](Self::from_bytes) continues, merges and finishes
+    /// bit for bit as this one.
+    ///
+    /// ```
+    /// use scanfit::mba::{BaAccumulator, ControlFormula};
+    /// let mut a = BaAccumulator::new(4, 2, ControlFormula::LeeWolbergShin)?;
+    /// a.add(&[[0.5, 1.0], [3.2, 0.1]], &[1.0, -2.0])?;
+    /// let b = BaAccumulator::from_bytes(&a.to_bytes())?;
+    /// assert_eq!(b.points(), 2);
+    /// assert_eq!(b.finish(), a.finish());
+    /// # Ok::<(), scanfit::Error>(())
+    /// ```
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut w = Writer::new(BA_TAG);
+        w.usize(self.m);
+        w.usize(self.n);
+        w.u64(u64::from(self.formula == ControlFormula::Hjelle));
+        write_pair_sums(&mut w, &self.sums);
+        w.finish()
+    }
+
+    /// Reads what [`to_bytes`](Self::to_bytes) wrote; errors for bytes of
+    /// another type, cut short or inconsistent.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
+        let mut r = Reader::new(bytes, BA_TAG, "the BA sums of an MBA level")?;
+        let (m, n) = (r.usize()?, r.usize()?);
+        let formula = match r.u64()? {
+            0 => ControlFormula::LeeWolbergShin,
+            1 => ControlFormula::Hjelle,
+            x => return Err(r.corrupt(&format!("control formula {x}"))),
+        };
+        let mut acc = Self::new(m, n, formula)?;
+        let len = (m + 3) * (n + 3);
+        acc.sums = read_pair_sums(&mut r, (len, len), BA_BLOCK.max(len))?;
+        r.end()?;
+        Ok(acc)
+    }
+
     /// The lattice: each control value the ratio of its sums (eq. 4), 0
     /// where no point reached it.
     pub fn finish(self) -> Lattice {
@@ -203,6 +248,29 @@ pub(super) fn ratio_lattice(m: usize, n: usize, num: &[f64], den: &[f64]) -> Lat
         .map(|(nu, de)| if *de > 0.0 { nu / de } else { 0.0 })
         .collect();
     Lattice { m, n, phi }
+}
+
+/// The statistics of the absolute residuals `|z - z0 - sum_k f_k(x, y)|`
+/// of `points` after `levels` (evaluated as [`BaAccumulator::add_residuals`]
+/// does): the vertical errors of the approximation so far, for a measuring
+/// pass after the last level. Errors for a non-finite coordinate.
+///
+/// ```
+/// use scanfit::mba::sums::residuals;
+/// use scanfit::mba::Frame;
+/// use scanfit::Point3;
+/// let p = [Point3::new(0.0, 0.0, 1.0), Point3::new(1.0, 1.0, 3.0)];
+/// let r = residuals(&Frame::of(&p)?, &[], &p)?; // no level: |z - mean z|
+/// assert_eq!((r.count, r.max), (2, 1.0));
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+pub fn residuals(frame: &Frame, levels: &[Lattice], points: &[Point3]) -> Result<ResidualSums> {
+    validate_points(points)?;
+    let mut stats = ResidualSums::default();
+    for p in points {
+        stats.push(residual(frame, levels, p, frame.unit(p)).abs());
+    }
+    Ok(stats)
 }
 
 /// The residual `z - z0 - sum_k f_k` of `p` (unit coordinates `u`) after
@@ -366,6 +434,39 @@ impl ResidualSums {
         self.count += other.count;
     }
 
+    /// The sums as bytes ([`crate::wire`], exact).
+    ///
+    /// ```
+    /// use scanfit::mba::ResidualSums;
+    /// let mut a = ResidualSums::default();
+    /// a.push(0.25);
+    /// assert_eq!(ResidualSums::from_bytes(&a.to_bytes())?, a);
+    /// # Ok::<(), scanfit::Error>(())
+    /// ```
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut w = Writer::new(RESIDUAL_TAG);
+        w.u64(self.count);
+        w.f64(self.sum);
+        w.f64(self.sum2);
+        w.f64(self.max);
+        w.u64(self.max_index);
+        w.finish()
+    }
+
+    /// Reads what [`to_bytes`](Self::to_bytes) wrote.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
+        let mut r = Reader::new(bytes, RESIDUAL_TAG, "residual statistics")?;
+        let s = Self {
+            count: r.u64()?,
+            sum: r.f64()?,
+            sum2: r.f64()?,
+            max: r.f64()?,
+            max_index: r.u64()?,
+        };
+        r.end()?;
+        Ok(s)
+    }
+
     /// Mean, maximum and RMSE.
     pub fn stats(&self) -> ErrorStats {
         let n = self.count.max(1) as f64;
@@ -439,6 +540,49 @@ impl FrameSums {
         self.count
     }
 
+    /// The sums as bytes ([`crate::wire`], exact).
+    ///
+    /// ```
+    /// use scanfit::mba::FrameSums;
+    /// use scanfit::Point3;
+    /// let mut s = FrameSums::default();
+    /// s.add(&[Point3::new(0.0, 0.0, 1.0), Point3::new(2.0, 1.0, 3.0)])?;
+    /// assert_eq!(FrameSums::from_bytes(&s.to_bytes())?, s);
+    /// # Ok::<(), scanfit::Error>(())
+    /// ```
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut w = Writer::new(FRAME_TAG);
+        w.u64(self.count);
+        let lo = self.lo.unwrap_or([f64::NAN; 2]);
+        for x in [lo[0], lo[1], self.hi[0], self.hi[1], self.zsum] {
+            w.f64(x);
+        }
+        w.finish()
+    }
+
+    /// Reads what [`to_bytes`](Self::to_bytes) wrote.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
+        let mut r = Reader::new(bytes, FRAME_TAG, "the frame sums of an MBA")?;
+        let count = r.u64()?;
+        let lo = [r.f64()?, r.f64()?];
+        let hi = [r.f64()?, r.f64()?];
+        let zsum = r.f64()?;
+        r.end()?;
+        Ok(Self {
+            lo: (count > 0).then_some(lo),
+            hi,
+            zsum,
+            count,
+        })
+    }
+
+    /// The mean height of the points added (`None` without points): the
+    /// frame's `z0`, for a frame over a given domain instead of the data's
+    /// bounding box.
+    pub fn mean_z(&self) -> Option<f64> {
+        (self.count > 0).then(|| self.zsum / self.count as f64)
+    }
+
     /// The frame; errors for fewer than 2 points or data without extent in
     /// x or y.
     pub fn finish(&self) -> Result<Frame> {
@@ -477,6 +621,40 @@ mod tests {
     use super::*;
     use crate::mba::{mba, MbaConfig, MbaLevels};
     use crate::testdata::franke;
+
+    #[test]
+    fn sums_sent_as_bytes_continue_bit_for_bit_and_damaged_bytes_are_refused() -> Result<()> {
+        let p = cloud(50_000);
+        let frame = Frame::of(&p)?;
+        let mut once = BaAccumulator::new(16, 8, ControlFormula::LeeWolbergShin)?;
+        once.add_residuals(&frame, &[], &p)?;
+        // stopped mid-block (20_000 is not a multiple of the block), sent, continued
+        let mut a = BaAccumulator::new(16, 8, ControlFormula::LeeWolbergShin)?;
+        a.add_residuals(&frame, &[], &p[..20_000])?;
+        let bytes = a.to_bytes();
+        let mut b = BaAccumulator::from_bytes(&bytes)?;
+        b.add_residuals(&frame, &[], &p[20_000..])?;
+        assert_eq!(b.points(), 50_000);
+        assert_eq!(b.finish(), once.finish());
+        // every truncation and a flipped tag are errors, never a panic
+        for cut in (0..bytes.len()).step_by(97) {
+            assert!(BaAccumulator::from_bytes(&bytes[..cut]).is_err(), "{cut}");
+        }
+        let mut other = bytes.clone();
+        other[0] = b'X';
+        let e = BaAccumulator::from_bytes(&other).unwrap_err().to_string();
+        assert!(e.contains("BA sums"), "{e}");
+        // a record of another type is named as such
+        let f = FrameSums::default().to_bytes();
+        assert!(BaAccumulator::from_bytes(&f).is_err());
+        let mut fs = FrameSums::default();
+        fs.add(&p[..10])?;
+        assert_eq!(
+            FrameSums::from_bytes(&fs.to_bytes())?.finish()?,
+            Frame::of(&p[..10])?
+        );
+        Ok(())
+    }
 
     fn cloud(n: usize) -> Vec<Point3> {
         let mut rng = crate::testdata::Lcg::new(17);
