@@ -21,6 +21,9 @@ use scanfit::Point3;
 use crate::table::{capacity, Format, Origin, PointTable, ReadOptions};
 use crate::{Error, Result};
 
+mod layered;
+use layered::read_layered;
+
 /// Points decoded per call into the crate (fewer for long records: see
 /// [`BATCH_BYTES`]).
 const BATCH: u64 = 1 << 18;
@@ -187,7 +190,11 @@ fn precheck(path: &Path, bytes: &[u8]) -> Result<Raw> {
 /// against the bytes left, walking the chunks the way the decoder will.
 /// Without them a few-kilobyte file can make the decoder allocate
 /// gigabytes (it sizes buffers from these fields before reading).
-fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<()> {
+///
+/// Returns, for the layered compressor, what scanfit's own decoder needs
+/// ([`Layered`]); `None` for the pointwise compressor (formats 0-5, read
+/// through the `laz` crate).
+fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<Option<Layered>> {
     let binary = |offset: u64, message: String| Error::Binary {
         path: path.to_path_buf(),
         offset,
@@ -226,7 +233,7 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<()> {
     }
     let Some((vlr_at, vlr_len)) = laz else {
         // the crate reports a missing LASzip VLR itself
-        return Ok(());
+        return Ok(None);
     };
     let Some(vlr) = usize::try_from(vlr_at)
         .ok()
@@ -313,7 +320,7 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<()> {
         )));
     }
     if compressor != 3 {
-        return Ok(());
+        return Ok(None);
     }
     if !layered_ok {
         return Err(binary(vlr_at, "the LASzip VLR uses the layered compressor with an item type it does not allow; the file is damaged".into()));
@@ -374,7 +381,24 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<()> {
         pos += head + sizes;
         chunk += 1;
     }
-    Ok(())
+    Ok(Some(Layered {
+        vlr_at,
+        vlr_len,
+        count,
+        data_end,
+        table_counts,
+    }))
+}
+
+/// A layered LAZ file (point formats 6-10) as [`laz_check`] found it.
+struct Layered {
+    vlr_at: u64,
+    vlr_len: u64,
+    count: u64,
+    /// where the chunks end: the chunk table, the first EVLR or the file's end
+    data_end: u64,
+    /// the chunk table's point counts (variable-size chunks only)
+    table_counts: Option<Vec<u64>>,
 }
 
 /// Runs `f`, turning a panic into `None` without the panic message on
@@ -517,16 +541,23 @@ fn read_with_crate(path: &Path, bytes: Vec<u8>, raw: &Raw) -> Result<Decoded> {
 /// Reads a LAS or LAZ file's bytes (`path` is for messages).
 pub(crate) fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<PointTable> {
     let raw = precheck(path, bytes)?;
-    if raw.compressed {
-        laz_check(path, bytes, &raw)?;
-    }
-    // the crate is third-party code: a panic on a damaged file becomes one
-    // error, without its message on stderr. Our own readers return errors
-    // and never panic on file content.
-    let decoded = quietly(|| read_with_crate(path, bytes.to_vec(), &raw)).ok_or_else(|| Error::Invalid {
-        path: path.to_path_buf(),
-        message: "the LAS/LAZ decoder failed on this file (it is damaged, or uses a variant the las crate does not handle)".into(),
-    })??;
+    let layered = if raw.compressed {
+        laz_check(path, bytes, &raw)?
+    } else {
+        None
+    };
+    let decoded = match layered {
+        // LAS 1.4 points: scanfit's own decoder (the laz crate's recursion
+        // on damaged GPS-time layers overflows the stack)
+        Some(layered) => read_layered(path, bytes, &raw, &layered)?,
+        // the crate is third-party code: a panic on a damaged file becomes
+        // one error, without its message on stderr. Our own readers return
+        // errors and never panic on file content.
+        None => quietly(|| read_with_crate(path, bytes.to_vec(), &raw)).ok_or_else(|| Error::Invalid {
+            path: path.to_path_buf(),
+            message: "the LAS/LAZ decoder failed on this file (it is damaged, or uses a variant the las crate does not handle)".into(),
+        })??,
+    };
     let n = decoded.points.len();
     if (n as u64) < decoded.declared {
         return Err(Error::Invalid {

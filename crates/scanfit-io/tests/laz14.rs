@@ -46,7 +46,11 @@ fn records(format: u8, n: usize, seed: u64) -> Vec<u8> {
     let mut k = 0;
     while k < n {
         // one pulse: 1 to 5 returns (sometimes up to 15), one GPS time
-        let returns = if rng.chance(3) { 6 + rng.below(10) as u8 } else { 1 + rng.below(5) as u8 };
+        let returns = if rng.chance(3) {
+            6 + rng.below(10) as u8
+        } else {
+            1 + rng.below(5) as u8
+        };
         if rng.chance(8) {
             channel = rng.below(4) as u8;
         }
@@ -66,7 +70,11 @@ fn records(format: u8, n: usize, seed: u64) -> Vec<u8> {
                 break;
             }
             x = x.wrapping_add(rng.below(400) as i32 - 200);
-            y = y.wrapping_add(if rng.chance(2) { 1 << 20 } else { rng.below(60) as i32 - 30 });
+            y = y.wrapping_add(if rng.chance(2) {
+                1 << 20
+            } else {
+                rng.below(60) as i32 - 30
+            });
             z = z.wrapping_add(rng.below(100) as i32 - 50 - 20 * i32::from(r));
             if rng.chance(10) {
                 class = [1, 2, 3, 5, 6, 9, 17, 64, 200][rng.below(9) as usize];
@@ -278,7 +286,16 @@ fn ours(f: &Laz, n: u64, variable: bool) -> (Vec<Point14>, usize) {
     } else {
         None
     };
-    let file = LayeredLaz::new(&f.bytes, &f.vlr_payload, 375 + 54, f.start, table_end(f), n, table.as_deref()).unwrap();
+    let file = LayeredLaz::new(
+        &f.bytes,
+        &f.vlr_payload,
+        375 + 54,
+        f.start,
+        table_end(f),
+        n,
+        table.as_deref(),
+    )
+    .unwrap();
     let mut out = Vec::new();
     for c in 0..file.chunks().len() {
         file.decode_chunk(c, &mut out).unwrap();
@@ -289,7 +306,10 @@ fn ours(f: &Laz, n: u64, variable: bool) -> (Vec<Point14>, usize) {
 fn same(a: &[Point14], b: &[Point14], what: &str) {
     assert_eq!(a.len(), b.len(), "{what}: point counts");
     for (k, (p, q)) in a.iter().zip(b).enumerate() {
-        assert!(p == q && p.gps_time.to_bits() == q.gps_time.to_bits(), "{what}: point {k}:\n ours {p:?}\n laz  {q:?}");
+        assert!(
+            p == q && p.gps_time.to_bits() == q.gps_time.to_bits(),
+            "{what}: point {k}:\n ours {p:?}\n laz  {q:?}"
+        );
     }
 }
 
@@ -300,7 +320,11 @@ fn check(format: u8, version4: bool, chunks: Chunks, n: usize, seed: u64) -> usi
     let theirs = laz_decode(&f, n, len);
     assert_eq!(theirs, raw, "the laz crate round trip (format {format})");
     let (mine, chunks) = ours(&f, n as u64, matches!(chunks, Chunks::Variable(_)));
-    same(&mine, &fields(&theirs, format), &format!("format {format}, version {}", if version4 { 4 } else { 3 }));
+    same(
+        &mine,
+        &fields(&theirs, format),
+        &format!("format {format}, version {}", if version4 { 4 } else { 3 }),
+    );
     chunks
 }
 
@@ -322,13 +346,22 @@ fn format_8_matches_laz() {
 #[test]
 fn variable_chunks_match_laz() {
     // chunks of 1 point (no layers decoded), 2, 700 and 1234 points
-    assert_eq!(check(8, false, Chunks::Variable(&[1, 2, 700, 1234]), 3000, 44), 8);
+    assert_eq!(
+        check(8, false, Chunks::Variable(&[1, 2, 700, 1234]), 3000, 44),
+        8
+    );
 }
 
 #[test]
 fn item_version_4_matches_laz() {
     for format in [6, 7, 8] {
-        check(format, true, Chunks::Fixed(900), 2500, 55 + u64::from(format));
+        check(
+            format,
+            true,
+            Chunks::Fixed(900),
+            2500,
+            55 + u64::from(format),
+        );
     }
 }
 
@@ -360,7 +393,11 @@ fn the_reader_uses_the_decoder_and_matches_the_las_crate() {
     let col = |name: &str| table.columns.iter().position(|c| c == name).unwrap() - 3;
     for (k, p) in points.iter().enumerate() {
         let q = table.points[k];
-        assert_eq!((q.x.to_bits(), q.y.to_bits(), q.z.to_bits()), (p.x.to_bits(), p.y.to_bits(), p.z.to_bits()), "point {k}");
+        assert_eq!(
+            (q.x.to_bits(), q.y.to_bits(), q.z.to_bits()),
+            (p.x.to_bits(), p.y.to_bits(), p.z.to_bits()),
+            "point {k}"
+        );
         let c = p.color.unwrap();
         let expect = [
             ("intensity", f64::from(p.intensity)),
@@ -374,7 +411,53 @@ fn the_reader_uses_the_decoder_and_matches_the_las_crate() {
             ("blue", f64::from(c.blue)),
         ];
         for (name, v) in expect {
-            assert_eq!(table.extra[col(name)][k].to_bits(), v.to_bits(), "point {k}, {name}");
+            assert_eq!(
+                table.extra[col(name)][k].to_bits(),
+                v.to_bits(),
+                "point {k}, {name}"
+            );
         }
     }
+}
+
+/// Fuzz finding (laz target, `docs/robustness.md` finding 2): a 993-byte
+/// file whose GPS-time layer keeps switching sequences. The laz crate
+/// recursed on every switch until the stack overflowed (an abort); the
+/// reader now refuses it with one error naming the chunk and the point.
+#[test]
+fn the_gps_time_recursion_input_is_a_clear_error() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fuzz/regressions/laz/gps-time-recursion.laz");
+    let bytes = std::fs::read(path).unwrap();
+    let read = |b: &[u8]| {
+        parse_cloud(Path::new("f.laz"), b, &ReadOptions::default())
+            .unwrap_err()
+            .to_string()
+    };
+    // its GPS-time layer starts with 0xFFFFFFFF, a value no encoder writes
+    let e = read(&bytes);
+    assert!(
+        e.contains("LAZ chunk 0 (points 0 to 39): its GPS time layer")
+            && e.contains("starts with a value no encoder writes"),
+        "{e}"
+    );
+    // with a start the decoder accepts, the switches run on until the
+    // bound on sequence switches stops them (or the layer's bytes end)
+    let chunk = 477;
+    let sizes: Vec<usize> = (0..9)
+        .map(|l| u32_le(&bytes, chunk + 34 + 4 * l) as usize)
+        .collect();
+    let gps = chunk + 34 + 36 + sizes[..8].iter().sum::<usize>();
+    let mut variant = bytes.clone();
+    variant[gps..gps + 4].copy_from_slice(&[0xff, 0xff, 0xff, 0xfe]);
+    let e = read(&variant);
+    assert!(e.contains("LAZ chunk 0 (points 0 to 39): point 1 cannot be decoded: its GPS time switches sequences more often than there are sequences"), "{e}");
+    // (kept in the replayed corpus too)
+    let kept = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fuzz/regressions/laz/gps-time-switches.laz");
+    assert_eq!(std::fs::read(kept).unwrap(), variant);
+}
+
+fn u32_le(b: &[u8], at: usize) -> u32 {
+    u32::from_le_bytes(b[at..at + 4].try_into().unwrap())
 }

@@ -1,19 +1,26 @@
 //! The LASzip arithmetic decoder (a range decoder with 32-bit registers
 //! after Amir Said's FastAC, as LASzip uses it) reading one layer held in
 //! a byte slice. It never reads past the slice: running out of bytes is
-//! an [`Exhausted`] error, as are the states only damaged data can reach.
+//! a [`Fault`], as are the states only damaged data can reach.
 
 use super::models::{BitModel, SymbolModel, BIT_SHIFT, SYMBOL_SHIFT};
 
 /// Renormalise when the interval length drops below this.
 const MIN_LENGTH: u32 = 1 << 24;
 
-/// The layer's bytes ran out (or hold a state no encoder writes).
+/// Why a layer cannot be decoded further.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) struct Exhausted;
+pub(super) enum Fault {
+    /// its bytes ran out (or it has fewer than the 4 it starts with)
+    Ended,
+    /// it starts with a value no encoder writes
+    Unwritten,
+    /// its GPS times switch sequences more often than there are sequences
+    Switches,
+}
 
 /// Result of one decoding step.
-pub(super) type Step<T> = std::result::Result<T, Exhausted>;
+pub(super) type Step<T> = std::result::Result<T, Fault>;
 
 /// Decoder over one layer.
 pub(super) struct Decoder<'a> {
@@ -26,11 +33,15 @@ pub(super) struct Decoder<'a> {
 impl<'a> Decoder<'a> {
     /// Starts decoding `bytes` (the first four bytes set the value).
     pub(super) fn new(bytes: &'a [u8]) -> Step<Self> {
-        let head: [u8; 4] = bytes.get(..4).ok_or(Exhausted)?.try_into().map_err(|_| Exhausted)?;
+        let head: [u8; 4] = bytes
+            .get(..4)
+            .ok_or(Fault::Ended)?
+            .try_into()
+            .map_err(|_| Fault::Ended)?;
         let value = u32::from_be_bytes(head);
         // an encoder's value is always below the initial length
         if value == u32::MAX {
-            return Err(Exhausted);
+            return Err(Fault::Unwritten);
         }
         Ok(Self {
             bytes,
@@ -43,7 +54,7 @@ impl<'a> Decoder<'a> {
     #[inline]
     fn renormalise(&mut self) -> Step<()> {
         while self.length < MIN_LENGTH {
-            let byte = *self.bytes.get(self.at).ok_or(Exhausted)?;
+            let byte = *self.bytes.get(self.at).ok_or(Fault::Ended)?;
             self.at += 1;
             self.value = (self.value << 8) | u32::from(byte);
             self.length <<= 8;

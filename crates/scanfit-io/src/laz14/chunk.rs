@@ -4,7 +4,7 @@
 //! the layers in the same order. Chunks follow each other after the 8-byte
 //! chunk-table offset at the start of the point data.
 
-use super::arithmetic::{Decoder, Exhausted};
+use super::arithmetic::{Decoder, Fault};
 use super::color::{NirDecoder, RgbDecoder};
 use super::point::{Layers, PointDecoder};
 use super::{Laz14Error, Point14};
@@ -26,10 +26,14 @@ const NAMES: [&str; POINT_LAYERS] = [
 ];
 
 fn u16_at(b: &[u8], at: usize) -> Option<u16> {
-    Some(u16::from_le_bytes(b.get(at..at.checked_add(2)?)?.try_into().ok()?))
+    Some(u16::from_le_bytes(
+        b.get(at..at.checked_add(2)?)?.try_into().ok()?,
+    ))
 }
 fn u32_at(b: &[u8], at: usize) -> Option<u32> {
-    Some(u32::from_le_bytes(b.get(at..at.checked_add(4)?)?.try_into().ok()?))
+    Some(u32::from_le_bytes(
+        b.get(at..at.checked_add(4)?)?.try_into().ok()?,
+    ))
 }
 
 /// What follows the point-14 item in the record.
@@ -47,20 +51,36 @@ struct Items {
 impl Items {
     /// Raw bytes of a record.
     fn record(&self) -> usize {
-        POINT_BYTES + 6 * usize::from(self.rgb) + 2 * usize::from(self.nir) + self.extra + 29 * usize::from(self.wave)
+        POINT_BYTES
+            + 6 * usize::from(self.rgb)
+            + 2 * usize::from(self.nir)
+            + self.extra
+            + 29 * usize::from(self.wave)
     }
     /// Layers of a chunk.
     fn layers(&self) -> usize {
-        POINT_LAYERS + usize::from(self.rgb) + usize::from(self.nir) + self.extra + usize::from(self.wave)
+        POINT_LAYERS
+            + usize::from(self.rgb)
+            + usize::from(self.nir)
+            + self.extra
+            + usize::from(self.wave)
     }
 
     /// Reads the item list of a LASzip VLR: a point-14 item first, then
     /// optionally RGB or RGB+NIR, extra bytes and a wave packet, all of
     /// the same version (3 or 4).
     fn from_vlr(vlr: &[u8], at: u64) -> Result<(Self, u32), Laz14Error> {
-        let err = |message: String| Laz14Error { offset: at, message };
-        let (Some(compressor), Some(chunk_size), Some(count)) = (u16_at(vlr, 0), u32_at(vlr, 12), u16_at(vlr, 32)) else {
-            return Err(err(format!("the LASzip VLR has {} bytes, too few for its fixed fields; the file is damaged", vlr.len())));
+        let err = |message: String| Laz14Error {
+            offset: at,
+            message,
+        };
+        let (Some(compressor), Some(chunk_size), Some(count)) =
+            (u16_at(vlr, 0), u32_at(vlr, 12), u16_at(vlr, 32))
+        else {
+            return Err(err(format!(
+                "the LASzip VLR has {} bytes, too few for its fixed fields; the file is damaged",
+                vlr.len()
+            )));
         };
         if compressor != 3 {
             return Err(err(format!("the LASzip VLR declares compressor {compressor}; LAS 1.4 points (formats 6-10) use the layered compressor 3")));
@@ -69,7 +89,11 @@ impl Items {
         let mut version = None;
         let mut stage = 0; // 0: point14 expected, 1: colour, 2: extra bytes, 3: wave packet, 4: done
         for k in 0..usize::from(count) {
-            let (Some(kind), Some(size), Some(v)) = (u16_at(vlr, 34 + 6 * k), u16_at(vlr, 36 + 6 * k), u16_at(vlr, 38 + 6 * k)) else {
+            let (Some(kind), Some(size), Some(v)) = (
+                u16_at(vlr, 34 + 6 * k),
+                u16_at(vlr, 36 + 6 * k),
+                u16_at(vlr, 38 + 6 * k),
+            ) else {
                 return Err(err(format!("the LASzip VLR declares {count} items, but its {} bytes hold fewer; the file is damaged", vlr.len())));
             };
             if !matches!(v, 3 | 4) || version.is_some_and(|w| w != v) {
@@ -104,7 +128,9 @@ impl Items {
             stage = next;
         }
         if stage == 0 {
-            return Err(err("the LASzip VLR lists no point-14 item; the file is damaged".into()));
+            return Err(err(
+                "the LASzip VLR lists no point-14 item; the file is damaged".into(),
+            ));
         }
         items.version4 = version == Some(4);
         Ok((items, chunk_size))
@@ -165,7 +191,10 @@ impl<'a> LayeredLaz<'a> {
         let mut done = 0u64;
         while done < count {
             let c = chunks.len();
-            let err = |message: String| Laz14Error { offset: pos, message };
+            let err = |message: String| Laz14Error {
+                offset: pos,
+                message,
+            };
             if pos.saturating_add(head) > end {
                 return Err(err(format!(
                     "the header declares {count} points, but the compressed data ends after {done} of them (before the header of chunk {c}); the file is truncated"
@@ -206,7 +235,11 @@ impl<'a> LayeredLaz<'a> {
             done += points;
             pos += head + sizes;
         }
-        Ok(Self { bytes, items, chunks })
+        Ok(Self {
+            bytes,
+            items,
+            chunks,
+        })
     }
 
     /// The chunks, in file order.
@@ -229,17 +262,29 @@ impl<'a> LayeredLaz<'a> {
     pub fn decode_chunk(&self, index: usize, out: &mut Vec<Point14>) -> Result<(), Laz14Error> {
         let span = *self.chunks.get(index).ok_or_else(|| Laz14Error {
             offset: 0,
-            message: format!("there is no LAZ chunk {index} (the file has {})", self.chunks.len()),
+            message: format!(
+                "there is no LAZ chunk {index} (the file has {})",
+                self.chunks.len()
+            ),
         })?;
         let err = |message: String| Laz14Error {
             offset: span.offset,
-            message: format!("LAZ chunk {index} (points {} to {}): {message}", span.first_point, span.first_point + span.points - 1),
+            message: format!(
+                "LAZ chunk {index} (points {} to {}): {message}",
+                span.first_point,
+                span.first_point + span.points - 1
+            ),
         };
         let items = self.items;
         // the walk in `new` checked that the header and layers fit
         let p = span.offset as usize;
-        let record = self.bytes.get(p..p + items.record()).ok_or_else(|| err("the chunk is truncated".into()))?;
-        let raw: &[u8; POINT_BYTES] = record[..POINT_BYTES].try_into().map_err(|_| err("the chunk is truncated".into()))?;
+        let record = self
+            .bytes
+            .get(p..p + items.record())
+            .ok_or_else(|| err("the chunk is truncated".into()))?;
+        let raw: &[u8; POINT_BYTES] = record[..POINT_BYTES]
+            .try_into()
+            .map_err(|_| err("the chunk is truncated".into()))?;
         let mut first = Point14::from_record(raw);
         let u16_of = |k: usize| u16_at(record, k).unwrap_or(0);
         if items.rgb {
@@ -253,7 +298,10 @@ impl<'a> LayeredLaz<'a> {
         let mut layers: Vec<&[u8]> = Vec::with_capacity(items.layers());
         for l in 0..items.layers() {
             let size = u32_at(self.bytes, sizes_at + 4 * l).unwrap_or(0) as usize;
-            let layer = self.bytes.get(layer_at..layer_at + size).ok_or_else(|| err("the chunk's layers run past the data".into()))?;
+            let layer = self
+                .bytes
+                .get(layer_at..layer_at + size)
+                .ok_or_else(|| err("the chunk's layers run past the data".into()))?;
             layers.push(layer);
             layer_at += size;
         }
@@ -261,9 +309,9 @@ impl<'a> LayeredLaz<'a> {
             if layers[l].is_empty() {
                 return Ok(None);
             }
-            Decoder::new(layers[l]).map(Some).map_err(|Exhausted| {
+            Decoder::new(layers[l]).map(Some).map_err(|_| {
                 let name = NAMES.get(l).copied().unwrap_or(if l == POINT_LAYERS { "RGB" } else { "NIR" });
-                err(format!("its {name} layer has {} bytes, too few to start decoding; the file is damaged", layers[l].len()))
+                err(format!("its {name} layer ({} bytes) is shorter than 4 bytes or starts with a value no encoder writes; the file is damaged", layers[l].len()))
             })
         };
         if span.points == 1 {
@@ -285,7 +333,11 @@ impl<'a> LayeredLaz<'a> {
             gps_time: open(8)?,
         };
         let mut rgb_layer = if items.rgb { open(POINT_LAYERS)? } else { None };
-        let mut nir_layer = if items.nir { open(POINT_LAYERS + 1)? } else { None };
+        let mut nir_layer = if items.nir {
+            open(POINT_LAYERS + 1)?
+        } else {
+            None
+        };
         let context = usize::from(first.scanner_channel());
         let mut points = PointDecoder::new(&first);
         let mut rgb = RgbDecoder::new(first.rgb, context, items.version4);
@@ -294,11 +346,24 @@ impl<'a> LayeredLaz<'a> {
         out.push(first);
         let mut point = first;
         for k in 1..span.points {
-            let fail = |_| err(format!("point {} cannot be decoded: a layer ends early or holds data no encoder writes; the file is damaged", span.first_point + k));
+            let fail = |f: Fault| {
+                let why = match f {
+                    Fault::Switches => "its GPS time switches sequences more often than there are sequences (an encoder switches at most once)",
+                    _ => "a layer ends before it, or holds data no encoder writes",
+                };
+                err(format!(
+                    "point {} cannot be decoded: {why}; the file is damaged",
+                    span.first_point + k
+                ))
+            };
             let switched = points.next(&mut pl, &mut point).map_err(fail)?;
             // version 3 hands the colour items the new channel only on the
             // point where it changes (channel 0 otherwise), version 4 always
-            let context = if items.version4 || switched { points.channel() } else { 0 };
+            let context = if items.version4 || switched {
+                points.channel()
+            } else {
+                0
+            };
             if items.rgb {
                 point.rgb = rgb.next(rgb_layer.as_mut(), context).map_err(fail)?;
             }

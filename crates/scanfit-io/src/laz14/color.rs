@@ -111,7 +111,9 @@ fn decode_rgb(dec: &mut Decoder<'_>, m: &mut RgbModels, last: [u16; 3]) -> Step<
     let [lr, lg, lb] = last;
     let mut byte = |k: usize, base: u8, dec: &mut Decoder<'_>| -> Step<u16> {
         if used & (1 << k) != 0 {
-            Ok(u16::from((dec.symbol(&mut m.bytes[k])? as u8).wrapping_add(base)))
+            Ok(u16::from(
+                (dec.symbol(&mut m.bytes[k])? as u8).wrapping_add(base),
+            ))
         } else {
             Ok(u16::from(base))
         }

@@ -11,7 +11,7 @@
 //! sequence that fits), more switches than there are sequences is refused
 //! as damaged data instead of being followed.
 
-use super::arithmetic::{Decoder, Exhausted, Step};
+use super::arithmetic::{Decoder, Fault, Step};
 use super::integer::IntegerDecoder;
 use super::models::SymbolModel;
 
@@ -62,7 +62,9 @@ impl GpsState {
     /// against the current time's high half, its low half raw.
     fn full(&mut self, dec: &mut Decoder<'_>) -> Step<()> {
         self.newest = (self.newest + 1) & 3;
-        let high = self.ints.decode(dec, (self.times[self.current] >> 32) as i32, 8)?;
+        let high = self
+            .ints
+            .decode(dec, (self.times[self.current] >> 32) as i32, 8)?;
         let low = dec.raw_u32()?;
         self.times[self.newest] = (i64::from(high) << 32) | i64::from(low);
         self.current = self.newest;
@@ -117,11 +119,15 @@ impl GpsState {
                 }
                 s if s < MULTI => {
                     let context = if s < 10 { 2 } else { 3 };
-                    let diff = self.ints.decode(dec, (s as i32).wrapping_mul(last), context)?;
+                    let diff = self
+                        .ints
+                        .decode(dec, (s as i32).wrapping_mul(last), context)?;
                     self.times[c] = self.times[c].wrapping_add(i64::from(diff));
                 }
                 MULTI => {
-                    let diff = self.ints.decode(dec, (MULTI as i32).wrapping_mul(last), 4)?;
+                    let diff = self
+                        .ints
+                        .decode(dec, (MULTI as i32).wrapping_mul(last), 4)?;
                     self.extreme(diff);
                     self.times[c] = self.times[c].wrapping_add(i64::from(diff));
                 }
@@ -131,7 +137,9 @@ impl GpsState {
                     let diff = if m > -(MULTI_MINUS as i32) {
                         self.ints.decode(dec, m.wrapping_mul(last), 5)?
                     } else {
-                        let diff = self.ints.decode(dec, (-(MULTI_MINUS as i32)).wrapping_mul(last), 6)?;
+                        let diff =
+                            self.ints
+                                .decode(dec, (-(MULTI_MINUS as i32)).wrapping_mul(last), 6)?;
                         self.extreme(diff);
                         diff
                     };
@@ -145,6 +153,6 @@ impl GpsState {
             }
             return Ok(());
         }
-        Err(Exhausted)
+        Err(Fault::Switches)
     }
 }

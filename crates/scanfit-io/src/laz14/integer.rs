@@ -32,7 +32,6 @@ impl IntegerDecoder {
             (32, 0, i32::MIN)
         };
         Self {
-
             range,
             smallest,
             classes: (0..contexts).map(|_| SymbolModel::new(width + 1)).collect(),
@@ -44,7 +43,12 @@ impl IntegerDecoder {
 
     /// Decodes the value predicted by `prediction` under `context`.
     #[inline]
-    pub(super) fn decode(&mut self, dec: &mut Decoder<'_>, prediction: i32, context: usize) -> Step<i32> {
+    pub(super) fn decode(
+        &mut self,
+        dec: &mut Decoder<'_>,
+        prediction: i32,
+        context: usize,
+    ) -> Step<i32> {
         let k = dec.symbol(&mut self.classes[context])?;
         self.k = k;
         let corrector = if k == 0 {

@@ -192,7 +192,10 @@ mod tests {
                 // a skewed stream: small symbols often
                 m.record((k * k + 7 * k) % symbols.min(1 + k % 40));
                 for v in (0..(1 << 15) + 50).step_by(97) {
-                    let linear = (0..symbols).rev().find(|&s| m.start[s as usize] <= v).unwrap();
+                    let linear = (0..symbols)
+                        .rev()
+                        .find(|&s| m.start[s as usize] <= v)
+                        .unwrap();
                     assert_eq!(m.find(v), linear, "symbols {symbols}, value {v}");
                 }
                 if k > 50 {

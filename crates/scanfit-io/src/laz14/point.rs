@@ -134,7 +134,9 @@ impl PointDecoder {
     /// Decodes the next point into `out` (its point-14 fields); returns
     /// whether the scanner channel changed at this point.
     pub(super) fn next(&mut self, l: &mut Layers<'_>, out: &mut Point14) -> Step<bool> {
-        let mut ch = self.channels[self.current].take().ok_or(super::arithmetic::Exhausted)?;
+        let mut ch = self.channels[self.current]
+            .take()
+            .ok_or(super::arithmetic::Fault::Ended)?;
         let lpr = usize::from(ch.last.return_number == 1)
             + 2 * usize::from(ch.last.return_number >= ch.last.number_of_returns)
             + 4 * usize::from(ch.time_changed);
@@ -176,7 +178,9 @@ fn decode_fields(ch: &mut Channel, changes: u32, l: &mut Layers<'_>) -> Step<()>
         0 => last_r,
         1 => (last_r + 1) % 16,
         2 => (last_r + 15) % 16,
-        _ if time_changed => l.xy.symbol(lazy(&mut ch.return_number[usize::from(last_r)], 16))? as u8,
+        _ if time_changed => {
+            l.xy.symbol(lazy(&mut ch.return_number[usize::from(last_r)], 16))? as u8
+        }
         _ => {
             let s = l.xy.symbol(&mut ch.return_same_time)? as u8;
             (last_r + s + 2) % 16
@@ -219,7 +223,9 @@ fn decode_fields(ch: &mut Channel, changes: u32, l: &mut Layers<'_>) -> Step<()>
     }
     if let Some(dec) = &mut l.intensity {
         let idx = (cpr << 1) | time;
-        let v = ch.iintensity.decode(dec, i32::from(ch.intensities[idx]), cpr)?;
+        let v = ch
+            .iintensity
+            .decode(dec, i32::from(ch.intensities[idx]), cpr)?;
         ch.last.intensity = v as u16;
         ch.intensities[idx] = ch.last.intensity;
     }
@@ -232,7 +238,9 @@ fn decode_fields(ch: &mut Channel, changes: u32, l: &mut Layers<'_>) -> Step<()>
         ch.last.user_data = dec.symbol(model)? as u8;
     }
     if let (Some(dec), true) = (&mut l.point_source, source_changed) {
-        let v = ch.isource.decode(dec, i32::from(ch.last.point_source_id), 0)?;
+        let v = ch
+            .isource
+            .decode(dec, i32::from(ch.last.point_source_id), 0)?;
         ch.last.point_source_id = v as u16;
     }
     ch.time_changed = time_changed;
