@@ -428,6 +428,28 @@ fn quietly<T>(f: impl FnOnce() -> T) -> Option<T> {
     result
 }
 
+/// The extra columns of a point format: the fields every format has, then
+/// GPS time, colour and NIR when it has them.
+fn column_names(gps_time: bool, color: bool, nir: bool) -> Vec<&'static str> {
+    let mut names = vec![
+        "intensity",
+        "return_number",
+        "number_of_returns",
+        "classification",
+        "point_source_id",
+    ];
+    if gps_time {
+        names.push("gps_time");
+    }
+    if color {
+        names.extend(["red", "green", "blue"]);
+    }
+    if nir {
+        names.push("nir");
+    }
+    names
+}
+
 /// Columns read from the crate.
 #[derive(Default)]
 struct Decoded {
@@ -472,22 +494,7 @@ fn read_with_crate(path: &Path, bytes: Vec<u8>, raw: &Raw) -> Result<Decoded> {
             ),
         });
     }
-    let mut names = vec![
-        "intensity",
-        "return_number",
-        "number_of_returns",
-        "classification",
-        "point_source_id",
-    ];
-    if fmt.has_gps_time {
-        names.push("gps_time");
-    }
-    if fmt.has_color {
-        names.extend(["red", "green", "blue"]);
-    }
-    if fmt.has_nir {
-        names.push("nir");
-    }
+    let names = column_names(fmt.has_gps_time, fmt.has_color, fmt.has_nir);
     let cap = capacity(n, (avail / record) as usize).min(1 << 24);
     let mut points = Vec::with_capacity(cap);
     let mut columns = vec![Vec::with_capacity(cap); names.len()];

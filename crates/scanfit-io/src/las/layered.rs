@@ -8,7 +8,7 @@ use std::path::Path;
 
 use scanfit::Point3;
 
-use super::{u64_at, Decoded, Layered, Raw};
+use super::{column_names, u64_at, Decoded, Layered, Raw};
 use crate::laz14::{LayeredLaz, Laz14Error, Point14};
 use crate::table::capacity;
 use crate::{Error, Result};
@@ -63,20 +63,7 @@ pub(super) fn read_layered(
         };
         *t = (f64::from_bits(scale), f64::from_bits(offset));
     }
-    let mut names = vec![
-        "intensity",
-        "return_number",
-        "number_of_returns",
-        "classification",
-        "point_source_id",
-        "gps_time",
-    ];
-    if rgb {
-        names.extend(["red", "green", "blue"]);
-    }
-    if nir {
-        names.push("nir");
-    }
+    let names = column_names(true, rgb, nir);
     let cap = capacity(layered.count, bytes.len()).min(1 << 24);
     let mut points = Vec::with_capacity(cap);
     let mut columns = vec![Vec::with_capacity(cap); names.len()];

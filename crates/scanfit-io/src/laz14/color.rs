@@ -105,50 +105,48 @@ impl RgbDecoder {
 }
 
 /// One colour: which bytes changed, then red's bytes as differences, and
-/// green's and blue's as differences from red's change (when not grey).
+/// green's and blue's as differences from red's change (when not grey),
+/// byte plane by byte plane (low byte: plane 0, high byte: plane 1).
 fn decode_rgb(dec: &mut Decoder<'_>, m: &mut RgbModels, last: [u16; 3]) -> Step<[u16; 3]> {
     let used = dec.symbol(&mut m.used)?;
-    let [lr, lg, lb] = last;
-    let mut byte = |k: usize, base: u8, dec: &mut Decoder<'_>| -> Step<u16> {
+    let byte = |v: u16, plane: usize| (v >> (8 * plane)) as u8;
+    // model k (0-5) = red low, red high, green low, green high, blue low,
+    // blue high; `base` plus the decoded difference, or `base` unchanged
+    let mut next = |k: usize, base: u8, dec: &mut Decoder<'_>| -> Step<u8> {
         if used & (1 << k) != 0 {
-            Ok(u16::from(
-                (dec.symbol(&mut m.bytes[k])? as u8).wrapping_add(base),
-            ))
+            Ok((dec.symbol(&mut m.bytes[k])? as u8).wrapping_add(base))
         } else {
-            Ok(u16::from(base))
+            Ok(base)
         }
     };
-    let red_lo = byte(0, lo(lr), dec)?;
-    let red_hi = byte(1, hi(lr), dec)?;
-    let red = red_lo | (red_hi << 8);
+    let mut out = [[0u8; 2]; 3];
+    for plane in 0..2 {
+        out[0][plane] = next(plane, byte(last[0], plane), dec)?;
+    }
+    let red = u16::from_le_bytes(out[0]);
     if used & (1 << 6) == 0 {
         return Ok([red, red, red]);
     }
-    let d = i32::from(lo(red)) - i32::from(lo(lr));
-    let green_lo = if used & (1 << 2) != 0 {
-        byte(2, clamp_u8(d + i32::from(lo(lg))), dec)?
-    } else {
-        u16::from(lo(lg))
-    };
-    let blue_lo = if used & (1 << 4) != 0 {
-        let d = (d + i32::from(green_lo as u8) - i32::from(lo(lg))) / 2;
-        byte(4, clamp_u8(d + i32::from(lo(lb))), dec)?
-    } else {
-        u16::from(lo(lb))
-    };
-    let d = i32::from(hi(red)) - i32::from(hi(lr));
-    let green_hi = if used & (1 << 3) != 0 {
-        byte(3, clamp_u8(d + i32::from(hi(lg))), dec)?
-    } else {
-        u16::from(hi(lg))
-    };
-    let blue_hi = if used & (1 << 5) != 0 {
-        let d = (d + i32::from(green_hi as u8) - i32::from(hi(lg))) / 2;
-        byte(5, clamp_u8(d + i32::from(hi(lb))), dec)?
-    } else {
-        u16::from(hi(lb))
-    };
-    Ok([red, green_lo | (green_hi << 8), blue_lo | (blue_hi << 8)])
+    for plane in 0..2 {
+        let (r, g, b) = (
+            byte(last[0], plane),
+            byte(last[1], plane),
+            byte(last[2], plane),
+        );
+        let d = i32::from(out[0][plane]) - i32::from(r);
+        out[1][plane] = if used & (1 << (2 + plane)) != 0 {
+            next(2 + plane, clamp_u8(d + i32::from(g)), dec)?
+        } else {
+            g
+        };
+        out[2][plane] = if used & (1 << (4 + plane)) != 0 {
+            let d = (d + i32::from(out[1][plane]) - i32::from(g)) / 2;
+            next(4 + plane, clamp_u8(d + i32::from(b)), dec)?
+        } else {
+            b
+        };
+    }
+    Ok(out.map(u16::from_le_bytes))
 }
 
 struct NirModels {
