@@ -16,7 +16,7 @@ use scanfit_io::{parse_cloud, ReadOptions};
 
 #[path = "support/laz_gen.rs"]
 mod laz_gen;
-use laz_gen::{compress, fields, laz_decode, ours, record_len, records, Chunks};
+use laz_gen::{compress, fields, laz_decode, ours, record_len, records, table_end, Chunks, Rng};
 
 fn same(a: &[Point14], b: &[Point14], what: &str) {
     assert_eq!(a.len(), b.len(), "{what}: point counts");
@@ -97,39 +97,62 @@ fn many_seeds_of_format_8_match_laz() {
 /// las crate gives, value for value.
 #[test]
 fn the_reader_uses_the_decoder_and_matches_the_las_crate() {
+    for format in [6, 7, 8] {
+        reader_matches_the_las_crate(format);
+    }
+}
+
+fn reader_matches_the_las_crate(format: u8) {
     let n = 3000;
-    let raw = records(7, n, 88);
-    let f = compress(7, false, Chunks::Fixed(1000), &raw);
+    let raw = records(format, n, 88);
+    let f = compress(format, false, Chunks::Fixed(1000), &raw);
     let table = parse_cloud(Path::new("f.laz"), &f.bytes, &ReadOptions::default()).unwrap();
     let mut reader = las::Reader::new(Cursor::new(f.bytes.clone())).unwrap();
     let pd = reader.read_points(n as u64).unwrap();
     let points: Vec<las::Point> = pd.points().map(|p| p.unwrap()).collect();
     assert_eq!(table.points.len(), n);
-    let col = |name: &str| table.columns.iter().position(|c| c == name).unwrap() - 3;
+    let mut names: Vec<&str> = vec![
+        "intensity",
+        "return_number",
+        "number_of_returns",
+        "classification",
+        "point_source_id",
+        "gps_time",
+    ];
+    if format != 6 {
+        names.extend(["red", "green", "blue"]);
+    }
+    if format == 8 {
+        names.push("nir");
+    }
+    assert_eq!(table.columns[3..], names[..], "format {format}");
     for (k, p) in points.iter().enumerate() {
         let q = table.points[k];
         assert_eq!(
             (q.x.to_bits(), q.y.to_bits(), q.z.to_bits()),
             (p.x.to_bits(), p.y.to_bits(), p.z.to_bits()),
-            "point {k}"
+            "format {format}, point {k}"
         );
-        let c = p.color.unwrap();
-        let expect = [
-            ("intensity", f64::from(p.intensity)),
-            ("return_number", f64::from(p.return_number)),
-            ("number_of_returns", f64::from(p.number_of_returns)),
-            ("classification", f64::from(u8::from(p.classification))),
-            ("point_source_id", f64::from(p.point_source_id)),
-            ("gps_time", p.gps_time.unwrap()),
-            ("red", f64::from(c.red)),
-            ("green", f64::from(c.green)),
-            ("blue", f64::from(c.blue)),
+        let mut expect = vec![
+            f64::from(p.intensity),
+            f64::from(p.return_number),
+            f64::from(p.number_of_returns),
+            f64::from(u8::from(p.classification)),
+            f64::from(p.point_source_id),
+            p.gps_time.unwrap(),
         ];
-        for (name, v) in expect {
+        if let Some(c) = p.color {
+            expect.extend([f64::from(c.red), f64::from(c.green), f64::from(c.blue)]);
+        }
+        if let Some(nir) = p.nir {
+            expect.push(f64::from(nir));
+        }
+        for (c, v) in expect.iter().enumerate() {
             assert_eq!(
-                table.extra[col(name)][k].to_bits(),
+                table.extra[c][k].to_bits(),
                 v.to_bits(),
-                "point {k}, {name}"
+                "format {format}, point {k}, {}",
+                names[c]
             );
         }
     }
@@ -175,4 +198,29 @@ fn the_gps_time_recursion_input_is_a_clear_error() {
 
 fn u32_le(b: &[u8], at: usize) -> u32 {
     u32::from_le_bytes(b[at..at + 4].try_into().unwrap())
+}
+
+/// Damaged layers (random bytes changed anywhere in the compressed data of
+/// a format 8 file) give an error or points, never a panic, and the
+/// decoder reports the chunk it failed in.
+#[test]
+fn damaged_chunks_are_errors_never_panics() {
+    let raw = records(8, 900, 5);
+    let f = compress(8, false, Chunks::Fixed(300), &raw);
+    let (from, to) = (f.start + 8, table_end(&f));
+    let mut rng = Rng(99);
+    let mut errors = 0;
+    for _ in 0..200 {
+        let mut b = f.bytes.clone();
+        for _ in 0..1 + rng.below(6) {
+            let at = (from + rng.below(to - from)) as usize;
+            b[at] = rng.below(256) as u8;
+        }
+        if let Err(e) = parse_cloud(Path::new("f.laz"), &b, &ReadOptions::default()) {
+            let e = e.to_string();
+            assert!(e.contains("chunk"), "{e}");
+            errors += 1;
+        }
+    }
+    assert!(errors > 0);
 }

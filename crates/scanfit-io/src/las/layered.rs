@@ -6,6 +6,7 @@
 
 use std::path::Path;
 
+use rayon::prelude::*;
 use scanfit::Point3;
 
 use super::{column_names, u64_at, Decoded, Layered, Raw};
@@ -67,33 +68,44 @@ pub(super) fn read_layered(
     let cap = capacity(layered.count, bytes.len()).min(1 << 24);
     let mut points = Vec::with_capacity(cap);
     let mut columns = vec![Vec::with_capacity(cap); names.len()];
-    let mut chunk: Vec<Point14> = Vec::new();
-    for c in 0..file.chunks().len() {
-        chunk.clear();
-        file.decode_chunk(c, &mut chunk).map_err(binary)?;
-        let at = |v: i32, k: usize| transform[k].0 * f64::from(v) + transform[k].1;
-        points.extend(
-            chunk
-                .iter()
-                .map(|p| Point3::new(at(p.x, 0), at(p.y, 1), at(p.z, 2))),
-        );
-        let fields: [&dyn Fn(&Point14) -> f64; 10] = [
-            &|p| f64::from(p.intensity),
-            &|p| f64::from(p.return_number),
-            &|p| f64::from(p.number_of_returns),
-            &|p| f64::from(p.classification),
-            &|p| f64::from(p.point_source_id),
-            &|p| p.gps_time,
-            &|p| f64::from(p.rgb[0]),
-            &|p| f64::from(p.rgb[1]),
-            &|p| f64::from(p.rgb[2]),
-            &|p| f64::from(p.nir),
-        ];
-        let used = [true, true, true, true, true, true, rgb, rgb, rgb, nir];
-        let mut column = columns.iter_mut();
-        for (f, _) in fields.iter().zip(used).filter(|(_, u)| *u) {
-            if let Some(col) = column.next() {
-                col.extend(chunk.iter().map(f));
+    let at = |v: i32, k: usize| transform[k].0 * f64::from(v) + transform[k].1;
+    let fields: [&(dyn Fn(&Point14) -> f64 + Sync); 10] = [
+        &|p| f64::from(p.intensity),
+        &|p| f64::from(p.return_number),
+        &|p| f64::from(p.number_of_returns),
+        &|p| f64::from(p.classification),
+        &|p| f64::from(p.point_source_id),
+        &|p| p.gps_time,
+        &|p| f64::from(p.rgb[0]),
+        &|p| f64::from(p.rgb[1]),
+        &|p| f64::from(p.rgb[2]),
+        &|p| f64::from(p.nir),
+    ];
+    let used = [true, true, true, true, true, true, rgb, rgb, rgb, nir];
+    // chunks are independent: decode a few per thread at a time, append in
+    // file order (the first damaged chunk in file order is the error)
+    let group = 2 * rayon::current_num_threads().max(1);
+    let count = file.chunks().len();
+    for first in (0..count).step_by(group) {
+        let decoded: Vec<_> = (first..(first + group).min(count))
+            .into_par_iter()
+            .map(|c| {
+                let mut chunk = Vec::new();
+                file.decode_chunk(c, &mut chunk).map(|()| chunk)
+            })
+            .collect();
+        for chunk in decoded {
+            let chunk = chunk.map_err(binary)?;
+            points.extend(
+                chunk
+                    .iter()
+                    .map(|p| Point3::new(at(p.x, 0), at(p.y, 1), at(p.z, 2))),
+            );
+            let mut column = columns.iter_mut();
+            for (f, _) in fields.iter().zip(used).filter(|(_, u)| *u) {
+                if let Some(col) = column.next() {
+                    col.extend(chunk.iter().map(f));
+                }
             }
         }
     }

@@ -11,15 +11,15 @@ use laz::{LasZipCompressor, LasZipDecompressor, LazItemRecordBuilder, LazVlr, La
 use scanfit_io::laz14::{LayeredLaz, Point14};
 
 /// xorshift64*: deterministic test data
-struct Rng(u64);
+pub struct Rng(pub u64);
 impl Rng {
-    fn next(&mut self) -> u64 {
+    pub fn next(&mut self) -> u64 {
         self.0 ^= self.0 >> 12;
         self.0 ^= self.0 << 25;
         self.0 ^= self.0 >> 27;
         self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
     }
-    fn below(&mut self, n: u64) -> u64 {
+    pub fn below(&mut self, n: u64) -> u64 {
         self.next() % n
     }
     fn chance(&mut self, percent: u64) -> bool {
