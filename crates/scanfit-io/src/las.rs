@@ -319,6 +319,17 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<Option<Layered>> {
             u16_at(vlr, 38).unwrap_or(0)
         )));
     }
+    // LAZ cannot compress a record below a few bits: a count beyond this is
+    // a damaged header, not data (both decoders produce points from almost
+    // no bytes on damaged data, so this bounds their output)
+    if count / 64 > len {
+        return Err(Error::Invalid {
+            path: path.to_path_buf(),
+            message: format!(
+                "the header declares {count} points, more than {len} compressed bytes can hold; the file is damaged"
+            ),
+        });
+    }
     if compressor != 3 {
         return Ok(None);
     }
@@ -481,16 +492,6 @@ fn read_with_crate(path: &Path, bytes: Vec<u8>, raw: &Raw) -> Result<Decoded> {
             message: format!(
                 "the header declares {n} point records of {record} bytes, but only {avail} bytes follow: {} complete records; the file is truncated or its point count is wrong",
                 avail / record
-            ),
-        });
-    }
-    // LAZ cannot compress a record below a few bits: a count beyond this is
-    // a damaged header, not data
-    if raw.compressed && n / 64 > total {
-        return Err(Error::Invalid {
-            path: path.to_path_buf(),
-            message: format!(
-                "the header declares {n} points, more than {total} compressed bytes can hold; the file is damaged"
             ),
         });
     }
