@@ -232,8 +232,12 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<Option<Layered>> {
         at = data + u64::from(length);
     }
     let Some((vlr_at, vlr_len)) = laz else {
-        // the crate reports a missing LASzip VLR itself
-        return Ok(None);
+        // refused here: the crate may look for VLRs elsewhere (a header
+        // size below the version's makes it read them after the full
+        // header) and then trust a chunk table this walk never checked
+        return Err(binary(header_size, format!(
+            "the point format is compressed (LAZ), but none of the {vlrs} VLRs that follow the {header_size}-byte header is the LASzip VLR; the file is damaged"
+        )));
     };
     let Some(vlr) = usize::try_from(vlr_at)
         .ok()
