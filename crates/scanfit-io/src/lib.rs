@@ -18,6 +18,7 @@ pub mod gltf;
 pub mod iges;
 pub mod json;
 mod las;
+pub mod laz14;
 mod mesh;
 pub mod model;
 mod obj;
