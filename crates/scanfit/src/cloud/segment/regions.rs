@@ -4,32 +4,10 @@
 
 use rayon::prelude::*;
 
+use crate::cloud::forest::Forest;
 use crate::cloud::neighbours::Neighbourhoods;
 use crate::spatial::KdTree;
 use crate::{Point3, Result, Vector3};
-
-/// Disjoint sets over point indices (path halving, union by index so the
-/// result does not depend on the order the unions arrive in).
-struct Forest(Vec<u32>);
-
-impl Forest {
-    fn root(&mut self, mut i: u32) -> u32 {
-        while self.0[i as usize] != i {
-            let up = self.0[self.0[i as usize] as usize];
-            self.0[i as usize] = up;
-            i = up;
-        }
-        i
-    }
-
-    fn join(&mut self, a: u32, b: u32) {
-        let (ra, rb) = (self.root(a), self.root(b));
-        if ra != rb {
-            let (lo, hi) = (ra.min(rb), ra.max(rb));
-            self.0[hi as usize] = lo;
-        }
-    }
-}
 
 /// Connected components of the points with `open[i]`, over the first `k`
 /// neighbours of each point in `graph`, joining two neighbours only when
@@ -43,10 +21,27 @@ pub fn grow(
     normals: &[Vector3],
     max_angle: f64,
 ) -> Vec<u32> {
+    let order: Vec<u32> = (0..open.len() as u32).collect();
+    grow_in(graph, k, open, normals, max_angle, &order)
+}
+
+/// [`grow`] with the points visited in `order` (a permutation; the cloud's
+/// Morton order keeps the forest's and the normals' entries of neighbouring
+/// points in the cache). The regions do not depend on it: the unions join
+/// by index.
+pub(crate) fn grow_in(
+    graph: &Neighbourhoods,
+    k: usize,
+    open: &[bool],
+    normals: &[Vector3],
+    max_angle: f64,
+    order: &[u32],
+) -> Vec<u32> {
     let n = open.len();
     let cos = max_angle.cos();
-    let mut forest = Forest((0..n as u32).collect());
-    for i in 0..n {
+    let mut forest = Forest::new(n);
+    for &i in order {
+        let i = i as usize;
         if !open[i] {
             continue;
         }
