@@ -22,7 +22,8 @@ pub struct Neighbourhoods {
     pub k: usize,
     /// `k` indices per row.
     pub indices: Vec<u32>,
-    /// `k` distances per row.
+    /// `k` distances per row (empty for a graph built without them,
+    /// [`PointCloud::knn_graph_indices`]).
     pub distances: Vec<f64>,
 }
 
@@ -42,9 +43,11 @@ impl Neighbourhoods {
         &self.indices[i * self.k..(i + 1) * self.k]
     }
 
-    /// Distances of row `i`.
+    /// Distances of row `i` (empty for a graph built without them).
     pub fn distances_of(&self, i: usize) -> &[f64] {
-        &self.distances[i * self.k..(i + 1) * self.k]
+        self.distances
+            .get(i * self.k..(i + 1) * self.k)
+            .unwrap_or(&[])
     }
 }
 
@@ -123,7 +126,7 @@ impl PointCloud {
         let tree = self.tree()?;
         let k = kq.get().min(self.points.len());
         let order = morton_order(queries);
-        Ok(rows(tree, queries, &order, kq, k, None))
+        Ok(rows(tree, queries, &order, kq, k))
     }
 
     /// The `k` nearest *other* points of every point of the cloud (the point
@@ -138,42 +141,56 @@ impl PointCloud {
             });
         }
         let k = checked_k(k)?.get().min(self.points.len() - 1);
-        let tree = self.tree()?;
-        let order = tree.spatial_order(&self.points);
-        let kq = NonZeroUsize::new(k + 1).unwrap_or(NonZeroUsize::MIN);
-        Ok(rows(tree, &self.points, order, kq, k, Some(())))
+        let (indices, distances) = self.tree()?.graph_rows(k);
+        Ok(Neighbourhoods {
+            k,
+            indices,
+            distances,
+        })
+    }
+
+    /// [`PointCloud::knn_graph`] without the distances (`distances` empty):
+    /// the same rows in a third of the memory, for the normals, which need
+    /// only who the neighbours are.
+    ///
+    /// ```
+    /// use scanfit::{Point3, PointCloud};
+    /// let pts = (0..50).map(|i| Point3::new(i as f64, (i * i % 7) as f64, 0.0)).collect();
+    /// let cloud = PointCloud::new(pts)?;
+    /// let (g, h) = (cloud.knn_graph(6)?, cloud.knn_graph_indices(6)?);
+    /// assert_eq!((g.indices, h.k, h.distances.len()), (h.indices, 6, 0));
+    /// # Ok::<(), scanfit::Error>(())
+    /// ```
+    pub fn knn_graph_indices(&self, k: usize) -> Result<Neighbourhoods> {
+        if self.points.len() < 2 {
+            return Err(Error::TooFewPoints {
+                got: self.points.len(),
+                needed: 2,
+                what: "a neighbour graph".into(),
+            });
+        }
+        let k = checked_k(k)?.get().min(self.points.len() - 1);
+        Ok(Neighbourhoods {
+            k,
+            indices: self.tree()?.graph_indices(k),
+            distances: Vec::new(),
+        })
     }
 }
 
 /// The rows of `k` neighbours of `queries` (asking the tree for `kq`),
-/// computed in `order`. With `skip_self` the queries are the indexed points
-/// themselves and each row drops the query point (or, among duplicates, one
-/// copy of it; the last neighbour when the point is not among the `kq`).
+/// computed in `order`.
 fn rows(
     tree: &KdTree,
     queries: &[Point3],
     order: &[u32],
     kq: NonZeroUsize,
     k: usize,
-    skip_self: Option<()>,
 ) -> Neighbourhoods {
     let mut indices = vec![0u32; queries.len() * k];
     let mut distances = vec![0.0; queries.len() * k];
     fill_rows_in_order(order, k, &mut indices, &mut distances, |i, idx, dist| {
-        let found = tree.nearest_n(&queries[i], kq);
-        let skip = match skip_self {
-            Some(()) => found
-                .iter()
-                .position(|n| n.index == i)
-                .unwrap_or(found.len() - 1),
-            None => usize::MAX,
-        };
-        let kept = found
-            .iter()
-            .enumerate()
-            .filter(|&(j, _)| j != skip)
-            .map(|(_, n)| n);
-        for (j, n) in kept.take(k).enumerate() {
+        for (j, n) in tree.nearest_n(&queries[i], kq).into_iter().take(k).enumerate() {
             idx[j] = n.index as u32;
             dist[j] = n.distance;
         }
@@ -377,7 +394,7 @@ mod tests {
         d
     }
 
-    /// The batch and graph queries run in Morton order; every row is still
+    /// The batch and graph queries run in a spatial order (Morton, tree); every row is still
     /// exactly the tree's answer for its own point, in input order (here a
     /// cloud in random order, over several chunks of work).
     #[test]

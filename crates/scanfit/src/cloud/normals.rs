@@ -108,7 +108,7 @@ pub fn estimate_normals(cloud: &PointCloud, config: &NormalsConfig) -> Result<No
             what: "normal estimation".into(),
         });
     }
-    let graph = cloud.knn_graph(config.k)?;
+    let graph = cloud.knn_graph_indices(config.k)?;
     estimate_normals_on(cloud, &graph, config)
 }
 
@@ -141,9 +141,9 @@ pub fn estimate_normals_on(
     }
     let points = cloud.points();
     let scale = cloud.diagonal();
-    // visited along the Morton curve: a point's neighbours are in the cache
+    // visited in the tree order: a point's neighbours are in the cache
     // from its predecessor's
-    let order = cloud.tree()?.spatial_order(points);
+    let order = cloud.tree()?.spatial_order();
     let per_point: Vec<(Vector3, f64, bool)> = map_in_order(order, |i| {
             let nb = graph.indices_of(i);
             let hood = std::iter::once(&points[i]).chain(nb.iter().map(|&j| &points[j as usize]));

@@ -185,7 +185,7 @@ pub fn segment(cloud: &PointCloud, cfg: &SegmentConfig) -> Result<Segmentation> 
     let min_cell = cfg.min_cell * spacing;
     let max_angle = cfg.max_angle_deg.to_radians();
     let points = cloud.points();
-    let order = cloud.tree()?.spatial_order(points);
+    let order = cloud.tree()?.spatial_order();
     let variation = octree::neighbour_variation_in(&graph, &normals, order);
     let tree = octree::subdivide(points, &variation, min_cell, max_angle);
     let edge: Vec<bool> = tree

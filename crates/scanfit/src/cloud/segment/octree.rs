@@ -53,7 +53,7 @@ pub fn neighbour_variation(graph: &Neighbourhoods, normals: &[Vector3]) -> Vec<f
 }
 
 /// [`neighbour_variation`] with the points visited in `order` (a
-/// permutation of the points: the cloud's Morton order keeps the neighbours'
+/// permutation of the points: the tree order keeps the neighbours'
 /// normals in the cache); the result does not depend on it.
 pub(crate) fn neighbour_variation_in(
     graph: &Neighbourhoods,

@@ -6,7 +6,7 @@ use rayon::prelude::*;
 
 use crate::cloud::forest::Forest;
 use crate::cloud::neighbours::Neighbourhoods;
-use crate::spatial::KdTree;
+use crate::spatial::{map_in_order, KdTree};
 use crate::{Point3, Result, Vector3};
 
 /// Connected components of the points with `open[i]`, over the first `k`
@@ -25,8 +25,8 @@ pub fn grow(
     grow_in(graph, k, open, normals, max_angle, &order)
 }
 
-/// [`grow`] with the points visited in `order` (a permutation; the cloud's
-/// Morton order keeps the forest's and the normals' entries of neighbouring
+/// [`grow`] with the points visited in `order` (a permutation; the tree order
+/// keeps the forest's and the normals' entries of neighbouring
 /// points in the cache). The regions do not depend on it: the unions join
 /// by index.
 pub(crate) fn grow_in(
@@ -39,15 +39,33 @@ pub(crate) fn grow_in(
 ) -> Vec<u32> {
     let n = open.len();
     let cos = max_angle.cos();
+    let joins = |i: usize, t: usize, j: u32| {
+        t < k && open[i] && open[j as usize] && normals[i].dot(&normals[j as usize]).abs() >= cos
+    };
     let mut forest = Forest::new(n);
-    for &i in order {
-        let i = i as usize;
-        if !open[i] {
-            continue;
+    if k <= 64 {
+        // which of its first k neighbours each point joins, in parallel (the
+        // normals' reads dominate); the unions then run serially
+        let masks: Vec<u64> = map_in_order(order, |i| {
+            let row = graph.indices_of(i).iter().enumerate();
+            row.filter(|&(t, &j)| joins(i, t, j))
+                .fold(0u64, |m, (t, _)| m | 1 << t)
+        });
+        for &i in order {
+            let (i, mut m) = (i as usize, masks[i as usize]);
+            while m != 0 {
+                let t = m.trailing_zeros() as usize;
+                forest.join(i as u32, graph.indices_of(i)[t]);
+                m &= m - 1;
+            }
         }
-        for &j in graph.indices_of(i).iter().take(k) {
-            if open[j as usize] && normals[i].dot(&normals[j as usize]).abs() >= cos {
-                forest.join(i as u32, j);
+    } else {
+        for &i in order {
+            let i = i as usize;
+            for (t, &j) in graph.indices_of(i).iter().enumerate() {
+                if joins(i, t, j) {
+                    forest.join(i as u32, j);
+                }
             }
         }
     }
