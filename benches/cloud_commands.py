@@ -136,7 +136,8 @@ def run_once(binary, args, d):
     if p.returncode != 0:
         sys.exit(f"{' '.join(args)} failed:\n{p.stderr}")
     rss = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", p.stderr).group(1))
-    return wall, rss / 1000.0, load, p.stdout
+    cpu = sum(float(re.search(rf"{k} time \(seconds\): ([0-9.]+)", p.stderr).group(1)) for k in ("User", "System"))
+    return wall, rss / 1000.0, load, p.stdout, cpu
 
 
 def main():
@@ -148,8 +149,8 @@ def main():
     ap.add_argument("--show", action="store_true", help="print each command's output")
     a = ap.parse_args()
     make_inputs(a.dir)
-    print("| command | median wall (s) | runs (s) | peak RSS (MB) | load average before |")
-    print("|---|---:|---|---:|---|")
+    print("| command | median wall (s) | runs (s) | CPU user+sys (s) | peak RSS (MB) | load average before |")
+    print("|---|---:|---|---|---:|---|")
     for key in a.only.split(","):
         args = COMMANDS[key]
         runs = [run_once(a.binary, args, a.dir) for _ in range(a.repeats)]
@@ -158,7 +159,8 @@ def main():
         walls = [r[0] for r in runs]
         print(
             f"| `scanfit {' '.join(args)}` | **{statistics.median(walls):.2f}** | "
-            f"{', '.join(f'{w:.2f}' for w in walls)} | {max(r[1] for r in runs):.0f} | "
+            f"{', '.join(f'{w:.2f}' for w in walls)} | {', '.join(f'{r[4]:.2f}' for r in runs)} | "
+            f"{max(r[1] for r in runs):.0f} | "
             f"{', '.join(f'{r[2]:.1f}' for r in runs)} |",
             flush=True,
         )

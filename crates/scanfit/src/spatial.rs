@@ -487,8 +487,14 @@ pub(crate) fn fill_rows_in_order<A, B, F>(
 
 /// [`fill_rows_in_order`] with the row of the work item `work[t]` stored
 /// at item `place[t]` (`fill` gets the work item).
-fn fill_rows_at<A, B, F>(work: &[u32], place: &[u32], width: usize, a: &mut [A], b: &mut [B], fill: F)
-where
+fn fill_rows_at<A, B, F>(
+    work: &[u32],
+    place: &[u32],
+    width: usize,
+    a: &mut [A],
+    b: &mut [B],
+    fill: F,
+) where
     A: Copy + Default + Send,
     B: Copy + Default + Send,
     F: Fn(usize, &mut [A], &mut [B]) + Sync,
@@ -574,7 +580,9 @@ mod tests {
         use kiddo::{ImmutableKdTree, SquaredEuclidean};
         let mut rng = crate::testdata::Lcg::new(17);
         let mut rnd = || rng.next_f64();
-        let random: Vec<Point3> = (0..20_000).map(|_| Point3::new(rnd(), rnd(), 0.2 * rnd())).collect();
+        let random: Vec<Point3> = (0..20_000)
+            .map(|_| Point3::new(rnd(), rnd(), 0.2 * rnd()))
+            .collect();
         let grid: Vec<Point3> = (0..4000)
             .map(|i| Point3::new((i % 20) as f64, (i / 20 % 20) as f64, (i / 400) as f64))
             .collect();
@@ -598,12 +606,22 @@ mod tests {
                     assert_eq!(x.distance, y.distance.sqrt(), "query {qi}");
                 }
                 // where the k-th distance does not tie, the same points
-                let mut sa: Vec<usize> = a.iter().filter(|n| n.distance < last).map(|n| n.index).collect();
-                let mut sb: Vec<usize> = b.iter().filter(|n| n.distance.sqrt() < last).map(|n| n.item as usize).collect();
+                let mut sa: Vec<usize> = a
+                    .iter()
+                    .filter(|n| n.distance < last)
+                    .map(|n| n.index)
+                    .collect();
+                let mut sb: Vec<usize> = b
+                    .iter()
+                    .filter(|n| n.distance.sqrt() < last)
+                    .map(|n| n.item as usize)
+                    .collect();
                 sa.sort_unstable();
                 sb.sort_unstable();
                 assert_eq!(sa, sb, "query {qi}");
-                assert!(a.windows(2).all(|w| (w[0].distance, w[0].index) < (w[1].distance, w[1].index)));
+                assert!(a
+                    .windows(2)
+                    .all(|w| (w[0].distance, w[0].index) < (w[1].distance, w[1].index)));
                 assert_eq!(ours.nearest(&q).index, a[0].index);
             }
         }
@@ -637,7 +655,12 @@ mod tests {
                 / (o.len() - 1) as f64
         };
         let input: Vec<u32> = (0..pts.len() as u32).collect();
-        assert!(step(&order) < 0.2 * step(&input), "{} vs {}", step(&order), step(&input));
+        assert!(
+            step(&order) < 0.2 * step(&input),
+            "{} vs {}",
+            step(&order),
+            step(&input)
+        );
         assert!(morton_order(&[]).is_empty());
         assert_eq!(morton_order(&[Point3::origin(); 3]), [0, 1, 2]);
     }
@@ -656,7 +679,10 @@ mod tests {
             assert_eq!(a[2 * i..2 * i + 2], [i as u32, 2 * i as u32]);
             assert_eq!(b[2 * i..2 * i + 2], [i as f64 / 2.0, -(i as f64)]);
         }
-        assert_eq!(map_in_order(&order, |i| i * i), (0..n).map(|i| i * i).collect::<Vec<_>>());
+        assert_eq!(
+            map_in_order(&order, |i| i * i),
+            (0..n).map(|i| i * i).collect::<Vec<_>>()
+        );
     }
 
     #[test]

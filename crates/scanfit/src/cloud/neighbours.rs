@@ -10,8 +10,8 @@ use std::num::NonZeroUsize;
 use rayon::prelude::*;
 
 use super::PointCloud;
-use crate::spatial::{fill_rows_in_order, morton_order, KdTree};
 pub use crate::spatial::Neighbour;
+use crate::spatial::{fill_rows_in_order, morton_order, KdTree};
 use crate::{Error, Point3, Result};
 
 /// The k nearest neighbours of many points, stored flat: row `i` holds the
@@ -190,7 +190,12 @@ fn rows(
     let mut indices = vec![0u32; queries.len() * k];
     let mut distances = vec![0.0; queries.len() * k];
     fill_rows_in_order(order, k, &mut indices, &mut distances, |i, idx, dist| {
-        for (j, n) in tree.nearest_n(&queries[i], kq).into_iter().take(k).enumerate() {
+        for (j, n) in tree
+            .nearest_n(&queries[i], kq)
+            .into_iter()
+            .take(k)
+            .enumerate()
+        {
             idx[j] = n.index as u32;
             dist[j] = n.distance;
         }
@@ -404,20 +409,37 @@ mod tests {
             .map(|_| Point3::new(rng.next_f64(), rng.next_f64(), 0.1 * rng.next_f64()))
             .collect();
         let cloud = PointCloud::new(pts.clone()).unwrap();
-        let qs: Vec<Point3> = pts.iter().rev().take(3000).map(|p| p + Vector3::repeat(0.01)).collect();
+        let qs: Vec<Point3> = pts
+            .iter()
+            .rev()
+            .take(3000)
+            .map(|p| p + Vector3::repeat(0.01))
+            .collect();
         let b = cloud.knn_batch(&qs, 6).unwrap();
         for (i, q) in qs.iter().enumerate() {
             let one = cloud.knn(q, 6).unwrap();
-            assert_eq!(b.indices_of(i), one.iter().map(|n| n.index as u32).collect::<Vec<_>>());
-            assert_eq!(b.distances_of(i), one.iter().map(|n| n.distance).collect::<Vec<_>>());
+            assert_eq!(
+                b.indices_of(i),
+                one.iter().map(|n| n.index as u32).collect::<Vec<_>>()
+            );
+            assert_eq!(
+                b.distances_of(i),
+                one.iter().map(|n| n.distance).collect::<Vec<_>>()
+            );
         }
         let g = cloud.knn_graph(5).unwrap();
         for (i, p) in pts.iter().enumerate() {
             let one: Vec<Neighbour> = cloud.knn(p, 6).unwrap();
             let rest: Vec<&Neighbour> = one.iter().filter(|n| n.index != i).collect();
             assert_eq!(rest.len(), 5);
-            assert_eq!(g.indices_of(i), rest.iter().map(|n| n.index as u32).collect::<Vec<_>>());
-            assert_eq!(g.distances_of(i), rest.iter().map(|n| n.distance).collect::<Vec<_>>());
+            assert_eq!(
+                g.indices_of(i),
+                rest.iter().map(|n| n.index as u32).collect::<Vec<_>>()
+            );
+            assert_eq!(
+                g.distances_of(i),
+                rest.iter().map(|n| n.distance).collect::<Vec<_>>()
+            );
         }
     }
 

@@ -28,8 +28,8 @@ use std::collections::BinaryHeap;
 
 use rayon::prelude::*;
 
-use super::neighbours::Neighbourhoods;
 use super::forest::Forest;
+use super::neighbours::Neighbourhoods;
 use super::PointCloud;
 use crate::spatial::map_in_order;
 use crate::{pca, Error, Point3, Result, Vector3};
@@ -145,22 +145,22 @@ pub fn estimate_normals_on(
     // from its predecessor's
     let order = cloud.tree()?.spatial_order();
     let per_point: Vec<(Vector3, f64, bool)> = map_in_order(order, |i| {
-            let nb = graph.indices_of(i);
-            let hood = std::iter::once(&points[i]).chain(nb.iter().map(|&j| &points[j as usize]));
-            match pca(hood) {
-                Some(p) => {
-                    let flat = p.values[1] <= 1e-24 * scale * scale;
-                    let n = if flat {
-                        // collinear neighbourhood: any perpendicular of the line
-                        p.axes[0].cross(&least_aligned_axis(&p.axes[0])).normalize()
-                    } else {
-                        p.axes[2]
-                    };
-                    (n, p.variation(), flat)
-                }
-                None => (Vector3::z(), 0.0, true),
+        let nb = graph.indices_of(i);
+        let hood = std::iter::once(&points[i]).chain(nb.iter().map(|&j| &points[j as usize]));
+        match pca(hood) {
+            Some(p) => {
+                let flat = p.values[1] <= 1e-24 * scale * scale;
+                let n = if flat {
+                    // collinear neighbourhood: any perpendicular of the line
+                    p.axes[0].cross(&least_aligned_axis(&p.axes[0])).normalize()
+                } else {
+                    p.axes[2]
+                };
+                (n, p.variation(), flat)
             }
-        });
+            None => (Vector3::z(), 0.0, true),
+        }
+    });
     let mut normals: Vec<Vector3> = per_point.iter().map(|t| t.0).collect();
     let variation = per_point.iter().map(|t| t.1).collect();
     let degenerate = (0..points.len()).filter(|&i| per_point[i].2).collect();
