@@ -8,9 +8,10 @@
 //! are sorted by distance, nearest first, ties by index (so no result
 //! depends on how the tree was built or on the order of the queries).
 //!
-//! The tree (Friedman, Bentley & Finkel 1977) splits each cell at the median
-//! along its widest side down to buckets of at most [`BUCKET`] points and
-//! keeps the points in its own depth-first order: a bucket's points lie side
+//! The tree (Friedman, Bentley & Finkel 1977) splits each cell (the
+//! bounding box cut by the splits above) at the median along its widest
+//! side down to buckets of at most [`BUCKET`] points and keeps the points
+//! in its own depth-first order: a bucket's points lie side
 //! by side in memory, and the tree order is a spatial order that batch work
 //! over all the points follows ([`KdTree::spatial_order`]). The search
 //! visits the nearer child first and skips a cell whose distance to the
@@ -124,17 +125,19 @@ impl Best {
 }
 
 /// Orders `items` into tree order, writing the splits of its inner cells
-/// (`split` and `axis` are the slices of the same positions).
-fn build(items: &mut [([f64; 3], u32)], split: &mut [f64], axis: &mut [u8]) {
+/// (`split` and `axis` are the slices of the same positions). `lo..hi` is
+/// the cell: the points' bounding box at the root, then the parent's cell
+/// cut at the split (no pass over the points per cell); the split axis is
+/// the cell's widest side.
+fn build(
+    items: &mut [([f64; 3], u32)],
+    split: &mut [f64],
+    axis: &mut [u8],
+    lo: [f64; 3],
+    hi: [f64; 3],
+) {
     if items.len() <= BUCKET {
         return;
-    }
-    let (mut lo, mut hi) = (items[0].0, items[0].0);
-    for (p, _) in items.iter() {
-        for a in 0..3 {
-            lo[a] = lo[a].min(p[a]);
-            hi[a] = hi[a].max(p[a]);
-        }
     }
     let mut ax = 0;
     for a in 1..3 {
@@ -144,16 +147,23 @@ fn build(items: &mut [([f64; 3], u32)], split: &mut [f64], axis: &mut [u8]) {
     }
     let mid = items.len() / 2;
     items.select_nth_unstable_by(mid, |x, y| x.0[ax].total_cmp(&y.0[ax]).then(x.1.cmp(&y.1)));
-    split[mid] = items[mid].0[ax];
+    let at = items[mid].0[ax];
+    split[mid] = at;
     axis[mid] = ax as u8;
+    let (mut below, mut above) = (hi, lo);
+    below[ax] = at;
+    above[ax] = at;
     let (il, ir) = items.split_at_mut(mid);
     let (sl, sr) = split.split_at_mut(mid);
     let (al, ar) = axis.split_at_mut(mid);
     if il.len() > 1 << 14 {
-        rayon::join(|| build(il, sl, al), || build(ir, sr, ar));
+        rayon::join(
+            || build(il, sl, al, lo, below),
+            || build(ir, sr, ar, above, hi),
+        );
     } else {
-        build(il, sl, al);
-        build(ir, sr, ar);
+        build(il, sl, al, lo, below);
+        build(ir, sr, ar, above, hi);
     }
 }
 
@@ -198,7 +208,16 @@ impl KdTree {
             .collect();
         let n = items.len();
         let (mut split, mut axis) = (vec![0.0; n], vec![0u8; n]);
-        build(&mut items, &mut split, &mut axis);
+        let (lo, hi) = items
+            .iter()
+            .fold((items[0].0, items[0].0), |(mut lo, mut hi), (p, _)| {
+                for a in 0..3 {
+                    lo[a] = lo[a].min(p[a]);
+                    hi[a] = hi[a].max(p[a]);
+                }
+                (lo, hi)
+            });
+        build(&mut items, &mut split, &mut axis, lo, hi);
         let (pts, ids) = items.into_iter().unzip();
         Ok(Self {
             pts,
