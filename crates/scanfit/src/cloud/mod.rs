@@ -25,6 +25,7 @@
 pub mod boundary;
 pub mod clean;
 pub mod corners;
+pub(crate) mod forest;
 pub mod hpr;
 pub mod hull;
 pub mod neighbours;

@@ -10,8 +10,8 @@ use std::num::NonZeroUsize;
 use rayon::prelude::*;
 
 use super::PointCloud;
-use crate::spatial::KdTree;
 pub use crate::spatial::Neighbour;
+use crate::spatial::{fill_rows_in_order, morton_order, KdTree};
 use crate::{Error, Point3, Result};
 
 /// The k nearest neighbours of many points, stored flat: row `i` holds the
@@ -22,7 +22,8 @@ pub struct Neighbourhoods {
     pub k: usize,
     /// `k` indices per row.
     pub indices: Vec<u32>,
-    /// `k` distances per row.
+    /// `k` distances per row (empty for a graph built without them,
+    /// [`PointCloud::knn_graph_indices`]).
     pub distances: Vec<f64>,
 }
 
@@ -42,9 +43,11 @@ impl Neighbourhoods {
         &self.indices[i * self.k..(i + 1) * self.k]
     }
 
-    /// Distances of row `i`.
+    /// Distances of row `i` (empty for a graph built without them).
     pub fn distances_of(&self, i: usize) -> &[f64] {
-        &self.distances[i * self.k..(i + 1) * self.k]
+        self.distances
+            .get(i * self.k..(i + 1) * self.k)
+            .unwrap_or(&[])
     }
 }
 
@@ -112,7 +115,9 @@ impl PointCloud {
         Ok(self.tree()?.within(query, radius))
     }
 
-    /// The `k` nearest points of each of `queries`, in parallel.
+    /// The `k` nearest points of each of `queries`, in parallel (the
+    /// queries are visited along a Morton curve for cache locality; each
+    /// row is what [`PointCloud::knn`] gives).
     pub fn knn_batch(&self, queries: &[Point3], k: usize) -> Result<Neighbourhoods> {
         let kq = checked_k(k)?;
         for (i, q) in queries.iter().enumerate() {
@@ -120,23 +125,8 @@ impl PointCloud {
         }
         let tree = self.tree()?;
         let k = kq.get().min(self.points.len());
-        let mut indices = vec![0u32; queries.len() * k];
-        let mut distances = vec![0.0; queries.len() * k];
-        indices
-            .par_chunks_mut(k)
-            .zip(distances.par_chunks_mut(k))
-            .zip(queries.par_iter())
-            .for_each(|((idx, dist), q)| {
-                for (j, n) in tree.nearest_n(q, kq).into_iter().enumerate().take(k) {
-                    idx[j] = n.index as u32;
-                    dist[j] = n.distance;
-                }
-            });
-        Ok(Neighbourhoods {
-            k,
-            indices,
-            distances,
-        })
+        let order = morton_order(queries);
+        Ok(rows(tree, queries, &order, kq, k))
     }
 
     /// The `k` nearest *other* points of every point of the cloud (the point
@@ -151,29 +141,69 @@ impl PointCloud {
             });
         }
         let k = checked_k(k)?.get().min(self.points.len() - 1);
-        let all = self.knn_batch(&self.points, k + 1)?;
-        let mut indices = Vec::with_capacity(self.points.len() * k);
-        let mut distances = Vec::with_capacity(self.points.len() * k);
-        for i in 0..self.points.len() {
-            let row = all.indices_of(i);
-            let drow = all.distances_of(i);
-            // drop the point itself (or, among duplicates, one copy of it)
-            let skip = row
-                .iter()
-                .position(|&j| j as usize == i)
-                .unwrap_or(row.len() - 1);
-            for j in 0..row.len() {
-                if j != skip {
-                    indices.push(row[j]);
-                    distances.push(drow[j]);
-                }
-            }
-        }
+        let (indices, distances) = self.tree()?.graph_rows(k);
         Ok(Neighbourhoods {
             k,
             indices,
             distances,
         })
+    }
+
+    /// [`PointCloud::knn_graph`] without the distances (`distances` empty):
+    /// the same rows in a third of the memory, for the normals, which need
+    /// only who the neighbours are.
+    ///
+    /// ```
+    /// use scanfit::{Point3, PointCloud};
+    /// let pts = (0..50).map(|i| Point3::new(i as f64, (i * i % 7) as f64, 0.0)).collect();
+    /// let cloud = PointCloud::new(pts)?;
+    /// let (g, h) = (cloud.knn_graph(6)?, cloud.knn_graph_indices(6)?);
+    /// assert_eq!((g.indices, h.k, h.distances.len()), (h.indices, 6, 0));
+    /// # Ok::<(), scanfit::Error>(())
+    /// ```
+    pub fn knn_graph_indices(&self, k: usize) -> Result<Neighbourhoods> {
+        if self.points.len() < 2 {
+            return Err(Error::TooFewPoints {
+                got: self.points.len(),
+                needed: 2,
+                what: "a neighbour graph".into(),
+            });
+        }
+        let k = checked_k(k)?.get().min(self.points.len() - 1);
+        Ok(Neighbourhoods {
+            k,
+            indices: self.tree()?.graph_indices(k),
+            distances: Vec::new(),
+        })
+    }
+}
+
+/// The rows of `k` neighbours of `queries` (asking the tree for `kq`),
+/// computed in `order`.
+fn rows(
+    tree: &KdTree,
+    queries: &[Point3],
+    order: &[u32],
+    kq: NonZeroUsize,
+    k: usize,
+) -> Neighbourhoods {
+    let mut indices = vec![0u32; queries.len() * k];
+    let mut distances = vec![0.0; queries.len() * k];
+    fill_rows_in_order(order, k, &mut indices, &mut distances, |i, idx, dist| {
+        for (j, n) in tree
+            .nearest_n(&queries[i], kq)
+            .into_iter()
+            .take(k)
+            .enumerate()
+        {
+            idx[j] = n.index as u32;
+            dist[j] = n.distance;
+        }
+    });
+    Neighbourhoods {
+        k,
+        indices,
+        distances,
     }
 }
 
@@ -319,6 +349,7 @@ fn check_query(query: &Point3, which: &str) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Vector3;
 
     /// Issue 14: `cloud info` measures the spacing of more than 10^6 points
     /// on a sample of 10^6. On 2 x 10^6 scattered points (uniform in a
@@ -366,6 +397,50 @@ mod tests {
         d.sort_by(f64::total_cmp);
         d.truncate(k);
         d
+    }
+
+    /// The batch and graph queries run in a spatial order (Morton, tree); every row is still
+    /// exactly the tree's answer for its own point, in input order (here a
+    /// cloud in random order, over several chunks of work).
+    #[test]
+    fn batch_rows_are_the_single_queries_whatever_the_visiting_order() {
+        let mut rng = crate::testdata::Lcg::new(3);
+        let pts: Vec<Point3> = (0..5000)
+            .map(|_| Point3::new(rng.next_f64(), rng.next_f64(), 0.1 * rng.next_f64()))
+            .collect();
+        let cloud = PointCloud::new(pts.clone()).unwrap();
+        let qs: Vec<Point3> = pts
+            .iter()
+            .rev()
+            .take(3000)
+            .map(|p| p + Vector3::repeat(0.01))
+            .collect();
+        let b = cloud.knn_batch(&qs, 6).unwrap();
+        for (i, q) in qs.iter().enumerate() {
+            let one = cloud.knn(q, 6).unwrap();
+            assert_eq!(
+                b.indices_of(i),
+                one.iter().map(|n| n.index as u32).collect::<Vec<_>>()
+            );
+            assert_eq!(
+                b.distances_of(i),
+                one.iter().map(|n| n.distance).collect::<Vec<_>>()
+            );
+        }
+        let g = cloud.knn_graph(5).unwrap();
+        for (i, p) in pts.iter().enumerate() {
+            let one: Vec<Neighbour> = cloud.knn(p, 6).unwrap();
+            let rest: Vec<&Neighbour> = one.iter().filter(|n| n.index != i).collect();
+            assert_eq!(rest.len(), 5);
+            assert_eq!(
+                g.indices_of(i),
+                rest.iter().map(|n| n.index as u32).collect::<Vec<_>>()
+            );
+            assert_eq!(
+                g.distances_of(i),
+                rest.iter().map(|n| n.distance).collect::<Vec<_>>()
+            );
+        }
     }
 
     #[test]

@@ -28,8 +28,10 @@ use std::collections::BinaryHeap;
 
 use rayon::prelude::*;
 
+use super::forest::Forest;
 use super::neighbours::Neighbourhoods;
 use super::PointCloud;
+use crate::spatial::map_in_order;
 use crate::{pca, Error, Point3, Result, Vector3};
 
 /// How to choose the sign of each normal.
@@ -109,7 +111,7 @@ pub fn estimate_normals(cloud: &PointCloud, config: &NormalsConfig) -> Result<No
             what: "normal estimation".into(),
         });
     }
-    let graph = cloud.knn_graph(config.k)?;
+    let graph = cloud.knn_graph_indices(config.k)?;
     estimate_normals_on(cloud, &graph, config)
 }
 
@@ -142,30 +144,30 @@ pub fn estimate_normals_on(
     }
     let points = cloud.points();
     let scale = cloud.diagonal();
-    let per_point: Vec<(Vector3, f64, bool)> = (0..points.len())
-        .into_par_iter()
-        .map(|i| {
-            let nb = graph.indices_of(i);
-            let hood = std::iter::once(&points[i]).chain(nb.iter().map(|&j| &points[j as usize]));
-            match pca(hood) {
-                Some(p) => {
-                    let flat = p.values[1] <= 1e-24 * scale * scale;
-                    let n = if flat {
-                        // collinear neighbourhood: any perpendicular of the line
-                        p.axes[0].cross(&least_aligned_axis(&p.axes[0])).normalize()
-                    } else {
-                        p.axes[2]
-                    };
-                    (n, p.variation(), flat)
-                }
-                None => (Vector3::z(), 0.0, true),
+    // visited in the tree order: a point's neighbours are in the cache
+    // from its predecessor's
+    let order = cloud.tree()?.spatial_order();
+    let per_point: Vec<(Vector3, f64, bool)> = map_in_order(order, |i| {
+        let nb = graph.indices_of(i);
+        let hood = std::iter::once(&points[i]).chain(nb.iter().map(|&j| &points[j as usize]));
+        match pca(hood) {
+            Some(p) => {
+                let flat = p.values[1] <= 1e-24 * scale * scale;
+                let n = if flat {
+                    // collinear neighbourhood: any perpendicular of the line
+                    p.axes[0].cross(&least_aligned_axis(&p.axes[0])).normalize()
+                } else {
+                    p.axes[2]
+                };
+                (n, p.variation(), flat)
             }
-        })
-        .collect();
+            None => (Vector3::z(), 0.0, true),
+        }
+    });
     let mut normals: Vec<Vector3> = per_point.iter().map(|t| t.0).collect();
     let variation = per_point.iter().map(|t| t.1).collect();
     let degenerate = (0..points.len()).filter(|&i| per_point[i].2).collect();
-    let adj = Adjacency::of(graph);
+    drop(per_point);
     let mut components = 0;
     match config.orientation {
         Orientation::None => {}
@@ -182,15 +184,16 @@ pub fn estimate_normals_on(
                     "the orientation hint must be a finite non-zero vector".into(),
                 ));
             }
+            let adj = Adjacency::of(graph);
             components = orient_by_spanning_tree(points, &adj, &mut normals, &hint);
         }
     }
     if components == 0 {
-        components = count_components(&adj, points.len());
+        components = count_components(graph);
     }
     let disagreement = match config.orientation {
         Orientation::None => None,
-        _ => disagreement(points, graph, &normals),
+        _ => disagreement(points, graph, &normals, order),
     };
     Ok(Normals {
         normals,
@@ -207,9 +210,11 @@ fn disagreement(
     points: &[Point3],
     graph: &super::neighbours::Neighbourhoods,
     normals: &[Vector3],
+    order: &[u32],
 ) -> Option<f64> {
-    let (pairs, bad) = (0..points.len())
-        .into_par_iter()
+    let (pairs, bad) = order
+        .par_chunks(1024)
+        .flat_map_iter(|chunk| chunk.iter().map(|&i| i as usize))
         .map(|i| {
             let (mut pairs, mut bad) = (0usize, 0usize);
             for &j in graph.indices_of(i) {
@@ -282,24 +287,15 @@ impl Adjacency {
     }
 }
 
-fn count_components(adj: &Adjacency, n: usize) -> usize {
-    let mut seen = vec![false; n];
-    let mut count = 0;
-    let mut stack = Vec::new();
-    for s in 0..n {
-        if seen[s] {
-            continue;
-        }
-        count += 1;
-        seen[s] = true;
-        stack.push(s);
-        while let Some(i) = stack.pop() {
-            for &j in adj.of_point(i) {
-                if !seen[j as usize] {
-                    seen[j as usize] = true;
-                    stack.push(j as usize);
-                }
-            }
+/// Connected components of the (undirected) neighbour graph, by union-find
+/// over its edges (no adjacency lists needed).
+fn count_components(graph: &Neighbourhoods) -> usize {
+    let n = graph.len();
+    let mut forest = Forest::new(n);
+    let mut count = n;
+    for i in 0..n {
+        for &j in graph.indices_of(i) {
+            count -= usize::from(forest.join(i as u32, j));
         }
     }
     count

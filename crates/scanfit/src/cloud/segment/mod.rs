@@ -185,7 +185,8 @@ pub fn segment(cloud: &PointCloud, cfg: &SegmentConfig) -> Result<Segmentation> 
     let min_cell = cfg.min_cell * spacing;
     let max_angle = cfg.max_angle_deg.to_radians();
     let points = cloud.points();
-    let variation = octree::neighbour_variation(&graph, &normals);
+    let order = cloud.tree()?.spatial_order();
+    let variation = octree::neighbour_variation_in(&graph, &normals, order);
     let tree = octree::subdivide(points, &variation, min_cell, max_angle);
     let edge: Vec<bool> = tree
         .cell_of
@@ -207,7 +208,7 @@ pub fn segment(cloud: &PointCloud, cfg: &SegmentConfig) -> Result<Segmentation> 
         )));
     }
     let open: Vec<bool> = edge.iter().map(|&e| !e).collect();
-    let mut region = regions::grow(&graph, cfg.grow_k, &open, &normals, max_angle);
+    let mut region = regions::grow_in(&graph, cfg.grow_k, &open, &normals, max_angle, order);
     let min_region = cfg.min_region.unwrap_or((points.len() / 500).max(30));
     let mut sizes: Vec<usize> = Vec::new();
     for &r in region.iter().filter(|&&r| r != u32::MAX) {

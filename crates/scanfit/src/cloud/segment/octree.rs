@@ -16,9 +16,8 @@
 //! holes in the edge band; the neighbour variation there is half the crease
 //! angle whatever the cell.)
 
-use rayon::prelude::*;
-
 use crate::cloud::neighbours::Neighbourhoods;
+use crate::spatial::map_in_order;
 use crate::{Point3, Vector3};
 
 /// A leaf cell of the octree.
@@ -49,17 +48,26 @@ pub struct Octree {
 /// point the largest angle (radians, sign-free) between its normal and the
 /// normal of any of its neighbours in `graph`.
 pub fn neighbour_variation(graph: &Neighbourhoods, normals: &[Vector3]) -> Vec<f64> {
-    (0..normals.len())
-        .into_par_iter()
-        .map(|i| {
-            let least = graph
-                .indices_of(i)
-                .iter()
-                .map(|&j| normals[i].dot(&normals[j as usize]).abs())
-                .fold(1.0_f64, f64::min);
-            least.clamp(0.0, 1.0).acos()
-        })
-        .collect()
+    let order: Vec<u32> = (0..normals.len() as u32).collect();
+    neighbour_variation_in(graph, normals, &order)
+}
+
+/// [`neighbour_variation`] with the points visited in `order` (a
+/// permutation of the points: the tree order keeps the neighbours'
+/// normals in the cache); the result does not depend on it.
+pub(crate) fn neighbour_variation_in(
+    graph: &Neighbourhoods,
+    normals: &[Vector3],
+    order: &[u32],
+) -> Vec<f64> {
+    map_in_order(order, |i| {
+        let least = graph
+            .indices_of(i)
+            .iter()
+            .map(|&j| normals[i].dot(&normals[j as usize]).abs())
+            .fold(1.0_f64, f64::min);
+        least.clamp(0.0, 1.0).acos()
+    })
 }
 
 /// Subdivides the bounding cube of `points` (see the module docs): cells

@@ -4,32 +4,10 @@
 
 use rayon::prelude::*;
 
+use crate::cloud::forest::Forest;
 use crate::cloud::neighbours::Neighbourhoods;
-use crate::spatial::KdTree;
+use crate::spatial::{map_in_order, KdTree};
 use crate::{Point3, Result, Vector3};
-
-/// Disjoint sets over point indices (path halving, union by index so the
-/// result does not depend on the order the unions arrive in).
-struct Forest(Vec<u32>);
-
-impl Forest {
-    fn root(&mut self, mut i: u32) -> u32 {
-        while self.0[i as usize] != i {
-            let up = self.0[self.0[i as usize] as usize];
-            self.0[i as usize] = up;
-            i = up;
-        }
-        i
-    }
-
-    fn join(&mut self, a: u32, b: u32) {
-        let (ra, rb) = (self.root(a), self.root(b));
-        if ra != rb {
-            let (lo, hi) = (ra.min(rb), ra.max(rb));
-            self.0[hi as usize] = lo;
-        }
-    }
-}
 
 /// Connected components of the points with `open[i]`, over the first `k`
 /// neighbours of each point in `graph`, joining two neighbours only when
@@ -43,16 +21,51 @@ pub fn grow(
     normals: &[Vector3],
     max_angle: f64,
 ) -> Vec<u32> {
+    let order: Vec<u32> = (0..open.len() as u32).collect();
+    grow_in(graph, k, open, normals, max_angle, &order)
+}
+
+/// [`grow`] with the points visited in `order` (a permutation; the tree order
+/// keeps the forest's and the normals' entries of neighbouring
+/// points in the cache). The regions do not depend on it: the unions join
+/// by index.
+pub(crate) fn grow_in(
+    graph: &Neighbourhoods,
+    k: usize,
+    open: &[bool],
+    normals: &[Vector3],
+    max_angle: f64,
+    order: &[u32],
+) -> Vec<u32> {
     let n = open.len();
     let cos = max_angle.cos();
-    let mut forest = Forest((0..n as u32).collect());
-    for i in 0..n {
-        if !open[i] {
-            continue;
+    let joins = |i: usize, t: usize, j: u32| {
+        t < k && open[i] && open[j as usize] && normals[i].dot(&normals[j as usize]).abs() >= cos
+    };
+    let mut forest = Forest::new(n);
+    if k <= 64 {
+        // which of its first k neighbours each point joins, in parallel (the
+        // normals' reads dominate); the unions then run serially
+        let masks: Vec<u64> = map_in_order(order, |i| {
+            let row = graph.indices_of(i).iter().enumerate();
+            row.filter(|&(t, &j)| joins(i, t, j))
+                .fold(0u64, |m, (t, _)| m | 1 << t)
+        });
+        for &i in order {
+            let (i, mut m) = (i as usize, masks[i as usize]);
+            while m != 0 {
+                let t = m.trailing_zeros() as usize;
+                forest.join(i as u32, graph.indices_of(i)[t]);
+                m &= m - 1;
+            }
         }
-        for &j in graph.indices_of(i).iter().take(k) {
-            if open[j as usize] && normals[i].dot(&normals[j as usize]).abs() >= cos {
-                forest.join(i as u32, j);
+    } else {
+        for &i in order {
+            let i = i as usize;
+            for (t, &j) in graph.indices_of(i).iter().enumerate() {
+                if joins(i, t, j) {
+                    forest.join(i as u32, j);
+                }
             }
         }
     }
