@@ -10,6 +10,7 @@ use clap::{Args, ValueEnum};
 use scanfit::bspline::{tessellate, Mesh};
 use scanfit::metrics::nearest_points;
 use scanfit::network::layout::{LabelSource, Layout};
+use scanfit::base::turntable::AxisChoice;
 use scanfit::network::FaceFit;
 use scanfit::pde::PdeConfig;
 use scanfit::pipeline::reconstruct::{self, ReconstructConfig, ReconstructReport};
@@ -24,7 +25,7 @@ use scanfit_io::render::{render_surface_scene_png, Colouring, Marker, Polyline};
 use scanfit_io::step_shell::step_shell_file_with;
 use scanfit_io::write_all_atomic;
 
-use crate::args::{choice, Ids, InputArgs, IDS, NXM};
+use crate::args::{choice, Ids, InputArgs, Parsed, IDS, NXM};
 use crate::outputs::{check_outputs, extension, print_written, Files};
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -65,11 +66,35 @@ pub enum FitRoute {
     Bspline,
 }
 
+/// `--layout`: `cube`, `grid:RxC` or `revolve:SxL`.
+pub const LAYOUT: Parsed<LayoutArg> = Parsed::new(layout);
+
 /// `--layout`: patches for a smooth object without labels.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LayoutArg {
     /// Six four-sided patches, central projection onto a box (star-shaped objects).
     Cube,
+    /// A sheet cut into R x C patches along iso-lines of its Coons base.
+    Grid(usize, usize),
+    /// S sectors x L bands about the axis, three-sided caps at closed ends.
+    Revolve(usize, usize),
+}
+
+fn layout(s: &str, what: &str) -> std::result::Result<LayoutArg, String> {
+    let t = s.trim().to_ascii_lowercase();
+    let usage = format!(
+        "{what} '{s}' must be cube, grid:RxC (a four-sided sheet, e.g. grid:3x3) or revolve:SxL (S >= 3 sectors x L bands about the axis, e.g. revolve:4x3)"
+    );
+    let count = |x: &str| match crate::args::NXM.parse_str(x, what) {
+        Ok((a, b)) if x.contains(['x', 'X']) && a > 0 && b > 0 => Ok((a, b)),
+        _ => Err(usage.clone()),
+    };
+    match t.split_once(':') {
+        None if t == "cube" => Ok(LayoutArg::Cube),
+        Some(("grid", n)) => count(n).map(|(r, c)| LayoutArg::Grid(r, c)),
+        Some(("revolve", n)) => count(n).map(|(a, b)| LayoutArg::Revolve(a, b)),
+        _ => Err(usage),
+    }
 }
 
 #[derive(Args, Debug)]
@@ -89,9 +114,16 @@ pub struct ReconstructArgs {
     pub segment_options: crate::segment::SegmentOptions,
     /// Make the patch ids by a layout for a smooth object: `cube` (six
     /// four-sided patches by central projection onto a box about the centre;
-    /// closed star-shaped objects).
-    #[arg(long, value_name = "LAYOUT", value_parser = choice::<LayoutArg>())]
+    /// closed star-shaped objects), `grid:RxC` (a four-sided sheet cut along
+    /// iso-lines of its Coons base into R x C patches), `revolve:SxL` (S
+    /// sectors x L bands about the axis, S three-sided caps at each closed
+    /// end).
+    #[arg(long, value_name = "LAYOUT", value_parser = LAYOUT)]
     pub layout: Option<LayoutArg>,
+    /// Axis of `--layout revolve`: x, y, z, a direction "X,Y,Z", or "auto"
+    /// (the cloud's principal axis, as `scanfit turntable`).
+    #[arg(long, value_name = "AXIS", value_parser = crate::turntable::AXIS)]
+    pub axis: Option<AxisChoice>,
     /// Patch ids to leave out, e.g. "0,99" (negative ids always are).
     #[arg(long, value_name = "LIST", allow_hyphen_values = true, value_parser = IDS)]
     pub ignore: Option<Ids>,
@@ -182,11 +214,7 @@ pub fn run(a: ReconstructArgs) -> Result<()> {
 fn config(a: &ReconstructArgs) -> Result<ReconstructConfig> {
     let mut cfg = ReconstructConfig::default();
     cfg.network.labels.attribute = a.labels.clone();
-    cfg.source = match (a.segment, a.layout) {
-        (true, _) => LabelSource::Segment(a.segment_options.config()),
-        (false, Some(LayoutArg::Cube)) => LabelSource::Layout(Layout::Cube),
-        (false, None) => LabelSource::Attribute,
-    };
+    cfg.source = source(a)?;
     if let Some(Ids(list)) = &a.ignore {
         cfg.network.labels.ignore = list.clone();
     }
@@ -207,6 +235,26 @@ fn config(a: &ReconstructArgs) -> Result<ReconstructConfig> {
         }
     };
     Ok(cfg)
+}
+
+/// Where the patch ids come from: the file, `--segment` or `--layout`.
+fn source(a: &ReconstructArgs) -> Result<LabelSource> {
+    if a.axis.is_some() && !matches!(a.layout, Some(LayoutArg::Revolve(..))) {
+        bail!("--axis sets the axis of --layout revolve:SxL; give that layout or leave --axis out");
+    }
+    Ok(match (a.segment, a.layout) {
+        (true, _) => LabelSource::Segment(a.segment_options.config()),
+        (false, Some(LayoutArg::Cube)) => LabelSource::Layout(Layout::Cube),
+        (false, Some(LayoutArg::Grid(rows, cols))) => {
+            LabelSource::Layout(Layout::Grid { rows, cols })
+        }
+        (false, Some(LayoutArg::Revolve(sectors, bands))) => LabelSource::Layout(Layout::Revolve {
+            sectors,
+            bands,
+            axis: a.axis.unwrap_or_default(),
+        }),
+        (false, None) => LabelSource::Attribute,
+    })
 }
 
 /// A distinct colour for patch `k` (hues a golden angle apart).

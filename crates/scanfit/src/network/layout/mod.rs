@@ -5,14 +5,18 @@
 //!   labels, or `scanfit cloud segment`'s output edited by hand).
 //! * [`LabelSource::Segment`]: regions between sharp edges
 //!   ([`crate::cloud::segment`], [COONS19] §I).
-//! * [`LabelSource::Layout`]: a layout for a smooth object ([`cube`]).
+//! * [`LabelSource::Layout`]: a layout for a smooth object ([`cube`],
+//!   [`grid`], [`revolve`]).
 //!
 //! Every source ends as one integer id per point in the attribute
 //! [`GENERATED_LABEL`], read by the same [`super::read_labels`] as hand
 //! labels: nothing downstream knows where the ids came from.
 
 pub mod cube;
+pub mod grid;
+pub mod revolve;
 
+use crate::base::turntable::AxisChoice;
 use crate::cloud::segment::{segment, SegmentConfig};
 use crate::progress::Progress;
 use crate::{PointCloud, Result};
@@ -22,12 +26,31 @@ use crate::{PointCloud, Result};
 pub const GENERATED_LABEL: &str = "label";
 
 /// A layout for a smooth object.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub enum Layout {
     /// Six four-sided patches by central projection onto a box
     /// ([`cube::cube_labels`]); for closed star-shaped objects.
     Cube,
+    /// A sheet cut along iso-parameter lines of its Coons base into
+    /// `rows x cols` patches ([`grid::grid_labels`]).
+    Grid {
+        /// Patches along the base's `u`.
+        rows: usize,
+        /// Patches along the base's `v`.
+        cols: usize,
+    },
+    /// A cylinder-like object cut into `sectors x bands` patches about its
+    /// axis, each closed end into `sectors` three-sided caps
+    /// ([`revolve::revolve_labels`]).
+    Revolve {
+        /// Angle ranges about the axis (at least 3).
+        sectors: usize,
+        /// Height ranges along the axis between the caps (or open ends).
+        bands: usize,
+        /// The axis (the turntable's choice; default the principal axis).
+        axis: AxisChoice,
+    },
 }
 
 /// Where the patch ids come from.
@@ -73,10 +96,26 @@ pub fn generate_labels(
             let s = segment(cloud, cfg)?;
             Ok(Some(s.labels.iter().map(|&l| i64::from(l)).collect()))
         }
-        LabelSource::Layout(Layout::Cube) => {
-            progress.stage("cube layout", None);
+        LabelSource::Layout(layout) => {
             let spacing = cloud.spacing()?.median;
-            Ok(Some(cube::cube_labels(cloud, spacing)?.labels))
+            Ok(Some(match *layout {
+                Layout::Cube => {
+                    progress.stage("cube layout", None);
+                    cube::cube_labels(cloud, spacing)?.labels
+                }
+                Layout::Grid { rows, cols } => {
+                    progress.stage("grid layout (Coons base)", None);
+                    grid::grid_labels(cloud, rows, cols, spacing)?.labels
+                }
+                Layout::Revolve {
+                    sectors,
+                    bands,
+                    axis,
+                } => {
+                    progress.stage("revolve layout", None);
+                    revolve::revolve_labels(cloud, sectors, bands, axis, spacing)?.labels
+                }
+            }))
         }
     }
 }
