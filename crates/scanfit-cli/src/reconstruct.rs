@@ -7,10 +7,10 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
+use scanfit::base::turntable::AxisChoice;
 use scanfit::bspline::{tessellate, Mesh};
 use scanfit::metrics::nearest_points;
 use scanfit::network::layout::{LabelSource, Layout};
-use scanfit::base::turntable::AxisChoice;
 use scanfit::network::FaceFit;
 use scanfit::pde::PdeConfig;
 use scanfit::pipeline::reconstruct::{self, ReconstructConfig, ReconstructReport};
@@ -36,13 +36,18 @@ const EXAMPLES: &str = "Examples:
   scanfit reconstruct examples/data/vessel_30k.ply --labels label --ignore 14 --fit bspline --ctrl 12x12 --json
   scanfit reconstruct examples/data/blob_30k.ply --layout cube --step blob.stp
   scanfit reconstruct examples/data/part_30k.ply --segment --png part.png
+  scanfit reconstruct examples/data/vessel_30k.ply --layout revolve:4x3 --step pot.stp
+  scanfit reconstruct examples/data/terrain_50k.xyz --layout grid:3x3 --fit bspline --png dem.png
 
 Input: a point cloud whose points carry an integer patch id (PLY/PCD property
 or text column `label`, `segment`, `segment_id`, `class` or `scalar_label`,
 case-insensitive, or the one named by --labels); negative ids and the ids of
 --ignore are left out. Without labels: --segment cuts the cloud at its sharp
 edges (as `scanfit cloud segment`), --layout cube lays six patches over a
-closed star-shaped object; their ids replace the file's and take the same path.
+closed star-shaped object, --layout grid:RxC cuts a four-sided sheet along
+iso-lines of its Coons base, --layout revolve:SxL cuts an object about its axis
+(--axis, default the principal axis) into S sectors x L bands with S three-sided
+caps at each closed end; their ids replace the file's and take the same path.
 Pipeline: each patch's border (alpha shape), the patch across every border
 point (within 3 spacings), corners where three or more patches meet or an
 interface reaches the free border, edges between corners shared by the two

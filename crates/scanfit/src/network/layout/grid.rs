@@ -195,8 +195,18 @@ mod tests {
         );
         // the two long sides (x from 0 to 2) carry the rows or the columns
         let far = |a: usize, b: usize| {
-            let pa: Vec<&Point3> = pts.iter().zip(&g.labels).filter(|(_, &l)| l as usize == a).map(|x| x.0).collect();
-            let pb: Vec<&Point3> = pts.iter().zip(&g.labels).filter(|(_, &l)| l as usize == b).map(|x| x.0).collect();
+            let pa: Vec<&Point3> = pts
+                .iter()
+                .zip(&g.labels)
+                .filter(|(_, &l)| l as usize == a)
+                .map(|x| x.0)
+                .collect();
+            let pb: Vec<&Point3> = pts
+                .iter()
+                .zip(&g.labels)
+                .filter(|(_, &l)| l as usize == b)
+                .map(|x| x.0)
+                .collect();
             let ca = pa.iter().map(|p| p.coords).sum::<Vector3>() / pa.len() as f64;
             let cb = pb.iter().map(|p| p.coords).sum::<Vector3>() / pb.len() as f64;
             (ca - cb).norm()
@@ -216,7 +226,10 @@ mod tests {
             .to_string();
         assert!(e.contains("1 hole(s)"), "{e}");
         // the hole's centre (1, 0.5, ~0.1)
-        assert!(e.contains("(1.0000, 0.5000") || e.contains("(0.9999") || e.contains("(1.000"), "{e}");
+        assert!(
+            e.contains("(1.0000, 0.5000") || e.contains("(0.9999") || e.contains("(1.000"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -15,8 +15,10 @@
 //! * Caps: at a closed end, the cap is the region around the pole where the
 //!   surface faces along the axis. From the end inwards the points are cut
 //!   into slices (2 spacings thick, at least 1/200 of the height); the cap
-//!   reaches up to the last slice of an unbroken run in which most points
-//!   have a normal within 45 degrees of the axis (a flat bottom: the disk; a
+//!   reaches up to the last slice in which most points have a normal within
+//!   45 degrees of the axis, before three slices in a row in which they do
+//!   not (a bump, or an empty slice at the pole, does not end the cap; a
+//!   flat bottom: the disk; a
 //!   dome or a pole of an egg: the part flatter than 45 degrees). A point
 //!   below that height whose normal is more than 60 degrees from the axis
 //!   (`|n . a| < 0.5`) is a wall point and stays in the bands, so the cut
@@ -181,9 +183,16 @@ fn cap_depth(
             along[k] += usize::from(f > std::f64::consts::FRAC_1_SQRT_2);
         }
     }
-    let run = (0..count)
-        .take_while(|&k| all[k] > 0 && 2 * along[k] > all[k])
-        .count();
+    // the last facing slice before three in a row that are not (a bump or
+    // an empty slice at a pole does not end the cap)
+    let mut run = 0;
+    for k in 0..count {
+        if all[k] > 0 && 2 * along[k] > all[k] {
+            run = k + 1;
+        } else if k >= run + 2 {
+            break;
+        }
+    }
     if run == 0 {
         fallback
     } else {
@@ -404,8 +413,8 @@ mod tests {
         let cloud = PointCloud::new(pts).unwrap();
         let spacing = cloud.spacing().unwrap().median;
         let e = revolve_labels(&cloud, 4, 2, AxisChoice::Given(Vector3::z()), spacing)
-        .unwrap_err()
-        .to_string();
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("two layers"), "{e}");
     }
 
