@@ -486,8 +486,12 @@ fn tables(r: &ReconstructReport, seconds: f64) -> String {
         ]);
     }
     let tt = &r.totals;
+    let layout = r
+        .layout
+        .as_ref()
+        .map_or(String::new(), |l| format!("{l}\n"));
     format!(
-        "{}\n{}\n{} patches, {} edges, {} corners, {}; {} points (eq. 15: mean {}, max {}, rmse {}; orthogonal rmse {}, max {})\nlargest gap along an edge {} ({:.1e} of the diagonal {}), largest normal angle {:.2} deg; {:.2} s\n",
+        "{layout}{}\n{}\n{} patches, {} edges, {} corners, {}; {} points (eq. 15: mean {}, max {}, rmse {}; orthogonal rmse {}, max {})\nlargest gap along an edge {} ({:.1e} of the diagonal {}), largest normal angle {:.2} deg; {:.2} s\n",
         t.render(), e.render(),
         r.faces.len(), r.network.edges.len(), r.network.vertices.len(),
         if tt.closed { "closed" } else { "open" },
@@ -509,6 +513,7 @@ fn json_report(
     serde_json::json!({
         "input": a.input.input.display().to_string(),
         "labels": r.network.attribute,
+        "layout": r.layout.as_deref().unwrap_or("the file's labels"),
         "ignored_points": r.network.ignored,
         "dropped_non_finite": dropped,
         "spacing": r.network.spacing,

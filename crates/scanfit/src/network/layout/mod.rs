@@ -66,6 +66,16 @@ pub enum LabelSource {
     Layout(Layout),
 }
 
+/// Labels made by a segmentation or a layout.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GeneratedLabels {
+    /// The patch id of every point.
+    pub labels: Vec<i64>,
+    /// One line on what was found (regions, the axis and ends of a revolve
+    /// layout, ...), for the report.
+    pub summary: String,
+}
+
 /// The patch id of every point from `source`, or `None` for
 /// [`LabelSource::Attribute`] (the cloud's own labels are used as they are).
 ///
@@ -81,31 +91,46 @@ pub enum LabelSource {
 /// }).collect();
 /// let cloud = PointCloud::new(pts)?;
 /// let ids = generate_labels(&cloud, &LabelSource::Layout(Layout::Cube), &NoProgress)?.unwrap();
-/// assert_eq!(ids.iter().max(), Some(&5));
+/// assert_eq!(ids.labels.iter().max(), Some(&5));
 /// # Ok::<(), scanfit::Error>(())
 /// ```
 pub fn generate_labels(
     cloud: &PointCloud,
     source: &LabelSource,
     progress: &dyn Progress,
-) -> Result<Option<Vec<i64>>> {
+) -> Result<Option<GeneratedLabels>> {
     match source {
         LabelSource::Attribute => Ok(None),
         LabelSource::Segment(cfg) => {
             progress.stage("segmentation by normal variation", None);
             let s = segment(cloud, cfg)?;
-            Ok(Some(s.labels.iter().map(|&l| i64::from(l)).collect()))
+            Ok(Some(GeneratedLabels {
+                labels: s.labels.iter().map(|&l| i64::from(l)).collect(),
+                summary: format!(
+                    "segmentation: {} regions between sharp edges",
+                    s.regions.len()
+                ),
+            }))
         }
         LabelSource::Layout(layout) => {
             let spacing = cloud.spacing()?.median;
-            Ok(Some(match *layout {
+            let (labels, summary) = match *layout {
                 Layout::Cube => {
                     progress.stage("cube layout", None);
-                    cube::cube_labels(cloud, spacing)?.labels
+                    let c = cube::cube_labels(cloud, spacing)?;
+                    (
+                        c.labels,
+                        "cube: 6 four-sided patches by central projection".into(),
+                    )
                 }
                 Layout::Grid { rows, cols } => {
                     progress.stage("grid layout (Coons base)", None);
-                    grid::grid_labels(cloud, rows, cols, spacing)?.labels
+                    let g = grid::grid_labels(cloud, rows, cols, spacing)?;
+                    let summary = format!(
+                        "grid {rows}x{cols} along iso-lines of the sheet's Coons base; {} patches",
+                        rows * cols
+                    );
+                    (g.labels, summary)
                 }
                 Layout::Revolve {
                     sectors,
@@ -113,9 +138,12 @@ pub fn generate_labels(
                     axis,
                 } => {
                     progress.stage("revolve layout", None);
-                    revolve::revolve_labels(cloud, sectors, bands, axis, spacing)?.labels
+                    let r = revolve::revolve_labels(cloud, sectors, bands, axis, spacing)?;
+                    let summary = r.summary(sectors);
+                    (r.labels, summary)
                 }
-            }))
+            };
+            Ok(Some(GeneratedLabels { labels, summary }))
         }
     }
 }
