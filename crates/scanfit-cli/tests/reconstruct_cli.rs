@@ -490,6 +490,11 @@ fn can_as_revolve_layout() {
     let j: serde_json::Value = serde_json::from_str(&out).unwrap();
     let t = &j["totals"];
     assert_eq!(t["faces"], 16, "{t}");
+    let layout = j["layout"].as_str().unwrap();
+    assert!(
+        layout.contains("low end closed") && layout.contains("high end closed"),
+        "{layout}"
+    );
     assert_eq!(t["closed"], true);
     assert_eq!(t["corners"], 2 + 3 * 4);
     assert!(t["max_gap"].as_f64().unwrap() <= 1e-9 * t["diagonal"].as_f64().unwrap());
