@@ -7,6 +7,7 @@ use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
+use scanfit::base::turntable::AxisChoice;
 use scanfit::bspline::{tessellate, Mesh};
 use scanfit::metrics::nearest_points;
 use scanfit::network::layout::{LabelSource, Layout};
@@ -26,7 +27,7 @@ use scanfit_io::render::{
 use scanfit_io::step_shell::step_shell_file_with;
 use scanfit_io::write_all_atomic;
 
-use crate::args::{choice, Ids, InputArgs, IDS, NXM};
+use crate::args::{choice, Ids, InputArgs, Parsed, IDS, NXM};
 use crate::outputs::{check_outputs, extension, print_written, Files};
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -37,13 +38,18 @@ const EXAMPLES: &str = "Examples:
   scanfit reconstruct examples/data/vessel_30k.ply --labels label --ignore 14 --fit bspline --ctrl 12x12 --json
   scanfit reconstruct examples/data/blob_30k.ply --layout cube --step blob.stp
   scanfit reconstruct examples/data/part_30k.ply --segment --png part.png
+  scanfit reconstruct examples/data/vessel_30k.ply --layout revolve:4x3 --step pot.stp
+  scanfit reconstruct examples/data/terrain_50k.xyz --layout grid:3x3 --fit bspline --png dem.png
 
 Input: a point cloud whose points carry an integer patch id (PLY/PCD property
 or text column `label`, `segment`, `segment_id`, `class` or `scalar_label`,
 case-insensitive, or the one named by --labels); negative ids and the ids of
 --ignore are left out. Without labels: --segment cuts the cloud at its sharp
 edges (as `scanfit cloud segment`), --layout cube lays six patches over a
-closed star-shaped object; their ids replace the file's and take the same path.
+closed star-shaped object, --layout grid:RxC cuts a four-sided sheet along
+iso-lines of its Coons base, --layout revolve:SxL cuts an object about its axis
+(--axis, default the principal axis) into S sectors x L bands with S three-sided
+caps at each closed end; their ids replace the file's and take the same path.
 Pipeline: each patch's border (alpha shape), the patch across every border
 point (within 3 spacings), corners where three or more patches meet or an
 interface reaches the free border, edges between corners shared by the two
@@ -67,11 +73,35 @@ pub enum FitRoute {
     Bspline,
 }
 
+/// `--layout`: `cube`, `grid:RxC` or `revolve:SxL`.
+pub const LAYOUT: Parsed<LayoutArg> = Parsed::new(layout);
+
 /// `--layout`: patches for a smooth object without labels.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LayoutArg {
     /// Six four-sided patches, central projection onto a box (star-shaped objects).
     Cube,
+    /// A sheet cut into R x C patches along iso-lines of its Coons base.
+    Grid(usize, usize),
+    /// S sectors x L bands about the axis, three-sided caps at closed ends.
+    Revolve(usize, usize),
+}
+
+fn layout(s: &str, what: &str) -> std::result::Result<LayoutArg, String> {
+    let t = s.trim().to_ascii_lowercase();
+    let usage = format!(
+        "{what} '{s}' must be cube, grid:RxC (a four-sided sheet, e.g. grid:3x3) or revolve:SxL (S >= 3 sectors x L bands about the axis, e.g. revolve:4x3)"
+    );
+    let count = |x: &str| match crate::args::NXM.parse_str(x, what) {
+        Ok((a, b)) if x.contains(['x', 'X']) && a > 0 && b > 0 => Ok((a, b)),
+        _ => Err(usage.clone()),
+    };
+    match t.split_once(':') {
+        None if t == "cube" => Ok(LayoutArg::Cube),
+        Some(("grid", n)) => count(n).map(|(r, c)| LayoutArg::Grid(r, c)),
+        Some(("revolve", n)) => count(n).map(|(a, b)| LayoutArg::Revolve(a, b)),
+        _ => Err(usage),
+    }
 }
 
 #[derive(Args, Debug)]
@@ -91,9 +121,16 @@ pub struct ReconstructArgs {
     pub segment_options: crate::segment::SegmentOptions,
     /// Make the patch ids by a layout for a smooth object: `cube` (six
     /// four-sided patches by central projection onto a box about the centre;
-    /// closed star-shaped objects).
-    #[arg(long, value_name = "LAYOUT", value_parser = choice::<LayoutArg>())]
+    /// closed star-shaped objects), `grid:RxC` (a four-sided sheet cut along
+    /// iso-lines of its Coons base into R x C patches), `revolve:SxL` (S
+    /// sectors x L bands about the axis, S three-sided caps at each closed
+    /// end).
+    #[arg(long, value_name = "LAYOUT", value_parser = LAYOUT)]
     pub layout: Option<LayoutArg>,
+    /// Axis of `--layout revolve`: x, y, z, a direction "X,Y,Z", or "auto"
+    /// (the cloud's principal axis, as `scanfit turntable`).
+    #[arg(long, value_name = "AXIS", value_parser = crate::turntable::AXIS)]
+    pub axis: Option<AxisChoice>,
     /// Patch ids to leave out, e.g. "0,99" (negative ids always are).
     #[arg(long, value_name = "LIST", allow_hyphen_values = true, value_parser = IDS)]
     pub ignore: Option<Ids>,
@@ -184,11 +221,7 @@ pub fn run(a: ReconstructArgs) -> Result<()> {
 fn config(a: &ReconstructArgs) -> Result<ReconstructConfig> {
     let mut cfg = ReconstructConfig::default();
     cfg.network.labels.attribute = a.labels.clone();
-    cfg.source = match (a.segment, a.layout) {
-        (true, _) => LabelSource::Segment(a.segment_options.config()),
-        (false, Some(LayoutArg::Cube)) => LabelSource::Layout(Layout::Cube),
-        (false, None) => LabelSource::Attribute,
-    };
+    cfg.source = source(a)?;
     if let Some(Ids(list)) = &a.ignore {
         cfg.network.labels.ignore = list.clone();
     }
@@ -209,6 +242,26 @@ fn config(a: &ReconstructArgs) -> Result<ReconstructConfig> {
         }
     };
     Ok(cfg)
+}
+
+/// Where the patch ids come from: the file, `--segment` or `--layout`.
+fn source(a: &ReconstructArgs) -> Result<LabelSource> {
+    if a.axis.is_some() && !matches!(a.layout, Some(LayoutArg::Revolve(..))) {
+        bail!("--axis sets the axis of --layout revolve:SxL; give that layout or leave --axis out");
+    }
+    Ok(match (a.segment, a.layout) {
+        (true, _) => LabelSource::Segment(a.segment_options.config()),
+        (false, Some(LayoutArg::Cube)) => LabelSource::Layout(Layout::Cube),
+        (false, Some(LayoutArg::Grid(rows, cols))) => {
+            LabelSource::Layout(Layout::Grid { rows, cols })
+        }
+        (false, Some(LayoutArg::Revolve(sectors, bands))) => LabelSource::Layout(Layout::Revolve {
+            sectors,
+            bands,
+            axis: a.axis.unwrap_or_default(),
+        }),
+        (false, None) => LabelSource::Attribute,
+    })
 }
 
 /// A distinct colour for patch `k` (hues a golden angle apart).
@@ -453,8 +506,12 @@ fn tables(r: &ReconstructReport, seconds: f64) -> String {
         ]);
     }
     let tt = &r.totals;
+    let layout = r
+        .layout
+        .as_ref()
+        .map_or(String::new(), |l| format!("{l}\n"));
     format!(
-        "{}\n{}\n{} patches, {} edges, {} corners, {}; {} points (eq. 15: mean {}, max {}, rmse {}; orthogonal rmse {}, max {})\nlargest gap along an edge {} ({:.1e} of the diagonal {}), largest normal angle {:.2} deg; {:.2} s\n",
+        "{layout}{}\n{}\n{} patches, {} edges, {} corners, {}; {} points (eq. 15: mean {}, max {}, rmse {}; orthogonal rmse {}, max {})\nlargest gap along an edge {} ({:.1e} of the diagonal {}), largest normal angle {:.2} deg; {:.2} s\n",
         t.render(), e.render(),
         r.faces.len(), r.network.edges.len(), r.network.vertices.len(),
         if tt.closed { "closed" } else { "open" },
@@ -476,6 +533,7 @@ fn json_report(
     serde_json::json!({
         "input": a.input.input.display().to_string(),
         "labels": r.network.attribute,
+        "layout": r.layout.as_deref().unwrap_or("the file's labels"),
         "ignored_points": r.network.ignored,
         "dropped_non_finite": dropped,
         "spacing": r.network.spacing,

@@ -469,3 +469,77 @@ fn umbrella_is_one_open_shell_of_three_sided_panels() {
         );
     }
 }
+
+#[test]
+fn can_as_revolve_layout() {
+    // the file's labels are replaced by 4 sectors x 2 bands and 4 three-sided
+    // patches on each flat cap (closed ends, decided from the data)
+    let d = tmpdir("reconstruct", "revolve");
+    let input = d.join("can.xyz");
+    write_can(&input, |_, l| l.to_string());
+    let out = ok(&run(&[
+        "reconstruct",
+        s(&input),
+        "--layout",
+        "revolve:4x2",
+        "--axis",
+        "z",
+        "--json",
+        "-q",
+    ]));
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let t = &j["totals"];
+    assert_eq!(t["faces"], 16, "{t}");
+    let layout = j["layout"].as_str().unwrap();
+    assert!(
+        layout.contains("low end closed") && layout.contains("high end closed"),
+        "{layout}"
+    );
+    assert_eq!(t["closed"], true);
+    assert_eq!(t["corners"], 2 + 3 * 4);
+    assert!(t["max_gap"].as_f64().unwrap() <= 1e-9 * t["diagonal"].as_f64().unwrap());
+    let patches = j["patches"].as_array().unwrap();
+    let three = patches.iter().filter(|p| p["sides"] == 3).count();
+    assert_eq!(three, 8);
+    for p in patches {
+        let (f, n) = (
+            p["fold_overs"].as_u64().unwrap(),
+            p["points"].as_u64().unwrap(),
+        );
+        assert!(f * 200 <= n, "{p}");
+    }
+    // the crease at the rims costs more than the noise (sigma 0.00115)
+    assert!(t["orthogonal"]["rmse"].as_f64().unwrap() < 0.01, "{t}");
+}
+
+#[test]
+fn layout_values_are_checked() {
+    let e = refused(
+        "layout-value",
+        |_, l| l.to_string(),
+        &["--layout", "grid:3"],
+    );
+    assert!(e.contains("grid:RxC") && e.contains("revolve:SxL"), "{e}");
+    let e = refused(
+        "axis-alone",
+        |_, l| l.to_string(),
+        &["--layout", "cube", "--axis", "z"],
+    );
+    assert!(
+        e.contains("--axis sets the axis of --layout revolve"),
+        "{e}"
+    );
+    let e = refused(
+        "two-sectors",
+        |_, l| l.to_string(),
+        &["--layout", "revolve:2x2", "--axis", "z"],
+    );
+    assert!(e.contains("3 to 360 sectors"), "{e}");
+    // a grid on a closed can: no four-sided sheet
+    let e = refused(
+        "grid-on-can",
+        |_, l| l.to_string(),
+        &["--layout", "grid:2x2"],
+    );
+    assert!(e.contains("grid layout needs a sheet"), "{e}");
+}

@@ -9,11 +9,12 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use scanfit::base::turntable::AxisChoice;
 use scanfit::cloud::segment::{segment, SegmentConfig};
 use scanfit::network::layout::{LabelSource, Layout};
 use scanfit::pipeline::reconstruct::{run, ReconstructConfig};
 use scanfit::progress::NoProgress;
-use scanfit::PointCloud;
+use scanfit::{PointCloud, Vector3};
 use scanfit_io::model::ModelDoc;
 use scanfit_io::step_shell::step_shell_file;
 
@@ -26,8 +27,9 @@ fn data(file: &str) -> PathBuf {
 /// The cloud of a shipped file and its column `name` (if asked).
 fn read(file: &str, name: Option<&str>) -> (PointCloud, Vec<f64>) {
     let path = data(file);
+    // the layouts' own samples are PLY (the older terrain text file is bigger)
     assert!(
-        std::fs::metadata(&path).unwrap().len() < 1 << 20,
+        !file.ends_with(".ply") || std::fs::metadata(&path).unwrap().len() < 1 << 20,
         "{file} is over 1 MB"
     );
     let t = scanfit_io::read_cloud(&path, &scanfit_io::ReadOptions::default()).unwrap();
@@ -173,4 +175,294 @@ fn blob_as_a_cube_is_a_closed_solid_of_the_true_volume() {
         (vo - truth).abs() < 0.01 * truth,
         "OpenCASCADE volume {vo} vs {truth}"
     );
+}
+
+/// OpenCASCADE's reading of `model` written as STEP (`tests/occ/check_model.py`),
+/// or `None`, said loudly, when OpenCASCADE is not installed.
+fn occ_read(model: &scanfit::topology::PatchComplex, name: &str) -> Option<serde_json::Value> {
+    let step = step_shell_file(model, name).unwrap();
+    if !occ_available() {
+        eprintln!("\n**************************************************************");
+        eprintln!("* OpenCASCADE (pip install cadquery-ocp) is NOT installed:   *");
+        eprintln!("* {name:<20} was NOT read back by a CAD kernel         *");
+        eprintln!("**************************************************************\n");
+        assert!(
+            std::env::var_os("SCANFIT_REQUIRE_OCC").is_none(),
+            "SCANFIT_REQUIRE_OCC is set but OpenCASCADE is missing"
+        );
+        return None;
+    }
+    let dir = std::env::temp_dir().join(format!("scanfit-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (jp, sp) = (dir.join("model.json"), dir.join("model.stp"));
+    std::fs::write(&jp, ModelDoc::new(model).to_json().unwrap()).unwrap();
+    std::fs::write(&sp, &step.text).unwrap();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/occ/check_model.py");
+    let o = Command::new("python3")
+        .arg(script)
+        .arg(&jp)
+        .arg(&sp)
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{out}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    std::fs::remove_dir_all(&dir).ok();
+    let occ: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+    println!("OpenCASCADE on {name}: {occ}");
+    Some(occ)
+}
+
+/// The revolve layout's numbers every test asserts: patch counts by sides,
+/// no gap, fold-overs per patch at most 0.5% (noise at the borders).
+fn check_revolve(r: &scanfit::pipeline::reconstruct::ReconstructReport, four: usize, three: usize) {
+    let sides = |n| r.patches.iter().filter(|p| p.sides == n).count();
+    assert_eq!((sides(4), sides(3)), (four, three), "{:?}", r.patches);
+    for p in &r.patches {
+        println!(
+            "patch {}: {} sides, {} points, {} folded, orth rmse {:.4}",
+            p.id, p.sides, p.points, p.fold_overs, p.orthogonal.rmse
+        );
+        assert!(
+            p.fold_overs * 200 <= p.points,
+            "patch {}: {} folded",
+            p.id,
+            p.fold_overs
+        );
+    }
+    assert!(
+        r.totals.max_gap <= 1e-9 * r.totals.diagonal,
+        "{}",
+        r.totals.max_gap
+    );
+}
+
+fn revolve(sectors: usize, bands: usize, axis: AxisChoice) -> ReconstructConfig {
+    let mut cfg = ReconstructConfig::default();
+    cfg.source = LabelSource::Layout(Layout::Revolve {
+        sectors,
+        bands,
+        axis,
+    });
+    cfg
+}
+
+#[test]
+fn vessel_as_revolve_is_a_closed_solid_of_the_true_volume() {
+    // the pot with its flat bottom and domed lid, its own labels ignored
+    let (cloud, _) = read("vessel_30k.ply", None);
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(data("vessel_30k.json")).unwrap()).unwrap();
+    let truth = doc["true_volume"].as_f64().unwrap();
+    let r = run(&cloud, &revolve(4, 3, AxisChoice::Principal), &NoProgress).unwrap();
+    // 4 x 3 side patches, 4 three-sided caps at each closed end
+    check_revolve(&r, 12, 8);
+    assert!(r.totals.closed);
+    // corners: 2 poles, 4 on each of the 4 circles (cap rims and band cuts)
+    assert_eq!(r.network.vertices.len(), 2 + 4 * 4);
+    assert_eq!(r.network.edges.len(), 4 * 4 + 4 * 5);
+    let v = r.complex.signed_volume().abs();
+    println!(
+        "vessel: volume {v} (true {truth}), orthogonal rmse {}",
+        r.totals.orthogonal.rmse
+    );
+    assert!((v - truth).abs() < 0.01 * truth, "volume {v} vs {truth}");
+    let Some(occ) = occ_read(&r.complex, "vessel") else {
+        return;
+    };
+    assert_eq!(occ["solids"], 1, "{occ}");
+    assert_eq!(occ["faces"], 20, "{occ}");
+    assert_eq!(occ["valid"], true, "{occ}");
+    assert_eq!(occ["free_edges"], 0, "{occ}");
+    let vo = occ["volume"].as_f64().unwrap();
+    assert!(
+        (vo - truth).abs() < 0.01 * truth,
+        "OpenCASCADE volume {vo} vs {truth}"
+    );
+}
+
+#[test]
+fn open_pot_as_revolve_is_the_pde_papers_twelve_subsets() {
+    // the vessel without its lid (label 14): open at the top, a flat bottom
+    let (cloud, label) = read("vessel_30k.ply", Some("label"));
+    let pts: Vec<_> = cloud
+        .points()
+        .iter()
+        .zip(&label)
+        .filter(|(_, &l)| l != 14.0)
+        .map(|(p, _)| *p)
+        .collect();
+    let cloud = PointCloud::new(pts).unwrap();
+    // without its lid the pot is wider than tall: its principal axis lies
+    // across it, so the axis is given (as `--axis z`)
+    let r = run(
+        &cloud,
+        &revolve(4, 2, AxisChoice::Given(Vector3::z())),
+        &NoProgress,
+    )
+    .unwrap();
+    // Fig. 9 of the PDE paper: 12 subsets, 8 side patches and 4 three-sided bottom patches
+    check_revolve(&r, 8, 4);
+    assert!(!r.totals.closed);
+    let free = r.edges.iter().filter(|e| e.patches[1].is_none()).count();
+    assert_eq!(free, 4, "the rim: one free edge per sector");
+    let Some(occ) = occ_read(&r.complex, "open-pot") else {
+        return;
+    };
+    assert_eq!(occ["shells"], 1, "{occ}");
+    assert_eq!(occ["faces"], 12, "{occ}");
+    assert_eq!(occ["valid"], true, "{occ}");
+    assert_eq!(occ["free_edges"], 4, "{occ}");
+}
+
+#[test]
+fn grid_3x3_against_one_patch_with_as_many_control_points() {
+    use scanfit::base::CoonsProjection;
+    use scanfit::network::FaceFit;
+    use scanfit::pipeline::coons::{self, CoonsConfig, CoonsRoute};
+    // a four-sided sheet with detail everywhere: the Jacksboro fault DEM
+    let (cloud, _) = read("terrain_50k.xyz", None);
+    let mut cfg = ReconstructConfig::default();
+    cfg.source = LabelSource::Layout(Layout::Grid { rows: 3, cols: 3 });
+    cfg.fit = FaceFit::Bspline { ctrl: (8, 8) };
+    let grid = run(&cloud, &cfg, &NoProgress).unwrap();
+    assert_eq!(grid.patches.len(), 9);
+    assert!(
+        grid.patches.iter().all(|p| p.sides == 4),
+        "{:?}",
+        grid.patches
+    );
+    assert!(grid.totals.max_gap <= 1e-9 * grid.totals.diagonal);
+    for p in &grid.patches {
+        assert!(
+            p.fold_overs * 200 <= p.points,
+            "patch {}: {} folded",
+            p.id,
+            p.fold_overs
+        );
+    }
+    // every control point of every face counts (shared boundary rows twice)
+    let total: usize = grid
+        .faces
+        .iter()
+        .map(|f| f.surface.control_points().len())
+        .sum();
+    let n = (total as f64).sqrt().ceil() as usize;
+    let mut one = CoonsConfig::default();
+    one.route = CoonsRoute::bspline((3, 3), (n, n));
+    one.ctrl_from_density = false;
+    one.relative_smoothing = None;
+    one.projection = Some(CoonsProjection::Inversion(Default::default()));
+    let single = coons::run(&cloud, &one, &NoProgress).unwrap();
+    let (g, s) = (
+        grid.totals.orthogonal.rmse,
+        single.assessment.quality.orthogonal.rmse,
+    );
+    println!(
+        "grid 3x3: {total} control points, orthogonal rmse {g:.3}; one patch {n}x{n}: rmse {s:.3}"
+    );
+    assert!(single.surface.control_points().len() >= total);
+    // the PDE route: 9 patches of 5 x 5 terms against one of 15 x 15
+    let mut cfg = ReconstructConfig::default();
+    cfg.source = LabelSource::Layout(Layout::Grid { rows: 3, cols: 3 });
+    let grid_pde = run(&cloud, &cfg, &NoProgress).unwrap();
+    let mut one = CoonsConfig::default();
+    one.route = CoonsRoute::pde(15, 15);
+    let single_pde = coons::run(&cloud, &one, &NoProgress).unwrap();
+    let (gp, sp) = (
+        grid_pde.totals.orthogonal.rmse,
+        single_pde.assessment.quality.orthogonal.rmse,
+    );
+    println!("PDE: grid 3x3 of 5x5 terms: rmse {gp:.3}; one patch of 15x15 terms: rmse {sp:.3}");
+    // Measured, not the hoped-for result: on this terrain (detail at every
+    // scale, a near-planar base) the grid does NOT beat one patch with as
+    // many control points. Least squares: grid 40.99 m against 36.56 m (the
+    // grid's shared boundary rows count twice and its patches join only
+    // C0); PDE route: 61.02 m against 61.82 m (1.3% better, the edge curves
+    // adding freedom the term count does not show). These bounds guard the
+    // measurement.
+    assert!(
+        (1.05..1.20).contains(&(g / s)),
+        "grid rmse {g} vs one patch {s}"
+    );
+    assert!(
+        (0.95..1.0).contains(&(gp / sp)),
+        "PDE grid rmse {gp} vs one patch {sp}"
+    );
+}
+
+#[test]
+fn layouts_refuse_the_wrong_shape() {
+    let spacing = |c: &PointCloud| c.spacing().unwrap().median;
+    // a grid on a closed object: no four clear corners
+    let (blob, _) = read("blob_30k.ply", None);
+    let e = scanfit::network::layout::grid::grid_labels(&blob, 3, 3, spacing(&blob))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("four clear corners") && e.contains("--layout cube"),
+        "{e}"
+    );
+    // a grid on a sheet with a hole: where the hole is
+    let (panel, _) = read("patch_20k.ply", None);
+    let e = scanfit::network::layout::grid::grid_labels(&panel, 3, 3, spacing(&panel))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("1 hole(s)"), "{e}");
+    // revolve on a sheet: no axis
+    let (terrain, _) = read("terrain_50k.xyz", None);
+    let e = scanfit::network::layout::revolve::revolve_labels(
+        &terrain,
+        4,
+        2,
+        AxisChoice::Principal,
+        spacing(&terrain),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("no axis to revolve about") && e.contains("grid:RxC"),
+        "{e}"
+    );
+}
+
+#[test]
+fn segmented_part_is_one_valid_solid() {
+    // faces with more than four corners (the step's riser and the side
+    // below it) are written as chains of edge uses
+    let (cloud, _) = read("part_30k.ply", None);
+    let mut cfg = ReconstructConfig::default();
+    cfg.source = LabelSource::Segment(SegmentConfig::default());
+    let r = run(&cloud, &cfg, &NoProgress).unwrap();
+    let uses: Vec<usize> = r
+        .sides
+        .iter()
+        .map(|s| s.iter().map(Vec::len).sum())
+        .collect();
+    println!(
+        "part: edge uses per face {uses:?}, gap {}",
+        r.totals.max_gap
+    );
+    assert_eq!(r.patches.len(), 8);
+    assert_eq!(uses.iter().filter(|&&u| u > 4).count(), 2, "{uses:?}");
+    assert!(r.totals.closed);
+    assert!(r.totals.max_gap <= 1e-9 * r.totals.diagonal);
+    let Some(occ) = occ_read(&r.complex, "part") else {
+        return;
+    };
+    assert_eq!(occ["shells"], 1, "{occ}");
+    assert_eq!(occ["solids"], 1, "{occ}");
+    assert_eq!(occ["faces"], 8, "{occ}");
+    assert_eq!(occ["valid"], true, "{occ}");
+    assert_eq!(occ["free_edges"], 0, "{occ}");
+    // OpenCASCADE's volume is scanfit's own quadrature of the same faces
+    let (vo, v) = (
+        occ["volume"].as_f64().unwrap(),
+        r.complex.signed_volume().abs(),
+    );
+    // (scanfit's quadrature differs from OpenCASCADE's by 4.4e-4 here)
+    assert!((vo - v).abs() < 1e-3 * v, "OpenCASCADE {vo} vs {v}");
 }

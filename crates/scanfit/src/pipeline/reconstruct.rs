@@ -135,6 +135,8 @@ pub struct ReconstructReport {
     pub edges: Vec<EdgeReport>,
     /// Totals.
     pub totals: Totals,
+    /// What the segmentation or layout found (`None`: the cloud's own labels).
+    pub layout: Option<String>,
     /// The model as a [`PatchComplex`] (faces sharing edges, a side of a
     /// patch with more than four corners a chain of several), for the CAD
     /// writers.
@@ -208,12 +210,15 @@ fn run_centred(
     // generated ids go into the label attribute of a copy, read as hand labels are
     let labelled;
     let mut net_cfg = cfg.network.clone();
-    let cloud = match generate_labels(cloud, &cfg.source, progress)? {
+    let generated = generate_labels(cloud, &cfg.source, progress)?;
+    let layout = generated.as_ref().map(|g| g.summary.clone());
+    let cloud = match generated {
         None => cloud,
-        Some(ids) => {
-            labelled = cloud
-                .clone()
-                .with_attribute(GENERATED_LABEL, ids.iter().map(|&i| i as f64).collect())?;
+        Some(g) => {
+            labelled = cloud.clone().with_attribute(
+                GENERATED_LABEL,
+                g.labels.iter().map(|&i| i as f64).collect(),
+            )?;
             net_cfg.labels.attribute = Some(GENERATED_LABEL.into());
             &labelled
         }
@@ -321,6 +326,7 @@ fn run_centred(
         patches,
         edges,
         totals,
+        layout,
         complex,
     })
 }

@@ -5,14 +5,18 @@
 //!   labels, or `scanfit cloud segment`'s output edited by hand).
 //! * [`LabelSource::Segment`]: regions between sharp edges
 //!   ([`crate::cloud::segment`], [COONS19] §I).
-//! * [`LabelSource::Layout`]: a layout for a smooth object ([`cube`]).
+//! * [`LabelSource::Layout`]: a layout for a smooth object ([`cube`],
+//!   [`grid`], [`revolve`]).
 //!
 //! Every source ends as one integer id per point in the attribute
 //! [`GENERATED_LABEL`], read by the same [`super::read_labels`] as hand
 //! labels: nothing downstream knows where the ids came from.
 
 pub mod cube;
+pub mod grid;
+pub mod revolve;
 
+use crate::base::turntable::AxisChoice;
 use crate::cloud::segment::{segment, SegmentConfig};
 use crate::progress::Progress;
 use crate::{PointCloud, Result};
@@ -22,12 +26,31 @@ use crate::{PointCloud, Result};
 pub const GENERATED_LABEL: &str = "label";
 
 /// A layout for a smooth object.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub enum Layout {
     /// Six four-sided patches by central projection onto a box
     /// ([`cube::cube_labels`]); for closed star-shaped objects.
     Cube,
+    /// A sheet cut along iso-parameter lines of its Coons base into
+    /// `rows x cols` patches ([`grid::grid_labels`]).
+    Grid {
+        /// Patches along the base's `u`.
+        rows: usize,
+        /// Patches along the base's `v`.
+        cols: usize,
+    },
+    /// A cylinder-like object cut into `sectors x bands` patches about its
+    /// axis, each closed end into `sectors` three-sided caps
+    /// ([`revolve::revolve_labels`]).
+    Revolve {
+        /// Angle ranges about the axis (at least 3).
+        sectors: usize,
+        /// Height ranges along the axis between the caps (or open ends).
+        bands: usize,
+        /// The axis (the turntable's choice; default the principal axis).
+        axis: AxisChoice,
+    },
 }
 
 /// Where the patch ids come from.
@@ -41,6 +64,16 @@ pub enum LabelSource {
     Segment(SegmentConfig),
     /// A layout for a smooth object.
     Layout(Layout),
+}
+
+/// Labels made by a segmentation or a layout.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GeneratedLabels {
+    /// The patch id of every point.
+    pub labels: Vec<i64>,
+    /// One line on what was found (regions, the axis and ends of a revolve
+    /// layout, ...), for the report.
+    pub summary: String,
 }
 
 /// The patch id of every point from `source`, or `None` for
@@ -58,25 +91,59 @@ pub enum LabelSource {
 /// }).collect();
 /// let cloud = PointCloud::new(pts)?;
 /// let ids = generate_labels(&cloud, &LabelSource::Layout(Layout::Cube), &NoProgress)?.unwrap();
-/// assert_eq!(ids.iter().max(), Some(&5));
+/// assert_eq!(ids.labels.iter().max(), Some(&5));
 /// # Ok::<(), scanfit::Error>(())
 /// ```
 pub fn generate_labels(
     cloud: &PointCloud,
     source: &LabelSource,
     progress: &dyn Progress,
-) -> Result<Option<Vec<i64>>> {
+) -> Result<Option<GeneratedLabels>> {
     match source {
         LabelSource::Attribute => Ok(None),
         LabelSource::Segment(cfg) => {
             progress.stage("segmentation by normal variation", None);
             let s = segment(cloud, cfg)?;
-            Ok(Some(s.labels.iter().map(|&l| i64::from(l)).collect()))
+            Ok(Some(GeneratedLabels {
+                labels: s.labels.iter().map(|&l| i64::from(l)).collect(),
+                summary: format!(
+                    "segmentation: {} regions between sharp edges",
+                    s.regions.len()
+                ),
+            }))
         }
-        LabelSource::Layout(Layout::Cube) => {
-            progress.stage("cube layout", None);
+        LabelSource::Layout(layout) => {
             let spacing = cloud.spacing()?.median;
-            Ok(Some(cube::cube_labels(cloud, spacing)?.labels))
+            let (labels, summary) = match *layout {
+                Layout::Cube => {
+                    progress.stage("cube layout", None);
+                    let c = cube::cube_labels(cloud, spacing)?;
+                    (
+                        c.labels,
+                        "cube: 6 four-sided patches by central projection".into(),
+                    )
+                }
+                Layout::Grid { rows, cols } => {
+                    progress.stage("grid layout (Coons base)", None);
+                    let g = grid::grid_labels(cloud, rows, cols, spacing)?;
+                    let summary = format!(
+                        "grid {rows}x{cols} along iso-lines of the sheet's Coons base; {} patches",
+                        rows * cols
+                    );
+                    (g.labels, summary)
+                }
+                Layout::Revolve {
+                    sectors,
+                    bands,
+                    axis,
+                } => {
+                    progress.stage("revolve layout", None);
+                    let r = revolve::revolve_labels(cloud, sectors, bands, axis, spacing)?;
+                    let summary = r.summary(sectors);
+                    (r.labels, summary)
+                }
+            };
+            Ok(Some(GeneratedLabels { labels, summary }))
         }
     }
 }
