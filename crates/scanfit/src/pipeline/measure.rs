@@ -98,7 +98,7 @@ pub fn run(
         centring.restore(assess_projected(&local, &pts, &config.assess)?)
     };
     let max = assessment.quality.orthogonal.max;
-    let mut sorted = assessment.distances();
+    let mut sorted = assessment.distances().to_vec();
     sorted.sort_by(f64::total_cmp);
     // nearest-rank percentiles; `assess_projected` refused an empty set
     let pct = |f: f64| {
