@@ -22,8 +22,8 @@ pub enum MeasureArg {
 #[derive(Args, Debug, Clone, Copy)]
 pub struct MeasureArgs {
     /// How much of the result is measured: full (every measure over every
-    /// point), sample (the point spacing, fold-overs and stretch on a seeded
-    /// random sample of 200000 points when there are more; the errors,
+    /// point), sample (the point spacing, fold-overs and stretch on seeded
+    /// random samples when there are more than 200000 points; the errors,
     /// orthogonal distances and eq. 17 over every point) or none (the errors
     /// at the parameters and the extent check only: the fastest).
     #[arg(long, default_value = "sample", value_name = "HOW", value_parser = choice::<MeasureArg>())]

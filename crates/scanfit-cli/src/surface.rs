@@ -194,6 +194,22 @@ fn locate(e: scanfit::Error, table: &PointTable) -> anyhow::Error {
     }
 }
 
+/// Reads the input and fits; an error names the file and the place in it
+/// of the point it is about.
+fn read_and_fit(a: &FitArgs, progress: &Progress) -> Result<(PointCloud, FitReport)> {
+    progress.stage(format!("reading {}", a.input.input.display()));
+    let mut table = a.outliers.apply_table(a.input.table(a.json)?, a.json)?;
+    let cloud = cloud_of(a, &mut table)?;
+    match fit(&cloud, &a.config(), progress) {
+        Ok(r) => Ok((cloud, r)),
+        Err(e) => {
+            // the points back into the table, to locate the one named
+            table.points = cloud.into_parts().0;
+            Err(locate(e, &table))
+        }
+    }
+}
+
 /// Runs `scanfit fit`.
 pub fn run(a: FitArgs) -> Result<()> {
     a.out.check(
@@ -208,17 +224,7 @@ pub fn run(a: FitArgs) -> Result<()> {
         return crate::stream::fit(&a, n);
     }
     let progress = Progress::spinner(a.quiet);
-    progress.stage(format!("reading {}", a.input.input.display()));
-    let mut table = a.outliers.apply_table(a.input.table(a.json)?, a.json)?;
-    let cloud = cloud_of(&a, &mut table)?;
-    let r = match fit(&cloud, &a.config(), &progress) {
-        Ok(r) => r,
-        Err(e) => {
-            // the points back into the table, to locate the one named
-            table.points = cloud.into_parts().0;
-            return Err(locate(e, &table));
-        }
-    };
+    let (cloud, r) = read_and_fit(&a, &progress)?;
     a.out.guard(
         &r.assessment.quality,
         "raise the smoothing (--smooth; by default it is scaled to the data) or use fewer control points (--ctrl)",
