@@ -10,8 +10,8 @@ make_franke.py.
 
 Each command runs `--repeat` times (default 3) under `/usr/bin/time -v`
 with SCANFIT_TIMINGS=1 (the CLI then prints each stage's wall time); the
-script prints, per command, the median wall time, the stage split of the
-median run, the largest peak RSS and the bytes per point, and the load
+script prints, per command, the median wall time and CPU time, the stage
+split of the median run, the largest peak RSS and the bytes per point, and the load
 average before and after (the machine is shared). Arguments after `--` are
 added to every command (e.g. `--measure full`).
 """
@@ -33,7 +33,9 @@ def run_once(cmd):
     seconds = sum(x * 60 ** (len(parts) - 1 - i) for i, x in enumerate(parts))
     rss_kb = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", p.stderr).group(1))
     stages = re.findall(r"^timing: (.*): ([0-9.]+) s$", p.stderr, re.M)
-    return seconds, rss_kb, stages
+    cpu = sum(float(re.search(rf"{k} time \(seconds\): ([0-9.]+)", p.stderr).group(1))
+              for k in ("User", "System"))
+    return seconds, rss_kb, stages, cpu
 
 
 def main():
@@ -65,7 +67,9 @@ def main():
         median_run = min(runs, key=lambda r: abs(r[0] - med))
         peak = max(r[1] for r in runs) * 1024
         print(f"## {name} {n} points: {' '.join(cmd[1:])}")
-        print(f"wall s: {' '.join(f'{t:.2f}' for t in times)}; median {med:.2f}")
+        cpu = statistics.median(r[3] for r in runs)
+        print(f"wall s: {' '.join(f'{t:.2f}' for t in times)}; median {med:.2f}; "
+              f"median CPU (user + system) {cpu:.2f} s")
         print(f"peak RSS {peak / 1e6:.0f} MB = {peak / n:.0f} bytes/point; "
               f"load average {load0:.1f} -> {load1:.1f}")
         print("stages of the median run: " + "; ".join(

@@ -57,9 +57,9 @@
 use rayon::prelude::*;
 
 use crate::bspline::Surface;
+use crate::mba::ResidualSums;
 use crate::metrics::{
-    parameterization_quality, parameterization_quality_where, parametric_distances, ErrorStats,
-    ParamQuality,
+    parameterization_quality, parameterization_quality_where, ErrorStats, ParamQuality,
 };
 use crate::progress::{NoProgress, Progress};
 use crate::project::{Inversion, InversionConfig, InversionWorkspace, SurfaceInverter};
@@ -414,13 +414,18 @@ fn assess(
     }
     check(config)?;
     progress.stage("measuring: errors at the parameters", None);
-    let residuals = parametric_distances(surface, points, uv);
-    let (distances, unconverged) = match config.measure {
-        Measure::None => (Vec::new(), Vec::new()),
+    let (residuals, at_parameters, _) = block_stats(
+        points.len(),
+        config.per_point,
+        || (),
+        |i, _| ((surface.point(uv[i][0], uv[i][1]) - points[i]).norm(), true),
+    );
+    let (distances, orthogonal, unconverged) = match config.measure {
+        Measure::None => (Vec::new(), ErrorStats::default(), Vec::new()),
         _ => {
             progress.stage("measuring: orthogonal distances", None);
             let inverter = SurfaceInverter::new(surface, config.inversion)?;
-            orthogonal_from(&inverter, points, uv)
+            orthogonal_from(&inverter, points, uv, config.per_point)
         }
     };
     finish(
@@ -428,6 +433,8 @@ fn assess(
         &all,
         uv,
         Measured {
+            at_parameters,
+            orthogonal,
             residuals,
             distances,
             unconverged,
@@ -439,47 +446,83 @@ fn assess(
     )
 }
 
-/// The orthogonal distance of every point and the indices of the points
-/// whose inversion did not converge: Newton started at the point's own
-/// parameters (the foot of a fitted point is near them), and where that does
-/// not converge the inverter's KD-tree start with its restarts; the better
-/// result counts.
+/// Values per block of the per-point statistics: fixed, so the sums (in
+/// blocks, merged in order) do not depend on the thread count.
+const STATS_BLOCK: usize = 1 << 16;
+
+/// Statistics of per-point values computed block by block in parallel
+/// (`value(i, ws)` with a workspace per block), merged in order; the values
+/// are kept only with `keep`, and the indices where `value` says "not
+/// converged" are collected.
+fn block_stats<W>(
+    n: usize,
+    keep: bool,
+    workspace: impl Fn() -> W + Sync,
+    value: impl Fn(usize, &mut W) -> (f64, bool) + Sync,
+) -> (Vec<f64>, ErrorStats, Vec<usize>) {
+    let block = |b: usize, mut out: Option<&mut [f64]>| {
+        let mut ws = workspace();
+        let (mut sums, mut bad) = (ResidualSums::default(), Vec::new());
+        for (k, i) in (b * STATS_BLOCK..((b + 1) * STATS_BLOCK).min(n)).enumerate() {
+            let (x, ok) = value(i, &mut ws);
+            sums.push(x);
+            if !ok {
+                bad.push(i);
+            }
+            if let Some(o) = out.as_deref_mut() {
+                o[k] = x;
+            }
+        }
+        (sums, bad)
+    };
+    let mut kept = if keep { vec![0.0; n] } else { Vec::new() };
+    let parts: Vec<(ResidualSums, Vec<usize>)> = if keep {
+        kept.par_chunks_mut(STATS_BLOCK)
+            .enumerate()
+            .map(|(b, o)| block(b, Some(o)))
+            .collect()
+    } else {
+        (0..n.div_ceil(STATS_BLOCK))
+            .into_par_iter()
+            .map(|b| block(b, None))
+            .collect()
+    };
+    let mut total = ResidualSums::default();
+    let mut bad = Vec::new();
+    for (sums, b) in parts {
+        total.merge(&sums);
+        bad.extend(b);
+    }
+    (kept, total.stats(), bad)
+}
+
+/// The orthogonal distances (kept with `keep`), their statistics and the
+/// indices of the points whose inversion did not converge: Newton started
+/// at the point's own parameters (the foot of a fitted point is near them),
+/// and where that does not converge the inverter's KD-tree start with its
+/// restarts; the better result counts.
 fn orthogonal_from(
     inverter: &SurfaceInverter<'_>,
     points: &[Point3],
     uv: &[[f64; 2]],
-) -> (Vec<f64>, Vec<usize>) {
-    // an unconverged distance is marked by its sign bit (a distance is >= 0)
-    // and restored below: no second per-point array
-    let mut d: Vec<f64> = points
-        .par_iter()
-        .zip(uv.par_iter())
-        .map_init(
-            || InversionWorkspace::new(inverter.surface()),
-            |ws, (p, t)| {
-                let mut r = inverter.invert_from(p, *t, ws);
-                if !r.converged {
-                    let again = inverter.invert(p, ws);
-                    if again.converged || again.distance < r.distance {
-                        r = again;
-                    }
+    keep: bool,
+) -> (Vec<f64>, ErrorStats, Vec<usize>) {
+    block_stats(
+        points.len(),
+        keep,
+        || InversionWorkspace::new(inverter.surface()),
+        |i, ws| {
+            let p = &points[i];
+            let mut r = inverter.invert_from(p, uv[i], ws);
+            if !r.converged {
+                let again = inverter.invert(p, ws);
+                if again.converged || again.distance < r.distance {
+                    r = again;
                 }
-                if r.converged {
-                    r.distance
-                } else {
-                    -r.distance - 0.0
-                }
-            },
-        )
-        .collect();
-    let mut unconverged = Vec::new();
-    for (i, x) in d.iter_mut().enumerate() {
-        if x.is_sign_negative() {
-            unconverged.push(i);
-            *x = x.abs();
-        }
-    }
-    (d, unconverged)
+            }
+            (r.distance, r.converged)
+        },
+    )
 }
 
 /// Assesses `surface` against `points` that have no parameters of their
@@ -538,6 +581,8 @@ pub fn assess_projected(
         &AllPoints::Slice(points),
         &uv,
         Measured {
+            at_parameters: ErrorStats::of(&distances),
+            orthogonal: ErrorStats::of(&distances),
             residuals: distances.clone(),
             distances,
             unconverged,
@@ -591,6 +636,8 @@ fn check(config: &AssessConfig) -> Result<()> {
 
 /// The per-point measures of an assessment.
 struct Measured {
+    at_parameters: ErrorStats,
+    orthogonal: ErrorStats,
     residuals: Vec<f64>,
     distances: Vec<f64>,
     unconverged: Vec<usize>,
@@ -718,8 +765,7 @@ fn finish(
 ) -> Result<Assessment> {
     let points = all.points();
     let n = points.len();
-    let at_parameters = ErrorStats::of(&measured.residuals);
-    let orthogonal = ErrorStats::of(&measured.distances);
+    let (at_parameters, orthogonal) = (measured.at_parameters, measured.orthogonal);
     let sampled = config.measure == Measure::Sample && n > config.sample_points;
     let mut sample = sampled.then_some(StatisticsSample {
         seed: config.seed,
@@ -786,11 +832,7 @@ fn finish(
         // fold-overs or stretch to report
         parameterization_quality(surface, points, uv).unwrap_or_default()
     };
-    let (residuals, distances) = if config.per_point {
-        (measured.residuals, measured.distances)
-    } else {
-        (Vec::new(), Vec::new())
-    };
+    let (residuals, distances) = (measured.residuals, measured.distances);
     Ok(Assessment {
         quality: SurfaceQuality {
             points: n,
