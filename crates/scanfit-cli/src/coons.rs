@@ -442,7 +442,7 @@ fn outputs(
         &document(a, points.len(), r),
         points,
         &Deviation {
-            per_point: &dist,
+            per_point: dist,
             stats: r.assessment.quality.orthogonal,
             name: "orthogonal distance",
         },
@@ -464,7 +464,7 @@ fn outputs(
             ("v", &v),
             ("coons", &r.coons_distances),
             ("residual", &r.assessment.residuals),
-            ("distance", &dist),
+            ("distance", dist),
             ("outside", &outside),
         ];
         files.push((pout.clone(), points_file(pout, points, &attrs)));

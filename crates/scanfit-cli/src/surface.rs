@@ -246,7 +246,7 @@ pub fn run(a: FitArgs) -> Result<()> {
     doc.quality = Some(quality.clone());
     let dist = r.assessment.distances();
     let deviation = Deviation {
-        per_point: &dist,
+        per_point: dist,
         stats: q.orthogonal,
         name: "orthogonal distance",
     };
@@ -266,7 +266,7 @@ pub fn run(a: FitArgs) -> Result<()> {
             ("u", &u),
             ("v", &v),
             ("residual", &r.assessment.residuals),
-            ("distance", &dist),
+            ("distance", dist),
         ];
         files.push((pout.clone(), points_file(pout, pts, &attrs)));
     }
