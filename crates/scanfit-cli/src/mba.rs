@@ -24,6 +24,7 @@ use crate::table::{num, Table};
 
 const EXAMPLES: &str = "Examples:
   scanfit mba examples/data/terrain_50k.xyz --levels 6 -o terrain.json --png terrain.png
+  scanfit mba examples/data/terrain_50k.xyz --levels 6 --units m --view top --png terrain_map.png
   scanfit mba examples/data/terrain_50k.xyz --levels 6 --adjust --weight aza04 --deviation-png dev.png
   scanfit mba lidar.las --base 3x2 --tolerance 0.05 --mesh dem.ply
 
