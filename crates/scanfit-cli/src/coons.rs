@@ -227,6 +227,7 @@ fn config(a: &CoonsArgs) -> Result<CoonsConfig> {
         (_, None) => None,
     };
     let mut cfg = CoonsConfig::default();
+    cfg.assess = a.out.measure.config(cfg.assess, true);
     cfg.route = match pde_terms {
         None => {
             let mut f = SurfaceFitConfig {
@@ -296,6 +297,10 @@ pub fn run(a: CoonsArgs) -> Result<()> {
     a.out.check(
         &a.input.input,
         &[(&a.points_out, "--points-out", &["ply", "xyz"][..])],
+    )?;
+    a.out.check_measured(
+        PngStyle::Deviation,
+        a.points_out.as_ref().map(|_| "--points-out"),
     )?;
     let cfg = config(&a)?;
     let t0 = Instant::now();
@@ -438,7 +443,7 @@ fn outputs(
         &document(a, points.len(), r),
         points,
         &Deviation {
-            per_point: &dist,
+            per_point: dist,
             stats: r.assessment.quality.orthogonal,
             name: "orthogonal distance",
         },
@@ -460,7 +465,7 @@ fn outputs(
             ("v", &v),
             ("coons", &r.coons_distances),
             ("residual", &r.assessment.residuals),
-            ("distance", &dist),
+            ("distance", dist),
             ("outside", &outside),
         ];
         files.push((pout.clone(), points_file(pout, points, &attrs)));

@@ -34,6 +34,7 @@ mod curve;
 mod export;
 mod extent;
 mod mba;
+mod measure;
 mod outputs;
 mod progress;
 mod reconstruct;

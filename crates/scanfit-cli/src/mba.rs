@@ -156,6 +156,9 @@ impl MbaArgs {
             max_steps: self.adjust_steps,
             ..Default::default()
         });
+        // the outputs show the vertical distances, which the report keeps
+        // anyway: the assessment keeps no per-point values
+        c.assess = self.out.measure.config(c.assess, false);
         c
     }
 
@@ -301,6 +304,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
             "levels": rows(&r.levels),
             "quality": doc.quality,
             "samples_to_points": samples_json(q),
+            "measure": crate::measure::json(&r.assessment),
             "trim": crate::cad::trim_json(trimmed.as_ref()),
             "seconds": r.seconds,
             "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
@@ -398,5 +402,8 @@ fn print_report(a: &MbaArgs, r: &MbaReport) -> Result<()> {
             "grid points to nearest point (eq. 17)"
         )
     );
+    if let Some(note) = crate::measure::note(&r.assessment) {
+        outln!("{note}");
+    }
     Ok(())
 }

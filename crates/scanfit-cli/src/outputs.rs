@@ -56,6 +56,8 @@ pub struct SurfaceOutputArgs {
     #[arg(long)]
     pub allow_extrapolation: bool,
     #[command(flatten)]
+    pub measure: crate::measure::MeasureArgs,
+    #[command(flatten)]
     pub units: crate::cad::UnitsArgs,
     #[command(flatten)]
     pub view: crate::view::ViewArgs,
@@ -154,6 +156,32 @@ impl SurfaceOutputArgs {
         check_outputs(&[input], &all)
     }
 
+    /// Whether an output shows the per-point deviation (`--deviation-png`,
+    /// a PLY or glb `--mesh`, `--png` in the deviation style), so the
+    /// assessment must keep it.
+    pub fn needs_deviation(&self, style: PngStyle) -> bool {
+        self.deviation_png.is_some()
+            || (self.png.is_some() && style == PngStyle::Deviation)
+            || self.mesh.as_deref().is_some_and(|m| extension(m) != "obj")
+    }
+
+    /// Refuses `--measure none` when an output (`extra`: the command's own,
+    /// e.g. `--points-out`) shows the orthogonal distances it leaves out.
+    pub fn check_measured(&self, style: PngStyle, extra: Option<&str>) -> Result<()> {
+        if self.measure.measure != crate::measure::MeasureArg::None {
+            return Ok(());
+        }
+        let what = if self.needs_deviation(style) {
+            Some("the deviation picture and the PLY/glb mesh colours")
+        } else {
+            extra
+        };
+        if let Some(what) = what {
+            bail!("{what} show the orthogonal distances, which --measure none leaves out; use --measure sample (the default)");
+        }
+        Ok(())
+    }
+
     /// Fails with one line that says how far the surface left the data and
     /// what to try (`fix`, the command's own options), unless
     /// `--allow-extrapolation` is given.
@@ -211,10 +239,7 @@ impl SurfaceOutputArgs {
         };
         // the local fit error on the surface: each mesh vertex shows the
         // deviation of its nearest input point, on the scale of the error table
-        let vertex_dev = if self.deviation_png.is_some()
-            || (self.png.is_some() && picture.style == PngStyle::Deviation)
-            || self.mesh.as_deref().is_some_and(|m| extension(m) != "obj")
-        {
+        let vertex_dev = if self.needs_deviation(picture.style) {
             let near = nearest_points(points, &mesh.vertices)?;
             Some(
                 near.iter()
@@ -504,6 +529,23 @@ pub fn provenance(
 /// `far_spacings` point spacings. `eq17` labels the eq. 17 row.
 pub fn quality_rows(t: &mut Table, q: &SurfaceQuality, eq17: &str) {
     let data = || "data units".to_string();
+    if q.orthogonal.count == 0 {
+        // --measure none
+        for what in [
+            "orthogonal distance to the surface",
+            eq17,
+            "surface samples to nearest point",
+        ] {
+            t.row(vec![
+                what.into(),
+                "-".into(),
+                "-".into(),
+                "-".into(),
+                "not measured".into(),
+            ]);
+        }
+        return;
+    }
     t.row(vec![
         "orthogonal distance to the surface".into(),
         num(q.orthogonal.mean),

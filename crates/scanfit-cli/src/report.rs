@@ -125,7 +125,7 @@ fn pictures(
     // colours from 0 to the 99th percentile of the points' distances
     let scale = ColourScale::deviation(
         "orthogonal distance [data units]",
-        &r.assessment.distances(),
+        r.assessment.distances(),
         DEVIATION_PERCENTILE,
     );
     let deviation = Colouring::Scalar {

@@ -17,7 +17,7 @@ use scanfit_io::{write_all_atomic, PointTable};
 use crate::args::{choice, option_note, InputArgs, NXM};
 use crate::outputs::{
     points_file, print_written, provenance, quality_doc, quality_rows, samples_json, Deviation,
-    Picture,
+    Picture, PngStyle,
 };
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -133,6 +133,9 @@ impl FitArgs {
             c.relative_smoothing = None;
         }
         c.correction_rounds = self.correct;
+        // per-point residuals and distances only for the outputs that show them
+        let per_point = self.points_out.is_some() || self.out.needs_deviation(PngStyle::Height);
+        c.assess = self.out.measure.config(c.assess, per_point);
         c
     }
 
@@ -158,25 +161,29 @@ impl FitArgs {
 }
 
 /// The points of `table` as a cloud, with its u and v columns as attributes
-/// when the parameters come from them.
-fn cloud_of(a: &FitArgs, table: &PointTable) -> Result<PointCloud> {
+/// when the parameters come from them. The points and those columns move
+/// out of the table (no copy); what stays locates points in the file.
+fn cloud_of(a: &FitArgs, table: &mut PointTable) -> Result<PointCloud> {
     if a.params == ParamsArg::Plane && a.periodic_u {
         bail!("--periodic-u needs parameters that go around (--params uv-columns); a plane cannot close");
     }
-    let cloud = PointCloud::new(table.points.clone()).map_err(|e| locate(e, table))?;
-    if a.params == ParamsArg::Plane {
-        return Ok(cloud);
-    }
-    let (Some(u), Some(v)) = (table.column("u"), table.column("v")) else {
+    let given = table.column("u").is_some() && table.column("v").is_some();
+    if a.params != ParamsArg::Plane && !given {
         bail!(
             "{} has no columns named u and v (its columns: {}); use --params plane or add them",
             a.input.input.display(),
             table.columns.join(", ")
         );
-    };
-    Ok(cloud
-        .with_attribute("u", u.to_vec())?
-        .with_attribute("v", v.to_vec())?)
+    }
+    // checked here, where a bad point can still be located in the file
+    scanfit::validate_points(&table.points).map_err(|e| locate(e, table))?;
+    let cloud = PointCloud::new(std::mem::take(&mut table.points))?;
+    if a.params == ParamsArg::Plane {
+        return Ok(cloud);
+    }
+    let u = table.take_column("u").unwrap_or_default();
+    let v = table.take_column("v").unwrap_or_default();
+    Ok(cloud.with_attribute("u", u)?.with_attribute("v", v)?)
 }
 
 /// The library's error with the file and line of the point it names.
@@ -189,20 +196,37 @@ fn locate(e: scanfit::Error, table: &PointTable) -> anyhow::Error {
     }
 }
 
+/// Reads the input and fits; an error names the file and the place in it
+/// of the point it is about.
+fn read_and_fit(a: &FitArgs, progress: &Progress) -> Result<(PointCloud, FitReport)> {
+    progress.stage(format!("reading {}", a.input.input.display()));
+    let mut table = a.outliers.apply_table(a.input.table(a.json)?, a.json)?;
+    let cloud = cloud_of(a, &mut table)?;
+    match fit(&cloud, &a.config(), progress) {
+        Ok(r) => Ok((cloud, r)),
+        Err(e) => {
+            // the points back into the table, to locate the one named
+            table.points = cloud.into_parts().0;
+            Err(locate(e, &table))
+        }
+    }
+}
+
 /// Runs `scanfit fit`.
 pub fn run(a: FitArgs) -> Result<()> {
     a.out.check(
         &a.input.input,
         &[(&a.points_out, "--points-out", &["ply", "xyz"][..])],
     )?;
+    a.out.check_measured(
+        PngStyle::Height,
+        a.points_out.as_ref().map(|_| "--points-out"),
+    )?;
     if let Some(n) = a.chunk_points {
         return crate::stream::fit(&a, n);
     }
     let progress = Progress::spinner(a.quiet);
-    progress.stage(format!("reading {}", a.input.input.display()));
-    let table = a.outliers.apply_table(a.input.table(a.json)?, a.json)?;
-    let cloud = cloud_of(&a, &table)?;
-    let r = fit(&cloud, &a.config(), &progress).map_err(|e| locate(e, &table))?;
+    let (cloud, r) = read_and_fit(&a, &progress)?;
     a.out.guard(
         &r.assessment.quality,
         "raise the smoothing (--smooth; by default it is scaled to the data) or use fewer control points (--ctrl)",
@@ -224,7 +248,7 @@ pub fn run(a: FitArgs) -> Result<()> {
     doc.quality = Some(quality.clone());
     let dist = r.assessment.distances();
     let deviation = Deviation {
-        per_point: &dist,
+        per_point: dist,
         stats: q.orthogonal,
         name: "orthogonal distance",
     };
@@ -244,7 +268,7 @@ pub fn run(a: FitArgs) -> Result<()> {
             ("u", &u),
             ("v", &v),
             ("residual", &r.assessment.residuals),
-            ("distance", &dist),
+            ("distance", dist),
         ];
         files.push((pout.clone(), points_file(pout, pts, &attrs)));
     }
@@ -259,6 +283,7 @@ pub fn run(a: FitArgs) -> Result<()> {
             "parameters": name(&a.params),
             "quality": quality,
             "samples_to_points": samples_json(q),
+            "measure": crate::measure::json(&r.assessment),
             "trim": crate::cad::trim_json(trimmed.as_ref()),
             "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
         });
@@ -336,13 +361,18 @@ fn print_report(a: &FitArgs, r: &FitReport) -> Result<()> {
         )
     );
     let pq = &q.parameterization;
-    outln!(
-        "\nparameterization: {} fold-overs in {} triangles, L2 stretch {:.3} (1 = uniform), max anisotropy {}",
-        pq.fold_overs,
-        pq.triangles,
-        pq.l2_stretch,
-        num(pq.max_anisotropy)
-    );
+    if let Some(note) = crate::measure::note(&r.assessment) {
+        outln!("{note}");
+    }
+    if pq.triangles > 0 {
+        outln!(
+            "\nparameterization: {} fold-overs in {} triangles, L2 stretch {:.3} (1 = uniform), max anisotropy {}",
+            pq.fold_overs,
+            pq.triangles,
+            pq.l2_stretch,
+            num(pq.max_anisotropy)
+        );
+    }
     if q.unconverged > 0 {
         outln!(
             "note: {} point inversions did not converge (their distance is the best found)",

@@ -163,6 +163,7 @@ pub struct TurntableArgs {
 fn config(a: &TurntableArgs) -> TurntableConfig {
     let weight = WeightFactor::from(a.weight);
     let mut cfg = TurntableConfig::default();
+    cfg.assess = a.out.measure.config(cfg.assess, true);
     let t = &mut cfg.turntable;
     t.axis = a.axis;
     t.views.views = a.views;

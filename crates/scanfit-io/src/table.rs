@@ -274,15 +274,27 @@ impl PointTable {
 
     /// The extra column named `name` (ASCII case-insensitive), if any.
     pub fn column(&self, name: &str) -> Option<&[f64]> {
+        self.extra
+            .get(self.extra_index(name)?)
+            .map(|v| v.as_slice())
+    }
+
+    /// Moves the extra column `name` out of the table (no copy; as
+    /// [`PointTable::column`] finds it), leaving it empty.
+    pub fn take_column(&mut self, name: &str) -> Option<Vec<f64>> {
+        let i = self.extra_index(name)?;
+        self.extra.get_mut(i).map(std::mem::take)
+    }
+
+    /// The index in `extra` of the column `name` (exact name first, then
+    /// ignoring case); `None` for x, y, z and unknown names.
+    fn extra_index(&self, name: &str) -> Option<usize> {
         let i = self.columns.iter().position(|c| c == name).or_else(|| {
             self.columns
                 .iter()
                 .position(|c| c.eq_ignore_ascii_case(name))
         })?;
-        if i < 3 {
-            return None;
-        }
-        self.extra.get(i - 3).map(|v| v.as_slice())
+        i.checked_sub(3)
     }
 
     /// The points as a [`PointCloud`] with every extra column as an attribute.

@@ -102,13 +102,13 @@ pub fn assessment(
     warn_extent(py, &a.quality)?;
     d.set_item("quality", quality(py, &a.quality, correction_rmse)?)?;
     d.set_item("residuals", vec1(py, a.residuals.clone()))?;
-    d.set_item("distances", vec1(py, a.distances()))?;
-    d.set_item(
-        "converged",
-        vec1(
-            py,
-            a.inversions.iter().map(|i| i.converged).collect::<Vec<_>>(),
-        ),
-    )?;
+    d.set_item("distances", vec1(py, a.distances().to_vec()))?;
+    let mut converged = vec![true; a.distances().len()];
+    for &i in &a.unconverged {
+        if let Some(c) = converged.get_mut(i) {
+            *c = false;
+        }
+    }
+    d.set_item("converged", vec1(py, converged))?;
     Ok(())
 }

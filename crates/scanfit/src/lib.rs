@@ -59,6 +59,7 @@ pub mod pipeline;
 pub mod progress;
 pub mod project;
 pub mod quality;
+pub mod sampling;
 pub mod spatial;
 pub mod surface;
 pub mod testdata;

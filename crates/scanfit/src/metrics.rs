@@ -186,6 +186,19 @@ pub fn parameterization_quality(
     points: &[Point3],
     uv: &[[f64; 2]],
 ) -> Result<ParamQuality> {
+    parameterization_quality_where(surface, points, uv, |_| true)
+}
+
+/// [`parameterization_quality`] over the Delaunay triangles of `uv` that
+/// `keep` accepts (given the triangle's three parameter pairs): the sampled
+/// measure keeps those of a cluster sample that are triangles of the whole
+/// set too ([`crate::sampling::CellSample::keeps_triangle`]).
+pub(crate) fn parameterization_quality_where(
+    surface: &Surface,
+    points: &[Point3],
+    uv: &[[f64; 2]],
+    keep: impl Fn([[f64; 2]; 3]) -> bool,
+) -> Result<ParamQuality> {
     if points.len() != uv.len() {
         return Err(Error::InvalidInput(format!(
             "{} points but {} parameter pairs",
@@ -206,7 +219,9 @@ pub fn parameterization_quality(
     let all: Vec<[usize; 3]> = tri
         .inner_faces()
         .map(|f| f.vertices().map(|v| v.data().index))
+        .filter(|f| keep(f.map(|i| uv[i])))
         .collect();
+    drop(tri);
     // Triangles with an edge longer than 4x the median edge are slivers along
     // the convex hull of the parameters (or across holes): artefacts of
     // triangulating a point set, not part of the parameterization.

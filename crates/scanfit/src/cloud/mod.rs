@@ -134,6 +134,13 @@ impl PointCloud {
         &self.points
     }
 
+    /// Whether the KD-tree of the neighbour queries is built already (by
+    /// an earlier query): a caller with a cheaper way to answer a few
+    /// queries uses the tree only when it costs nothing more.
+    pub fn has_tree(&self) -> bool {
+        self.tree.get().is_some()
+    }
+
     /// Number of points.
     pub fn len(&self) -> usize {
         self.points.len()

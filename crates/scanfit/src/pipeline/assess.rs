@@ -28,16 +28,81 @@
 //! [`assess_projected`] does the same for points without parameters (they
 //! get those of their orthogonal projections), as `scanfit report` needs.
 //!
+//! **What it costs** (issue 18): [`AssessConfig::measure`] chooses between
+//! every measure over every point ([`Measure::Full`]), the default
+//! [`Measure::Sample`], and [`Measure::None`] (the errors at the parameters
+//! and the extent check only). With `Sample`, a cloud of more than
+//! [`AssessConfig::sample_points`] points has its *statistical* measures
+//! taken on a seeded random sample ([`crate::sampling`]): the median point
+//! spacing over `sample_points / 4` uniformly drawn points (each measured
+//! against all points), fold-overs and stretch over the Delaunay triangles
+//! of a cluster sample of about `sample_points` points that are triangles of
+//! the whole set's triangulation too; [`Assessment::sample`] says so.
+//! Everything else stays exact over every point: the errors at the
+//! parameters, the orthogonal distances (point inversion started at the
+//! points' own parameters, falling back to the KD-tree start where that does
+//! not converge), eq. 17 and the sample-grid distances (nearest points over
+//! the cloud's KD-tree when it is built already, as after the MBA level
+//! check, else over KD-trees of chunks of [`CHUNK_POINTS`] points, so no
+//! index of all points is held).
+//! [`assess_cloud`] takes the pipeline's own cloud, so the points are not
+//! copied and its KD-tree is reused.
+//!
 //! A pipeline whose error at the parameters is measured on another surface
 //! than the one assessed (the PDE route measures eq. 15 on the PDE surface,
 //! before its B-spline conversion) overwrites
 //! [`SurfaceQuality::at_parameters`] after the call; the fields are public
 //! for that.
 
+use rayon::prelude::*;
+
 use crate::bspline::Surface;
-use crate::metrics::{parameterization_quality, parametric_distances, ErrorStats, ParamQuality};
-use crate::project::{Inversion, InversionConfig, SurfaceInverter};
+use crate::mba::ResidualSums;
+use crate::metrics::{
+    parameterization_quality, parameterization_quality_where, ErrorStats, ParamQuality,
+};
+use crate::progress::{NoProgress, Progress};
+use crate::project::{Inversion, InversionConfig, InversionWorkspace, SurfaceInverter};
+use crate::sampling::{sample_indices, CellSample, DEFAULT_SEED};
+use crate::spatial::KdTree;
 use crate::{Error, Point3, PointCloud, Result};
+
+/// Points per KD-tree when the nearest points are searched chunk by chunk
+/// (2^20: 32 MiB of tree at a time).
+pub const CHUNK_POINTS: usize = 1 << 20;
+
+/// Default of [`AssessConfig::sample_points`].
+pub const DEFAULT_SAMPLE_POINTS: usize = 200_000;
+
+/// How much [`assess_surface`] measures (`--measure` on the command line).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum Measure {
+    /// Every measure over every point (the spacing of every point, a
+    /// Delaunay triangulation of all parameters).
+    Full,
+    /// Statistical measures (spacing, fold-overs, stretch) on a seeded
+    /// random sample of [`AssessConfig::sample_points`] points when there
+    /// are more; the rest over every point (the default).
+    #[default]
+    Sample,
+    /// The errors at the parameters and the extent check only (by the
+    /// diagonal rule, as the spacing is not measured): no orthogonal
+    /// distances, eq. 17, sample-grid distances or parameterization
+    /// quality (their fields stay zero).
+    None,
+}
+
+impl Measure {
+    /// The name on the command line and in JSON reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Measure::Full => "full",
+            Measure::Sample => "sample",
+            Measure::None => "none",
+        }
+    }
+}
 
 /// Settings of [`assess_surface`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -65,6 +130,18 @@ pub struct AssessConfig {
     /// median point spacings (default 10) *and* than `leave_diagonal` x
     /// the box's diagonal.
     pub leave_spacings: f64,
+    /// How much is measured (default [`Measure::Sample`]).
+    pub measure: Measure,
+    /// Above this many points, [`Measure::Sample`] takes the spacing and the
+    /// parameterization quality on a sample of about this many points
+    /// (default [`DEFAULT_SAMPLE_POINTS`]; at least 1000).
+    pub sample_points: usize,
+    /// Seed of the samples (default [`DEFAULT_SEED`]).
+    pub seed: u64,
+    /// Keep the per-point residuals and orthogonal distances in the
+    /// [`Assessment`] (default true); without them only the statistics are
+    /// kept, 16 bytes per point less.
+    pub per_point: bool,
     /// The share of the diagonal in that rule (default 0.25). A fit that
     /// covers the empty corners of its parameter rectangle by continuing the
     /// data's slope leaves the box by a share of the diagonal, not of the
@@ -84,8 +161,27 @@ impl Default for AssessConfig {
             parameterization: true,
             leave_spacings: 10.0,
             leave_diagonal: 0.25,
+            measure: Measure::Sample,
+            sample_points: DEFAULT_SAMPLE_POINTS,
+            seed: DEFAULT_SEED,
+            per_point: true,
         }
     }
+}
+
+/// The samples the statistical measures were taken on ([`Measure::Sample`]
+/// on more than [`AssessConfig::sample_points`] points).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub struct StatisticsSample {
+    /// Points whose nearest-neighbour distance gave the median spacing
+    /// (uniformly drawn, each measured against all points).
+    pub spacing_points: usize,
+    /// Points of the cluster sample whose Delaunay triangles gave the
+    /// fold-overs and stretch (0 when the parameterization was not measured).
+    pub parameterization_points: usize,
+    /// The seed of both samples.
+    pub seed: u64,
 }
 
 /// Distances from surface samples to their nearest input point (the
@@ -161,16 +257,30 @@ pub struct SurfaceQuality {
 pub struct Assessment {
     /// The summary.
     pub quality: SurfaceQuality,
-    /// `|P_i - S(u_i, v_i)|` per point.
+    /// What was measured ([`AssessConfig::measure`]).
+    pub measured: Measure,
+    /// `Some` when the spacing and the parameterization quality were taken
+    /// on samples (see [`StatisticsSample`]), `None` when over every point.
+    pub sample: Option<StatisticsSample>,
+    /// `|P_i - S(u_i, v_i)|` per point (empty without
+    /// [`AssessConfig::per_point`]).
     pub residuals: Vec<f64>,
-    /// The orthogonal projection of each point.
+    /// The orthogonal distance of each point (empty without
+    /// [`AssessConfig::per_point`] or with [`Measure::None`]).
+    pub distances: Vec<f64>,
+    /// Indices of the points whose inversion did not converge (their
+    /// distance is the best found), increasing.
+    pub unconverged: Vec<usize>,
+    /// The orthogonal projection of each point: filled by
+    /// [`assess_projected`] (the points' parameters are their
+    /// projections'), empty otherwise.
     pub inversions: Vec<Inversion>,
 }
 
 impl Assessment {
-    /// The orthogonal distance of each point.
-    pub fn distances(&self) -> Vec<f64> {
-        self.inversions.iter().map(|r| r.distance).collect()
+    /// The orthogonal distance of each point (see [`Assessment::distances`]).
+    pub fn distances(&self) -> &[f64] {
+        &self.distances
     }
 }
 
@@ -213,6 +323,83 @@ pub fn assess_surface(
     uv: &[[f64; 2]],
     config: &AssessConfig,
 ) -> Result<Assessment> {
+    assess(
+        surface,
+        AllPoints::Slice(points),
+        uv,
+        None,
+        config,
+        &NoProgress,
+    )
+}
+
+/// [`assess_surface`] of the points of `cloud` (a pipeline's own cloud):
+/// the points are not copied, and the cloud's KD-tree serves the
+/// nearest-point queries when it is built already (the full measure builds
+/// it). Its steps show as stages of `progress` (`measuring: ...`).
+///
+/// ```
+/// use scanfit::bspline::{KnotVector, Surface};
+/// use scanfit::pipeline::assess::{assess_cloud, assess_surface, AssessConfig};
+/// use scanfit::progress::NoProgress;
+/// use scanfit::{Point3, PointCloud};
+///
+/// let k = KnotVector::uniform_clamped(1, 2)?;
+/// let c = vec![
+///     Point3::new(0., 0., 0.), Point3::new(0., 1., 0.),
+///     Point3::new(1., 0., 0.), Point3::new(1., 1., 0.),
+/// ];
+/// let s = Surface::new(k.clone(), k, c)?;
+/// let uv: Vec<[f64; 2]> = (0..400).map(|i| [(i % 20) as f64 / 19.0, (i / 20) as f64 / 19.0]).collect();
+/// let pts: Vec<Point3> = uv.iter().map(|t| Point3::new(t[0], t[1], 0.01 * t[0])).collect();
+/// let cloud = PointCloud::new(pts.clone())?;
+/// let a = assess_cloud(&s, &cloud, &uv, &AssessConfig::default(), &NoProgress)?;
+/// assert_eq!(a, assess_surface(&s, &pts, &uv, &AssessConfig::default())?);
+/// assert!((a.quality.at_parameters.max - 0.01).abs() < 1e-12);
+/// assert!(a.sample.is_none()); // 400 points: everything measured on all
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+pub fn assess_cloud(
+    surface: &Surface,
+    cloud: &PointCloud,
+    uv: &[[f64; 2]],
+    config: &AssessConfig,
+    progress: &dyn Progress,
+) -> Result<Assessment> {
+    assess(surface, AllPoints::Cloud(cloud), uv, None, config, progress)
+}
+
+/// [`assess_cloud`] with [MBA18] eq. 17 measured at the points `eq17`
+/// instead of the surface's knot lines (the MBA pipeline measures it at its
+/// lattice's knot grid), in the same pass over the points.
+pub(crate) fn assess_cloud_eq17(
+    surface: &Surface,
+    cloud: &PointCloud,
+    uv: &[[f64; 2]],
+    eq17: Vec<Point3>,
+    config: &AssessConfig,
+    progress: &dyn Progress,
+) -> Result<Assessment> {
+    assess(
+        surface,
+        AllPoints::Cloud(cloud),
+        uv,
+        Some(eq17),
+        config,
+        progress,
+    )
+}
+
+/// The assessment of the points of `all` at parameters `uv`.
+fn assess(
+    surface: &Surface,
+    all: AllPoints<'_>,
+    uv: &[[f64; 2]],
+    eq17: Option<Vec<Point3>>,
+    config: &AssessConfig,
+    progress: &dyn Progress,
+) -> Result<Assessment> {
+    let points = all.points();
     if points.is_empty() {
         return Err(Error::InvalidInput(
             "no points to assess the surface against".into(),
@@ -226,10 +413,116 @@ pub fn assess_surface(
         });
     }
     check(config)?;
-    let residuals = parametric_distances(surface, points, uv);
-    let inverter = SurfaceInverter::new(surface, config.inversion)?;
-    let inversions = inverter.invert_all(points);
-    finish(surface, points, uv, residuals, inversions, config)
+    progress.stage("measuring: errors at the parameters", None);
+    let (residuals, at_parameters, _) = block_stats(
+        points.len(),
+        config.per_point,
+        || (),
+        |i, _| ((surface.point(uv[i][0], uv[i][1]) - points[i]).norm(), true),
+    );
+    let (distances, orthogonal, unconverged) = match config.measure {
+        Measure::None => (Vec::new(), ErrorStats::default(), Vec::new()),
+        _ => {
+            progress.stage("measuring: orthogonal distances", None);
+            let inverter = SurfaceInverter::new(surface, config.inversion)?;
+            orthogonal_from(&inverter, points, uv, config.per_point)
+        }
+    };
+    finish(
+        surface,
+        &all,
+        uv,
+        Measured {
+            at_parameters,
+            orthogonal,
+            residuals,
+            distances,
+            unconverged,
+            inversions: Vec::new(),
+        },
+        eq17,
+        config,
+        progress,
+    )
+}
+
+/// Values per block of the per-point statistics: fixed, so the sums (in
+/// blocks, merged in order) do not depend on the thread count.
+const STATS_BLOCK: usize = 1 << 16;
+
+/// Statistics of per-point values computed block by block in parallel
+/// (`value(i, ws)` with a workspace per block), merged in order; the values
+/// are kept only with `keep`, and the indices where `value` says "not
+/// converged" are collected.
+fn block_stats<W>(
+    n: usize,
+    keep: bool,
+    workspace: impl Fn() -> W + Sync,
+    value: impl Fn(usize, &mut W) -> (f64, bool) + Sync,
+) -> (Vec<f64>, ErrorStats, Vec<usize>) {
+    let block = |b: usize, mut out: Option<&mut [f64]>| {
+        let mut ws = workspace();
+        let (mut sums, mut bad) = (ResidualSums::default(), Vec::new());
+        for (k, i) in (b * STATS_BLOCK..((b + 1) * STATS_BLOCK).min(n)).enumerate() {
+            let (x, ok) = value(i, &mut ws);
+            sums.push(x);
+            if !ok {
+                bad.push(i);
+            }
+            if let Some(o) = out.as_deref_mut() {
+                o[k] = x;
+            }
+        }
+        (sums, bad)
+    };
+    let mut kept = if keep { vec![0.0; n] } else { Vec::new() };
+    let parts: Vec<(ResidualSums, Vec<usize>)> = if keep {
+        kept.par_chunks_mut(STATS_BLOCK)
+            .enumerate()
+            .map(|(b, o)| block(b, Some(o)))
+            .collect()
+    } else {
+        (0..n.div_ceil(STATS_BLOCK))
+            .into_par_iter()
+            .map(|b| block(b, None))
+            .collect()
+    };
+    let mut total = ResidualSums::default();
+    let mut bad = Vec::new();
+    for (sums, b) in parts {
+        total.merge(&sums);
+        bad.extend(b);
+    }
+    (kept, total.stats(), bad)
+}
+
+/// The orthogonal distances (kept with `keep`), their statistics and the
+/// indices of the points whose inversion did not converge: Newton started
+/// at the point's own parameters (the foot of a fitted point is near them),
+/// and where that does not converge the inverter's KD-tree start with its
+/// restarts; the better result counts.
+fn orthogonal_from(
+    inverter: &SurfaceInverter<'_>,
+    points: &[Point3],
+    uv: &[[f64; 2]],
+    keep: bool,
+) -> (Vec<f64>, ErrorStats, Vec<usize>) {
+    block_stats(
+        points.len(),
+        keep,
+        || InversionWorkspace::new(inverter.surface()),
+        |i, ws| {
+            let p = &points[i];
+            let mut r = inverter.invert_from(p, uv[i], ws);
+            if !r.converged {
+                let again = inverter.invert(p, ws);
+                if again.converged || again.distance < r.distance {
+                    r = again;
+                }
+            }
+            (r.distance, r.converged)
+        },
+    )
 }
 
 /// Assesses `surface` against `points` that have no parameters of their
@@ -270,8 +563,35 @@ pub fn assess_projected(
     let inverter = SurfaceInverter::new(surface, config.inversion)?;
     let inversions = inverter.invert_all(points);
     let uv: Vec<[f64; 2]> = inversions.iter().map(|r| r.uv).collect();
-    let residuals: Vec<f64> = inversions.iter().map(|r| r.distance).collect();
-    finish(surface, points, &uv, residuals, inversions, config)
+    let distances: Vec<f64> = inversions.iter().map(|r| r.distance).collect();
+    let unconverged = (0..inversions.len())
+        .filter(|&i| !inversions[i].converged)
+        .collect();
+    // the projections are measured whatever `measure` says: they are the
+    // parameters
+    let config = AssessConfig {
+        measure: match config.measure {
+            Measure::None => Measure::Sample,
+            m => m,
+        },
+        ..*config
+    };
+    finish(
+        surface,
+        &AllPoints::Slice(points),
+        &uv,
+        Measured {
+            at_parameters: ErrorStats::of(&distances),
+            orthogonal: ErrorStats::of(&distances),
+            residuals: distances.clone(),
+            distances,
+            unconverged,
+            inversions,
+        },
+        None,
+        &config,
+        &NoProgress,
+    )
 }
 
 /// Rejects settings the assessment cannot use.
@@ -295,6 +615,13 @@ fn check(config: &AssessConfig) -> Result<()> {
             });
         }
     }
+    if config.sample_points < 1000 {
+        return Err(Error::InvalidSetting {
+            setting: "sample_points",
+            value: config.sample_points.to_string(),
+            hint: "give a sample of at least 1000 points".into(),
+        });
+    }
     if let Some((nu, nv)) = config.samples {
         if !(1..=4096).contains(&nu) || !(1..=4096).contains(&nv) {
             return Err(Error::InvalidSetting {
@@ -307,44 +634,262 @@ fn check(config: &AssessConfig) -> Result<()> {
     Ok(())
 }
 
+/// The per-point measures of an assessment.
+struct Measured {
+    at_parameters: ErrorStats,
+    orthogonal: ErrorStats,
+    residuals: Vec<f64>,
+    distances: Vec<f64>,
+    unconverged: Vec<usize>,
+    inversions: Vec<Inversion>,
+}
+
+/// All points of an assessment, and where their nearest-point queries go.
+enum AllPoints<'a> {
+    /// Points without an index: one is built when needed (a cloud of a
+    /// copy for the full measure, KD-trees of chunks for the sampled one).
+    Slice(&'a [Point3]),
+    /// A cloud whose KD-tree is used (built if the full measure needs it).
+    Cloud(&'a PointCloud),
+}
+
+impl AllPoints<'_> {
+    fn points(&self) -> &[Point3] {
+        match self {
+            AllPoints::Slice(p) => p,
+            AllPoints::Cloud(c) => c.points(),
+        }
+    }
+}
+
+/// The nearest-point queries over all points.
+enum Index<'a> {
+    /// A cloud and its KD-tree.
+    Cloud(std::borrow::Cow<'a, PointCloud>),
+    /// KD-trees of [`CHUNK_POINTS`] points at a time.
+    Chunks(&'a [Point3]),
+}
+
+impl<'a> Index<'a> {
+    /// The index for `all`: the cloud's tree when `all` is a cloud and the
+    /// tree is built or `exact` (every point's spacing) is asked, else
+    /// chunks; for a slice and `exact`, a cloud of a copy (small data).
+    fn of(all: &AllPoints<'a>, exact: bool) -> Result<Self> {
+        Ok(match *all {
+            AllPoints::Cloud(c) if exact || c.has_tree() => {
+                Index::Cloud(std::borrow::Cow::Borrowed(c))
+            }
+            AllPoints::Cloud(c) => Index::Chunks(c.points()),
+            AllPoints::Slice(p) if exact => {
+                Index::Cloud(std::borrow::Cow::Owned(PointCloud::new(p.to_vec())?))
+            }
+            AllPoints::Slice(p) => Index::Chunks(p),
+        })
+    }
+
+    /// The distance from each of `queries` to the nearest point, and from
+    /// each point `i` of `others` to its nearest other point (a duplicate
+    /// of it counts, at 0; as [`PointCloud::spacing`] measures it), in one
+    /// pass over the points.
+    fn query(&self, queries: &[Point3], others: &[usize]) -> Result<(Vec<f64>, Vec<f64>)> {
+        let other = |tree: &KdTree, p: &Point3, i: usize, offset: usize| {
+            let two = tree.nearest_n(p, std::num::NonZeroUsize::MIN.saturating_add(1));
+            two.iter()
+                .find(|n| n.index + offset != i)
+                .map_or(f64::INFINITY, |n| n.distance)
+        };
+        match self {
+            Index::Cloud(c) => {
+                let near = c
+                    .nearest_batch(queries)?
+                    .into_iter()
+                    .map(|n| n.distance)
+                    .collect();
+                if others.is_empty() {
+                    return Ok((near, Vec::new()));
+                }
+                let tree = c.tree()?;
+                let pts = c.points();
+                let far = others
+                    .par_iter()
+                    .map(|&i| other(tree, &pts[i], i, 0))
+                    .collect();
+                Ok((near, far))
+            }
+            Index::Chunks(points) => {
+                let mut near = vec![f64::INFINITY; queries.len()];
+                let mut far = vec![f64::INFINITY; others.len()];
+                for (k, chunk) in points.chunks(CHUNK_POINTS).enumerate() {
+                    let tree = KdTree::new(chunk, "the points")?;
+                    near.par_iter_mut()
+                        .zip(queries.par_iter())
+                        .for_each(|(b, q)| *b = b.min(tree.nearest(q).distance));
+                    let offset = k * CHUNK_POINTS;
+                    far.par_iter_mut()
+                        .zip(others.par_iter())
+                        .for_each(|(b, &i)| *b = b.min(other(&tree, &points[i], i, offset)));
+                }
+                Ok((near, far))
+            }
+        }
+    }
+}
+
+/// Points whose nearest-neighbour distance gives the sampled median
+/// spacing: a quarter of [`AssessConfig::sample_points`] (50 000 by
+/// default: the median of that many nearest-neighbour distances is within
+/// about 0.5% of the whole cloud's, at a quarter of the KD-tree queries).
+fn spacing_sample(config: &AssessConfig) -> usize {
+    config.sample_points / 4
+}
+
+/// The median of `d` (the upper one for an even count, as
+/// [`PointCloud::spacing`]); 0 when empty.
+fn median(mut d: Vec<f64>) -> f64 {
+    if d.is_empty() {
+        return 0.0;
+    }
+    let mid = d.len() / 2;
+    *d.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
 /// The rest of the assessment once the residuals and projections are known.
 fn finish(
     surface: &Surface,
-    points: &[Point3],
+    all: &AllPoints<'_>,
     uv: &[[f64; 2]],
-    residuals: Vec<f64>,
-    inversions: Vec<Inversion>,
+    measured: Measured,
+    eq17: Option<Vec<Point3>>,
     config: &AssessConfig,
+    progress: &dyn Progress,
 ) -> Result<Assessment> {
-    let at_parameters = ErrorStats::of(&residuals);
-    let dist: Vec<f64> = inversions.iter().map(|r| r.distance).collect();
-    let orthogonal = ErrorStats::of(&dist);
-    let unconverged = inversions.iter().filter(|r| !r.converged).count();
-    let cloud = PointCloud::new(points.to_vec())?;
-    let grid_rmse = crate::metrics::rmse_to_cloud(&cloud, &knot_line_points(surface))?;
-    let (samples_to_points, samples) = sample_distances(surface, &cloud, config)?;
-    let extent = extent(surface, &cloud, &samples, samples_to_points.spacing, config);
-    let parameterization = if config.parameterization {
+    let points = all.points();
+    let n = points.len();
+    let (at_parameters, orthogonal) = (measured.at_parameters, measured.orthogonal);
+    let sampled = config.measure == Measure::Sample && n > config.sample_points;
+    let mut sample = sampled.then_some(StatisticsSample {
+        seed: config.seed,
+        ..Default::default()
+    });
+    let ((nu, nv), samples) = sample_grid(surface, config)?;
+    let (grid_rmse, samples_to_points) = if config.measure == Measure::None {
+        let distances = SampleDistances {
+            grid: (nu, nv),
+            far_spacings: config.far_spacings,
+            ..Default::default()
+        };
+        (0.0, distances)
+    } else {
+        progress.stage("measuring: nearest points and spacing", None);
+        let index = Index::of(all, !sampled)?;
+        let chosen = match sample.as_mut() {
+            Some(s) if n >= 2 => {
+                let c = sample_indices(n, spacing_sample(config), config.seed);
+                s.spacing_points = c.len();
+                c
+            }
+            _ => Vec::new(),
+        };
+        let mut queries = eq17.unwrap_or_else(|| knot_line_points(surface));
+        let k = queries.len();
+        queries.extend_from_slice(&samples);
+        let (near, others) = index.query(&queries, &chosen)?;
+        drop(queries);
+        let grid_rmse = rms(&near[..k]);
+        let spacing = match &index {
+            _ if n < 2 => 0.0,
+            _ if sampled => median(others),
+            Index::Cloud(c) => c.spacing()?.median,
+            Index::Chunks(_) => median(index.query(&[], &(0..n).collect::<Vec<_>>())?.1),
+        };
+        let d = &near[k..];
+        let limit = config.far_spacings * spacing;
+        let far = d.iter().filter(|&&x| x > limit).count();
+        let distances = SampleDistances {
+            grid: (nu, nv),
+            stats: ErrorStats::of(d),
+            spacing,
+            far_spacings: config.far_spacings,
+            far_share: far as f64 / d.len().max(1) as f64,
+        };
+        (grid_rmse, distances)
+    };
+    let extent = match bounding_box(points) {
+        Some(b) => extent_in_box(surface, b, &samples, samples_to_points.spacing, config),
+        None => Extent::default(),
+    };
+    if config.parameterization && config.measure != Measure::None {
+        progress.stage("measuring: fold-overs and stretch", None);
+    }
+    let parameterization = if !config.parameterization || config.measure == Measure::None {
+        ParamQuality::default()
+    } else if let Some(s) = sample.as_mut() {
+        let (q, count) = sampled_parameterization(surface, points, uv, config);
+        s.parameterization_points = count;
+        q
+    } else {
         // a parameter set that cannot be triangulated (all collinear) has no
         // fold-overs or stretch to report
         parameterization_quality(surface, points, uv).unwrap_or_default()
-    } else {
-        ParamQuality::default()
     };
+    let (residuals, distances) = (measured.residuals, measured.distances);
     Ok(Assessment {
         quality: SurfaceQuality {
-            points: points.len(),
+            points: n,
             at_parameters,
             orthogonal,
-            unconverged,
+            unconverged: measured.unconverged.len(),
             grid_rmse,
             samples_to_points,
             parameterization,
             extent,
         },
+        measured: config.measure,
+        sample,
         residuals,
-        inversions,
+        distances,
+        unconverged: measured.unconverged,
+        inversions: measured.inversions,
     })
+}
+
+/// Root mean square of `d` (0 when empty): [MBA18] eq. 17 over its grid.
+fn rms(d: &[f64]) -> f64 {
+    (d.iter().map(|x| x * x).sum::<f64>() / d.len().max(1) as f64).sqrt()
+}
+
+/// The axis-aligned bounding box of `points` (`None` when empty).
+fn bounding_box(points: &[Point3]) -> Option<(Point3, Point3)> {
+    let first = *points.first()?;
+    Some(
+        points
+            .par_iter()
+            .fold(|| (first, first), |(lo, hi), p| (lo.inf(p), hi.sup(p)))
+            .reduce(|| (first, first), |a, b| (a.0.inf(&b.0), a.1.sup(&b.1))),
+    )
+}
+
+/// Fold-overs and stretch over a cluster sample of about
+/// [`AssessConfig::sample_points`] points ([`CellSample`]): only the
+/// Delaunay triangles of the sample that are triangles of the whole set's
+/// triangulation count. Returns the measure and the sample's size.
+fn sampled_parameterization(
+    surface: &Surface,
+    points: &[Point3],
+    uv: &[[f64; 2]],
+    config: &AssessConfig,
+) -> (ParamQuality, usize) {
+    let Some(cells) = CellSample::new(uv, config.sample_points, config.seed) else {
+        // parameters that span no area: nothing to triangulate
+        return (ParamQuality::default(), 0);
+    };
+    let idx = cells.indices();
+    let p: Vec<Point3> = idx.iter().map(|&i| points[i]).collect();
+    let t: Vec<[f64; 2]> = idx.iter().map(|&i| uv[i]).collect();
+    let q =
+        parameterization_quality_where(surface, &p, &t, |[a, b, c]| cells.keeps_triangle(a, b, c))
+            .unwrap_or_default();
+    (q, idx.len())
 }
 
 /// Distance of `p` outside the box `(lo, hi)` (0 inside; infinite for a
@@ -355,20 +900,6 @@ fn outside_box(p: &Point3, lo: &Point3, hi: &Point3) -> f64 {
     }
     let d = (lo - p).sup(&(p - hi)).sup(&Point3::origin().coords);
     d.norm()
-}
-
-/// The [`Extent`] of `surface` (its `samples`) against the box of `cloud`.
-fn extent(
-    surface: &Surface,
-    cloud: &PointCloud,
-    samples: &[Point3],
-    spacing: f64,
-    config: &AssessConfig,
-) -> Extent {
-    match cloud.bounding_box() {
-        Some(b) => extent_in_box(surface, b, samples, spacing, config),
-        None => Extent::default(),
-    }
 }
 
 /// The [`Extent`] of `surface` (its `samples`) against the points' bounding
@@ -441,35 +972,6 @@ pub(crate) fn sample_grid(
         })
         .collect();
     Ok(((nu, nv), samples))
-}
-
-/// The surface-to-points distances over the sample grid of `config`.
-fn sample_distances(
-    surface: &Surface,
-    cloud: &PointCloud,
-    config: &AssessConfig,
-) -> Result<(SampleDistances, Vec<Point3>)> {
-    let ((nu, nv), samples) = sample_grid(surface, config)?;
-    let d: Vec<f64> = cloud
-        .nearest_batch(&samples)?
-        .into_iter()
-        .map(|n| n.distance)
-        .collect();
-    let spacing = if cloud.len() >= 2 {
-        cloud.spacing()?.median
-    } else {
-        0.0
-    };
-    let limit = config.far_spacings * spacing;
-    let far = d.iter().filter(|&&x| x > limit).count();
-    let distances = SampleDistances {
-        grid: (nu, nv),
-        stats: ErrorStats::of(&d),
-        spacing,
-        far_spacings: config.far_spacings,
-        far_share: far as f64 / d.len().max(1) as f64,
-    };
-    Ok((distances, samples))
 }
 
 #[cfg(test)]
@@ -570,5 +1072,117 @@ mod tests {
             ..Default::default()
         };
         assert!(assess_surface(&s, &p, &uv, &c).is_err());
+    }
+
+    /// `n` noisy points of a wavy sheet over [0, 2] x [0, 1] at uniform
+    /// random parameters (a fixed LCG), and a bicubic 10 x 10 least-squares
+    /// surface fitted to them.
+    fn wavy(n: usize) -> (Surface, Vec<Point3>, Vec<[f64; 2]>) {
+        let mut state = 12345u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut pts = Vec::with_capacity(n);
+        let mut uv = Vec::with_capacity(n);
+        for _ in 0..n {
+            let (u, v) = (next(), next());
+            let noise = 0.002 * (next() - 0.5);
+            let (x, y) = (2.0 * u + 0.003 * (next() - 0.5), v);
+            pts.push(Point3::new(
+                x,
+                y,
+                0.1 * (3.0 * x).sin() * (2.0 * y).cos() + noise,
+            ));
+            uv.push([u, v]);
+        }
+        let cfg = crate::fit::surface::SurfaceFitConfig {
+            ctrl: (10, 10),
+            ..Default::default()
+        };
+        let s = crate::fit::surface::fit_surface(&pts, &uv, &cfg).unwrap();
+        (s, pts, uv)
+    }
+
+    /// Issue 18: the sampled statistics agree with the full computation
+    /// within the margins stated in BENCHMARKS.md, and everything exact
+    /// stays exact.
+    #[test]
+    fn sampled_statistics_agree_with_the_full_computation() {
+        let (s, pts, uv) = wavy(60_000);
+        let full = AssessConfig {
+            measure: Measure::Full,
+            ..Default::default()
+        };
+        let sampled = AssessConfig {
+            sample_points: 10_000,
+            ..Default::default()
+        };
+        let cloud = PointCloud::new(pts.clone()).unwrap();
+        let f = assess_surface(&s, &pts, &uv, &full).unwrap();
+        let a = assess_cloud(&s, &cloud, &uv, &sampled, &NoProgress).unwrap();
+        assert!(f.sample.is_none());
+        let info = a.sample.unwrap();
+        assert_eq!((info.spacing_points, info.seed), (2_500, DEFAULT_SEED));
+        assert!(
+            (7_000..13_000).contains(&info.parameterization_points),
+            "{info:?}"
+        );
+        let (fq, aq) = (f.quality, a.quality);
+        // exact over every point in both
+        assert_eq!(fq.at_parameters, aq.at_parameters);
+        assert_eq!(fq.orthogonal, aq.orthogonal);
+        assert_eq!(fq.grid_rmse, aq.grid_rmse);
+        assert_eq!(fq.samples_to_points.stats, aq.samples_to_points.stats);
+        assert_eq!(f.distances, a.distances);
+        // the sampled ones within their margins
+        let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
+        let (fs, as_) = (fq.samples_to_points.spacing, aq.samples_to_points.spacing);
+        let (fp, ap) = (fq.parameterization, aq.parameterization);
+        eprintln!("spacing {fs} {as_}; param full {fp:?} sampled {ap:?}");
+        assert!(rel(as_, fs) < 0.03, "spacing {as_} vs {fs}");
+        assert!(rel(ap.l2_stretch, fp.l2_stretch) < 0.02, "{ap:?} vs {fp:?}");
+        for k in 0..3 {
+            let (x, y) = (ap.area_ratio_percentiles[k], fp.area_ratio_percentiles[k]);
+            assert!(rel(x, y) < 0.05, "percentile {k}: {x} vs {y}");
+        }
+        let share = |q: &ParamQuality| q.fold_overs as f64 / q.triangles as f64;
+        assert!(fp.fold_overs > 100, "{fp:?}");
+        assert!((share(&ap) - share(&fp)).abs() < 0.005, "{ap:?} vs {fp:?}");
+        assert!(ap.max_anisotropy <= fp.max_anisotropy * (1.0 + 1e-12));
+        // the extent's verdict does not change
+        assert_eq!(fq.extent.leaves, aq.extent.leaves);
+    }
+
+    /// The orthogonal distances from the points' own parameters equal the
+    /// KD-tree-started inversion's, and `none` measures only the errors at
+    /// the parameters.
+    #[test]
+    fn distances_from_the_parameters_and_the_none_measure() {
+        let (s, pts, uv) = wavy(3000);
+        let a = assess_surface(&s, &pts, &uv, &AssessConfig::default()).unwrap();
+        let inv = SurfaceInverter::new(&s, InversionConfig::default()).unwrap();
+        for (r, d) in inv.invert_all(&pts).iter().zip(a.distances()) {
+            assert!((r.distance - d).abs() <= 1e-12 * (1.0 + d), "{r:?} vs {d}");
+        }
+        assert!(a.unconverged.is_empty());
+        let none = AssessConfig {
+            measure: Measure::None,
+            ..Default::default()
+        };
+        let b = assess_surface(&s, &pts, &uv, &none).unwrap();
+        assert_eq!(b.quality.at_parameters, a.quality.at_parameters);
+        assert_eq!(b.quality.orthogonal.count, 0);
+        assert!(b.distances.is_empty() && b.quality.parameterization.triangles == 0);
+        assert_eq!(b.quality.extent.diagonal, a.quality.extent.diagonal);
+        let lean = AssessConfig {
+            per_point: false,
+            ..Default::default()
+        };
+        let c = assess_surface(&s, &pts, &uv, &lean).unwrap();
+        assert_eq!(c.quality, a.quality);
+        assert!(c.residuals.is_empty() && c.distances.is_empty());
     }
 }

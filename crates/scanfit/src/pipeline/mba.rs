@@ -16,8 +16,8 @@ use std::time::Instant;
 use crate::bspline::Surface;
 use crate::mba::adjust::{knot_grid, lattice_grid_rmse, mba_adjusted, AdjustConfig};
 use crate::mba::{lattice_surface, mba, Frame, Lattice, MbaConfig};
-use crate::metrics::{rmse_to_cloud, ErrorStats};
-use crate::pipeline::assess::{assess_surface, AssessConfig, Assessment};
+use crate::metrics::ErrorStats;
+use crate::pipeline::assess::{assess_cloud_eq17, AssessConfig, Assessment};
 use crate::progress::Progress;
 use crate::{Error, PointCloud, Result};
 
@@ -184,9 +184,10 @@ fn run_centred(
         .zip(&uv)
         .map(|(p, t)| (p.z - surface.point(t[0], t[1]).z).abs())
         .collect();
-    let mut assessment = assess_surface(&surface, pts, &uv, &config.assess)?;
+    // eq. 17 at the lattice's knot grid, in the assessment's pass
+    let eq17 = knot_grid(&frame, &result.lattice);
+    let mut assessment = assess_cloud_eq17(&surface, cloud, &uv, eq17, &config.assess, progress)?;
     assessment.quality.at_parameters = ErrorStats::of(&vertical);
-    assessment.quality.grid_rmse = rmse_to_cloud(cloud, &knot_grid(&frame, &result.lattice))?;
     Ok(MbaReport {
         surface,
         frame,

@@ -98,7 +98,7 @@ pub fn run(
         let pts = centring.points(points);
         centring.restore(assess_projected(&local, &pts, &config.assess)?)
     };
-    let mut sorted = assessment.distances();
+    let mut sorted = assessment.distances().to_vec();
     sorted.sort_by(f64::total_cmp);
     // nearest-rank percentiles; `assess_projected` refused an empty set
     let pct = |f: f64| percentile_sorted(&sorted, f).unwrap_or(0.0);

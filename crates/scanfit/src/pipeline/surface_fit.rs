@@ -8,7 +8,7 @@
 //! [`fit_surface`] (NURBS Book eq. 9.63 on a tensor-product basis, optional
 //! thin-plate smoothing), optionally followed by Hoschek's parameter
 //! correction ([`correct_parameters`]); the result is assessed by
-//! [`assess_surface`].
+//! [`assess_cloud`].
 //!
 //! By default the net follows the point density and the thin-plate weight
 //! is scaled to the data ([`super::regularize`]), so sparsely covered spans
@@ -20,7 +20,7 @@ use crate::bspline::Surface;
 use crate::centring::Centring;
 use crate::fit::correction::{correct_parameters, CorrectionConfig, CorrectionRound};
 use crate::fit::surface::{fit_surface, SurfaceFitConfig};
-use crate::pipeline::assess::{assess_surface, AssessConfig, Assessment};
+use crate::pipeline::assess::{assess_cloud, AssessConfig, Assessment};
 use crate::pipeline::regularize::{density_ctrl, scaled_smoothing, DEFAULT_RELATIVE_SMOOTHING};
 use crate::progress::Progress;
 use crate::{Error, PointCloud, Result};
@@ -223,8 +223,7 @@ fn run_centred(
     } else {
         (fit(&uv)?, Vec::new())
     };
-    progress.stage("measuring", None);
-    let assessment = assess_surface(&surface, pts, &uv, &config.assess)?;
+    let assessment = assess_cloud(&surface, cloud, &uv, &config.assess, progress)?;
     Ok(FitReport {
         surface,
         uv,
