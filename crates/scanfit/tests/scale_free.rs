@@ -10,7 +10,7 @@
 
 use std::f64::consts::PI;
 
-use scanfit::bspline::{Curve, Surface};
+use scanfit::bspline::Surface;
 use scanfit::cloud::clean::OutlierConfig;
 use scanfit::pipeline::{cloud, coons, curve, mba, reconstruct, surface_fit, turntable};
 use scanfit::progress::NoProgress;
@@ -23,17 +23,22 @@ fn scaled(points: &[Point3]) -> PointCloud {
     PointCloud::new(points.iter().map(|p| p * SCALE).collect()).unwrap()
 }
 
-/// Largest distance between `big`'s control points and `small`'s scaled by
+/// Largest distance between the control points `big` and `small` scaled by
 /// 1000, as a share of the scaled diagonal `diag`.
-fn mismatch(small: &Surface, big: &Surface, diag: f64) -> f64 {
-    assert_eq!(small.counts(), big.counts());
+fn net_mismatch(small: &[Point3], big: &[Point3], diag: f64) -> f64 {
+    assert_eq!(small.len(), big.len());
     small
-        .control_points()
         .iter()
-        .zip(big.control_points())
+        .zip(big)
         .map(|(a, b)| (a * SCALE - b).norm())
         .fold(0.0, f64::max)
         / diag
+}
+
+/// [`net_mismatch`] of two surfaces (with the same net size).
+fn mismatch(small: &Surface, big: &Surface, diag: f64) -> f64 {
+    assert_eq!(small.counts(), big.counts());
+    net_mismatch(small.control_points(), big.control_points(), diag)
 }
 
 /// A curved four-sided patch of scattered points (unit-ish size).
@@ -147,19 +152,6 @@ fn turntable_is_scale_free() {
     assert!(m < 1e-7, "{m}");
 }
 
-/// Largest distance between `big`'s control points and `small`'s scaled by
-/// 1000, as a share of the scaled diagonal `diag` (curves).
-fn curve_mismatch(small: &Curve, big: &Curve, diag: f64) -> f64 {
-    assert_eq!(small.control_points().len(), big.control_points().len());
-    small
-        .control_points()
-        .iter()
-        .zip(big.control_points())
-        .map(|(a, b)| (a * SCALE - b).norm())
-        .fold(0.0, f64::max)
-        / diag
-}
-
 #[test]
 fn curve_fits_are_scale_free() {
     // an open spiral arc, unevenly spaced, and a closed loop
@@ -196,7 +188,11 @@ fn curve_fits_are_scale_free() {
             assert!((ua - ub).abs() < 1e-12, "{ua} {ub}");
         }
         let diag = PointCloud::new(big).unwrap().diagonal();
-        let m = curve_mismatch(&a.fit.curve, &b.fit.curve, diag);
+        let m = net_mismatch(
+            a.fit.curve.control_points(),
+            b.fit.curve.control_points(),
+            diag,
+        );
         assert!(m < 1e-9, "{cfg:?}: {m}");
         let (ea, eb) = (a.quality.max_deviation, b.quality.max_deviation);
         assert!((eb - SCALE * ea).abs() <= 1e-6 * diag, "{ea} {eb}");
