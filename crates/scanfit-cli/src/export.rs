@@ -49,14 +49,14 @@ enum Item {
     Curve(Curve),
     Surface(Surface),
     /// A surface whose document carries trimming loops.
-    Trimmed(TrimmedSurface),
+    Trimmed(Box<TrimmedSurface>),
 }
 
 /// The surface of the document at `path`, trimmed when it says so.
 fn read_face(path: &Path) -> Result<Item> {
     let (doc, surface) = read_surface(path)?;
     Ok(match doc.trimmed(&surface) {
-        Ok(Some(t)) => Item::Trimmed(t),
+        Ok(Some(t)) => Item::Trimmed(Box::new(t)),
         Ok(None) => Item::Surface(surface),
         Err(e) => bail!("{}: {e}", path.display()),
     })
