@@ -19,9 +19,11 @@ use scanfit_io::units::{CadOptions, LengthUnit};
 pub struct UnitsArgs {
     /// Length unit the data are in, declared in the STEP and IGES files
     /// (the coordinates are written unscaled; a CAD system converts on
-    /// import: data in metres with --units m arrive at their true size).
-    #[arg(long, value_name = "UNIT", default_value = "mm", value_parser = crate::args::choice::<UnitsArg>())]
-    pub units: UnitsArg,
+    /// import: data in metres with --units m arrive at their true size);
+    /// pictures label their colour bars with it [default: mm in CAD files,
+    /// "data units" in pictures].
+    #[arg(long, value_name = "UNIT", value_parser = crate::args::choice::<UnitsArg>())]
+    pub units: Option<UnitsArg>,
 }
 
 /// The command-line names of [`LengthUnit`].
@@ -42,13 +44,27 @@ pub enum UnitsArg {
 impl UnitsArgs {
     /// The writers' options.
     pub fn options(&self) -> CadOptions {
-        CadOptions::with_units(match self.units {
+        CadOptions::with_units(match self.units.unwrap_or(UnitsArg::Mm) {
             UnitsArg::Mm => LengthUnit::Millimetre,
             UnitsArg::Cm => LengthUnit::Centimetre,
             UnitsArg::M => LengthUnit::Metre,
             UnitsArg::In => LengthUnit::Inch,
             UnitsArg::Ft => LengthUnit::Foot,
         })
+    }
+}
+
+impl UnitsArgs {
+    /// The unit's name for pictures: the one given, else "data units".
+    pub fn label(&self) -> &'static str {
+        match self.units {
+            Some(UnitsArg::Mm) => "mm",
+            Some(UnitsArg::Cm) => "cm",
+            Some(UnitsArg::M) => "m",
+            Some(UnitsArg::In) => "in",
+            Some(UnitsArg::Ft) => "ft",
+            None => "data units",
+        }
     }
 }
 

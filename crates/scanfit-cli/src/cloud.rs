@@ -18,17 +18,16 @@ use scanfit::pipeline::cloud::{
 };
 use scanfit::{Point3, PointCloud, Vector3};
 use scanfit_io::render::{
-    angles_facing, render_scene_png, viridis, Marker, PointScene, Polyline, RenderOptions,
+    render_scene_png, viridis, Camera, Marker, PointScene, Polyline, RenderOptions,
 };
 use scanfit_io::{cloud_bytes, write_all_atomic, WriteFormat};
 
 pub use crate::args::InputArgs;
-use crate::args::{
-    choice, option_note, value_name, Angles, Indices, Parsed, ANGLES, INDICES, VECTOR3,
-};
+use crate::args::{choice, option_note, value_name, Indices, Parsed, INDICES, VECTOR3};
 use crate::outputs::{check_outputs, extension, Files};
 use crate::progress::Progress;
 use crate::table::{num, Table};
+use crate::view::DefaultView;
 
 /// The `cloud` subcommands.
 #[derive(Subcommand, Debug)]
@@ -131,9 +130,14 @@ pub struct HprArgs {
     /// height, hidden ones grey.
     #[arg(long, value_name = "OUT.png")]
     pub png: Option<PathBuf>,
-    /// Camera azimuth and elevation of the picture [default: from the side of the view direction].
-    #[arg(long = "camera", value_name = "AZ,EL", allow_hyphen_values = true, value_parser = ANGLES)]
-    pub camera: Option<Angles>,
+    /// Camera of the picture: front, top, iso, or azimuth and elevation in
+    /// degrees around the up axis [default: from the side of the view direction].
+    #[arg(long = "camera", value_name = "VIEW", allow_hyphen_values = true, value_parser = crate::view::VIEW)]
+    pub camera: Option<crate::view::View>,
+    /// The axis that is up in the picture: x, y, z, or auto (the thin axis
+    /// of sheet-like data; z otherwise).
+    #[arg(long, value_name = "AXIS", default_value = "auto", value_parser = crate::args::choice::<crate::view::UpArg>())]
+    pub up: crate::view::UpArg,
     /// Print the report as JSON on stdout instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -237,7 +241,8 @@ by its normal: wrongly oriented normals show as dark speckles.";
 pub struct NormalsArgs {
     #[command(flatten)]
     pub input: InputArgs,
-    /// Neighbours per point.
+    /// Neighbours per point, the point itself not counted (Open3D's knn and
+    /// PCL's k count it: --k 16 here is their 17).
     #[arg(long, default_value_t = 16)]
     pub k: usize,
     /// Orientation: `mst`, `view:X,Y,Z` or `none`.
@@ -389,14 +394,13 @@ fn print_info(input: &Path, r: &CloudInfo, read_s: f64) -> Result<()> {
 /// normals stand out. `z_scale` is the picture's vertical exaggeration (the
 /// normals of the exaggerated shape are `(nx, ny, nz / z_scale)`).
 fn normal_shading(normals: &[Vector3], opts: &RenderOptions) -> Vec<[u8; 3]> {
-    let (az, el) = (opts.azimuth.to_radians(), opts.elevation.to_radians());
-    let d = Vector3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
+    let camera = Camera::new(opts);
+    let d = camera.toward;
     let light = (d + Vector3::new(0.0, 0.0, 0.5)).normalize();
-    let zs = opts.z_scale;
     normals
         .iter()
         .map(|n| {
-            let m = Vector3::new(n.x, n.y, n.z / zs);
+            let m = camera.normal(n);
             let m = m / m.norm().max(f64::MIN_POSITIVE);
             let l = m.dot(&light);
             let (v, base) = if m.dot(&d) >= 0.0 {
@@ -531,10 +535,19 @@ fn hpr_picture(a: &HprArgs, cloud: &PointCloud, view: Point3, r: &CloudHpr) -> R
     let (lo, hi) = cloud.bounding_box().context("no points")?;
     let centre = Point3::from((lo.coords + hi.coords) / 2.0);
     let dir = view - centre;
+    let up = crate::view::ViewArgs {
+        view: None,
+        up: a.up,
+        z_scale: None,
+    }
+    .up(cloud.points());
     let (az, el) = match a.camera {
-        Some(c) => (c.azimuth, c.elevation),
+        Some(c) => c.angles(),
         // from the side: the visible cap shows as a half shell
-        None => (dir.y.atan2(dir.x).to_degrees() + 90.0, 20.0),
+        None => {
+            let d = up.to_frame(&dir);
+            (d.y.atan2(d.x).to_degrees() + 90.0, 20.0)
+        }
     };
     let is_visible = r.visible_mask(cloud.len());
     let along: Vec<f64> = cloud
@@ -562,6 +575,7 @@ fn hpr_picture(a: &HprArgs, cloud: &PointCloud, view: Point3, r: &CloudHpr) -> R
     let opts = RenderOptions {
         azimuth: az,
         elevation: el,
+        up,
         legend: vec![
             format!(
                 "{}: {} of {} points visible from ({}, {}, {}), gamma = {}",
@@ -705,7 +719,7 @@ fn boundary_picture(a: &BoundaryArgs, cloud: &PointCloud, r: &CloudBoundary) -> 
     let b = &r.boundary;
     let mut opts = a
         .view
-        .options_or(cloud.points(), angles_facing(&b.plane.normal))?;
+        .options_or(cloud.points(), DefaultView::Facing(b.plane.normal))?;
     opts.legend = vec![
         format!(
             "{}: {} points, {} boundary loop(s), outer loop {} points, alpha = {}",

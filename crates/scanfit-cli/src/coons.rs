@@ -424,6 +424,7 @@ fn picture(points: &[Point3], r: &CoonsReport) -> Picture {
             "{}; dots = points, lines = boundary curves, C0.. = corners",
             r.route
         )],
+        ..Default::default()
     }
 }
 

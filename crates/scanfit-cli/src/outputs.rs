@@ -17,7 +17,8 @@ use scanfit_io::gltf::mesh_glb;
 use scanfit_io::json::{Provenance, SurfaceDoc, SurfaceQualityDoc};
 use scanfit_io::ply::{mesh_obj, mesh_ply, points_ply, points_xyz, PlyFormat};
 use scanfit_io::render::{
-    render_surface_scene_png, viridis, Colouring, Marker, Polyline, RenderOptions,
+    format_value, render_surface_scene_png, viridis, ColourScale, Colouring, Marker, Polyline,
+    RenderOptions, DEVIATION_PERCENTILE,
 };
 use scanfit_io::step::CadItem;
 
@@ -37,7 +38,8 @@ pub struct SurfaceOutputArgs {
     pub iges: Option<PathBuf>,
     /// Write a triangle mesh of the surface (.obj, .ply or .glb; PLY and glb
     /// carry the local fit error, the deviation of each vertex's nearest
-    /// input point, as a colour, PLY also as the property `deviation`).
+    /// input point, as a colour from 0 to its 99th percentile, PLY also as
+    /// the property `deviation`).
     #[arg(long, value_name = "OUT")]
     pub mesh: Option<PathBuf>,
     /// Write a shaded, height-coloured picture with the input points.
@@ -120,6 +122,10 @@ pub struct Picture {
     pub markers: Vec<Marker>,
     /// Legend lines of `--png` (the deviation picture has its own).
     pub legend: Vec<String>,
+    /// The points whose deviations set the colour scale (its 99th
+    /// percentile and maximum), one flag per point [default: all]; e.g. the
+    /// fitted points of `turntable`, whose caps are left out of the fit.
+    pub scale_points: Option<Vec<bool>>,
 }
 
 /// How far the input points are from the surface, as the pictures and the
@@ -222,10 +228,6 @@ impl SurfaceOutputArgs {
         } else {
             None
         };
-        if let Some(m) = &self.mesh {
-            let bytes = mesh_file(m, &mesh, vertex_dev.as_deref(), deviation.stats.max, input);
-            files.push((m.clone(), bytes));
-        }
         let scene = Scene {
             mesh: &mesh,
             points,
@@ -234,6 +236,12 @@ impl SurfaceOutputArgs {
             input,
             picture,
         };
+        if let Some(m) = &self.mesh {
+            // the mesh colours on the pictures' scale (0 to the 99th percentile)
+            let top = scene.deviation_scale(self.units.label()).range.1;
+            let bytes = mesh_file(m, &mesh, vertex_dev.as_deref(), top, input);
+            files.push((m.clone(), bytes));
+        }
         if let (Some(dp), Some(_)) = (&self.deviation_png, &vertex_dev) {
             files.push((dp.clone(), self.deviation_picture(&scene)?));
         }
@@ -246,16 +254,25 @@ impl SurfaceOutputArgs {
         Ok((files, exaggeration))
     }
 
+    /// The render options of `points`' pictures, in `--units`.
+    fn render_options(&self, points: &[Point3]) -> Result<RenderOptions> {
+        Ok(RenderOptions {
+            units: self.units.label().into(),
+            ..self.view.options(points)?
+        })
+    }
+
     /// `--deviation-png`: the surface coloured by the local fit error.
     fn deviation_picture(&self, s: &Scene) -> Result<Vec<u8>> {
         let d = s.vertex_dev.unwrap_or(&[]);
+        let scale = s.deviation_scale(self.units.label());
         let opts = RenderOptions {
-            legend: s.deviation_legend(),
-            ..self.view.options(s.points)?
+            legend: s.deviation_legend(&scale, self.units.label()),
+            ..self.render_options(s.points)?
         };
         let colouring = Colouring::Scalar {
             values: d,
-            range: (0.0, s.deviation.stats.max),
+            scale: &scale,
         };
         Ok(render_surface_scene_png(
             s.mesh,
@@ -272,16 +289,23 @@ impl SurfaceOutputArgs {
         // at most 5,000 points drawn, evenly picked; flat data (terrain) exaggerated
         let step = (s.points.len() / 5_000).max(1);
         let shown: Vec<_> = s.points.iter().step_by(step).copied().collect();
-        let mut opts = self.view.options(s.points)?;
+        let mut opts = self.render_options(s.points)?;
+        let scale = s.deviation_scale(self.units.label());
         let colouring = match (s.picture.style, s.vertex_dev) {
             (PngStyle::Deviation, Some(d)) => {
-                opts.legend = s.deviation_legend();
+                opts.legend = s.deviation_legend(&scale, self.units.label());
                 Colouring::Scalar {
                     values: d,
-                    range: (0.0, s.deviation.stats.max),
+                    scale: &scale,
                 }
             }
-            _ => Colouring::Height,
+            _ => {
+                opts.legend = vec![format!(
+                    "{}: the surface coloured by height, red dots = input points",
+                    s.input.display()
+                )];
+                Colouring::Height
+            }
         };
         opts.legend.extend(s.picture.legend.iter().cloned());
         let bytes = render_surface_scene_png(
@@ -307,17 +331,45 @@ struct Scene<'a> {
 }
 
 impl Scene<'_> {
+    /// The colour scale of the local fit error: 0 to the 99th percentile of
+    /// the points' deviations, the maximum on the bar.
+    fn deviation_scale(&self, units: &str) -> ColourScale {
+        let name = format!("{} [{units}]", self.deviation.name);
+        let all = self.deviation.per_point;
+        match &self.picture.scale_points {
+            Some(mask) => {
+                let some: Vec<f64> = all
+                    .iter()
+                    .zip(mask)
+                    .filter(|(_, &m)| m)
+                    .map(|(&d, _)| d)
+                    .collect();
+                ColourScale::deviation(name, &some, DEVIATION_PERCENTILE)
+            }
+            None => ColourScale::deviation(name, all, DEVIATION_PERCENTILE),
+        }
+    }
+
     /// The legend of a picture coloured by the local fit error.
-    fn deviation_legend(&self) -> Vec<String> {
+    fn deviation_legend(&self, scale: &ColourScale, units: &str) -> Vec<String> {
         let d = self.deviation;
+        let clip = match scale.high {
+            Some(c) => format!(
+                "; colours from 0 to the {}th percentile {} (max {})",
+                c.percentile,
+                format_value(scale.range.1),
+                format_value(c.extreme)
+            ),
+            None => String::new(),
+        };
         vec![
             format!(
-                "{}: colour = {} of the nearest input point [data units]",
+                "{}: colour = {} of the nearest input point [{units}]{clip}",
                 self.input.display(),
                 d.name
             ),
             format!(
-                "input points to surface ({}): mean {}  max {}  RMSE {}  [data units]",
+                "input points to surface ({}): mean {}  max {}  RMSE {}  [{units}]",
                 d.name,
                 num(d.stats.mean),
                 num(d.stats.max),
@@ -328,7 +380,8 @@ impl Scene<'_> {
 }
 
 /// The bytes of `--mesh` by its extension: OBJ, glb or PLY (the last two
-/// coloured by the local fit error `vertex_dev` on the scale `[0, dmax]`).
+/// coloured by the local fit error `vertex_dev` on the scale `[0, dmax]`,
+/// larger values at the top colour).
 fn mesh_file(
     path: &Path,
     mesh: &scanfit::bspline::Mesh,

@@ -20,7 +20,9 @@ use scanfit_io::iges::iges_model_file_with;
 use scanfit_io::json::Provenance;
 use scanfit_io::model::{self, ModelDoc, ModelReport, ModelTotals};
 use scanfit_io::ply::{mesh_obj, mesh_ply, PlyFormat};
-use scanfit_io::render::{render_surface_scene_png, Colouring, Marker, Polyline};
+use scanfit_io::render::{
+    render_surface_scene_png, ColourScale, Colouring, Marker, Polyline, DEVIATION_PERCENTILE,
+};
 use scanfit_io::step_shell::step_shell_file_with;
 use scanfit_io::write_all_atomic;
 
@@ -327,6 +329,7 @@ fn pictures(
     let (lines, markers) = overlay(r);
     let mut opts = a.view.options(cloud.points())?;
     opts.iso_lines = 0;
+    opts.units = a.units.label().into();
     if let Some(p) = &a.png {
         let colours: Vec<[u8; 3]> = patch.iter().map(|&k| patch_colour(k)).collect();
         opts.legend = vec![format!(
@@ -347,11 +350,28 @@ fn pictures(
     }
     if let Some(p) = &a.deviation_png {
         let dev = vertex_deviation(r, cloud, mesh, patch)?;
-        let hi = r.totals.orthogonal.max.max(f64::MIN_POSITIVE);
+        // the scale: 0 to the 99th percentile of the points' distances
+        let per_point: Vec<f64> = r
+            .faces
+            .iter()
+            .flat_map(|f| f.distances.iter().copied())
+            .collect();
+        let units = a.units.label();
+        let scale = ColourScale::deviation(
+            format!("orthogonal distance [{units}]"),
+            &per_point,
+            DEVIATION_PERCENTILE,
+        );
         opts.legend = vec![
-            "orthogonal distance of the nearest point (0 .. max)".into(),
             format!(
-                "mean {}  max {}  rmse {}",
+                "colour = orthogonal distance of the nearest point, 0 to the {}",
+                match scale.high {
+                    Some(c) => format!("{}th percentile (max on the bar)", c.percentile),
+                    None => "max".into(),
+                }
+            ),
+            format!(
+                "mean {}  max {}  rmse {}  [{units}]",
                 num(r.totals.orthogonal.mean),
                 num(r.totals.orthogonal.max),
                 num(r.totals.orthogonal.rmse)
@@ -362,7 +382,7 @@ fn pictures(
             None,
             Colouring::Scalar {
                 values: &dev,
-                range: (0.0, hi),
+                scale: &scale,
             },
             &lines,
             &markers,

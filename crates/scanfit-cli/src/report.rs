@@ -8,12 +8,16 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::Args;
 use scanfit::bspline::{tessellate, Surface};
+use scanfit::distribution::Histogram;
 use scanfit::metrics::nearest_points;
 use scanfit::pipeline::measure::{run as measure, MeasureConfig, MeasureReport};
 use scanfit::trim::TrimmedSurface;
 use scanfit::Point3;
 use scanfit_io::json::{read_surface, SurfaceDoc};
-use scanfit_io::render::{render_png, render_points_png, Colouring, RenderOptions};
+use scanfit_io::render::{
+    format_value, render_png, render_points_png, ColourScale, Colouring, RenderOptions,
+    DEVIATION_PERCENTILE,
+};
 use scanfit_io::write_atomic;
 
 use crate::args::InputArgs;
@@ -88,12 +92,14 @@ fn escape(s: &str) -> String {
         .replace('>', "&gt;")
 }
 
-/// The three pictures of the page and the vertical exaggeration used.
+/// The three pictures of the page, the vertical exaggeration used and the
+/// deviation picture's colour scale.
 struct Pictures {
     height: Vec<u8>,
     deviation: Vec<u8>,
     points: Vec<u8>,
     z_scale: f64,
+    scale: ColourScale,
 }
 
 fn pictures(
@@ -123,16 +129,22 @@ fn pictures(
         .step_by((pts.len() / 5000).max(1))
         .copied()
         .collect();
-    let max = r.assessment.quality.orthogonal.max;
+    // colours from 0 to the 99th percentile of the points' distances
+    let scale = ColourScale::deviation(
+        "orthogonal distance [data units]",
+        &r.assessment.distances(),
+        DEVIATION_PERCENTILE,
+    );
     let deviation = Colouring::Scalar {
         values: &local,
-        range: (0.0, max),
+        scale: &scale,
     };
     Ok(Pictures {
         height: render_png(&mesh, Some(&shown), Colouring::Height, &base)?,
         deviation: render_png(&mesh, None, deviation, &base)?,
         points: render_points_png(pts, &base)?,
         z_scale: base.z_scale,
+        scale,
     })
 }
 
@@ -197,7 +209,7 @@ fn page(
         html,
         "</table><p>{}.</p><h3>Histogram</h3>{}",
         escape(&samples_line(r)),
-        histogram_svg(&r.histogram, q.orthogonal.max)
+        histogram_svg(&r.histogram)
     );
     let _ = write!(html, "<h2>Surface</h2><table><tr><td>degrees</td><td class=n>{p} x {qd}</td></tr><tr><td>control points</td><td class=n>{cu} x {cv}</td></tr><tr><td>periodic</td><td class=n>{:?}</td></tr>", surface.periodic());
     if let Some(pv) = &doc.provenance {
@@ -228,10 +240,22 @@ fn page(
         String::new()
     };
     let _ = write!(html, "</table><h2>Pictures{}</h2>", escape(&ex));
+    let clip = match pic.scale.high {
+        Some(c) => format!(
+            "; colours from 0 to the {}th percentile of the distances, {} (max {} on the bar)",
+            c.percentile,
+            format_value(pic.scale.range.1),
+            format_value(c.extreme)
+        ),
+        None => String::new(),
+    };
+    let deviation_caption = format!(
+        "The surface coloured by the local fit error (orthogonal distance of the nearest point){clip}"
+    );
     for (cap, img) in [
         ("The surface, coloured by height, with iso-parameter lines and the input points", &pic.height),
-        ("The surface coloured by the local fit error (orthogonal distance of the nearest point)", &pic.deviation),
-        ("The input points, coloured by height", &pic.points),
+        (deviation_caption.as_str(), &pic.deviation),
+        ("The input points, coloured by height (colours clipped at the 1st and 99th percentiles, the extremes on the bar)", &pic.points),
     ] {
         let _ = write!(html, "<figure><img src=\"data:image/png;base64,{}\"><figcaption>{}</figcaption></figure>", base64(img), escape(cap));
     }
@@ -274,7 +298,7 @@ pub fn run(a: ReportArgs) -> Result<()> {
             "points": pts.len(),
             "mean": s.mean, "median": r.median, "p95": r.p95, "max": s.max, "rmse": s.rmse,
             "unconverged": q.unconverged,
-            "histogram": {"max": s.max, "counts": r.histogram},
+            "histogram": histogram_json(&r.histogram),
             "samples_to_points": crate::outputs::samples_json(q),
             "trim": crate::cad::trim_json(trimmed.as_ref()),
             "report": out.display().to_string(),
@@ -307,17 +331,70 @@ pub fn run(a: ReportArgs) -> Result<()> {
     Ok(())
 }
 
-/// An inline SVG bar chart of the distance histogram.
-fn histogram_svg(hist: &[usize], max: f64) -> String {
-    let (w, h) = (720.0, 220.0);
-    let top = *hist.iter().max().unwrap_or(&1).max(&1) as f64;
-    let bw = (w - 60.0) / hist.len() as f64;
-    let mut s = format!("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"11\">");
-    for (k, &c) in hist.iter().enumerate() {
-        let bh = (h - 40.0) * c as f64 / top;
-        let _ = write!(s, "<rect x=\"{:.1}\" y=\"{:.1}\" width=\"{:.1}\" height=\"{bh:.1}\" fill=\"#3b6fb6\"><title>{c}</title></rect>", 50.0 + k as f64 * bw, h - 25.0 - bh, bw - 1.0);
+/// The histogram in `--json`: bins over `[0, top]` (`top` the
+/// `percentile`-th percentile) and the overflow bin.
+fn histogram_json(h: &Histogram) -> serde_json::Value {
+    serde_json::json!({
+        "top": h.top,
+        "percentile": h.percentile,
+        "bin_width": h.bin_width(),
+        "counts": h.counts,
+        "overflow": h.overflow,
+        "max": h.max,
+    })
+}
+
+/// An inline SVG bar chart of the distance histogram: equal bins from 0 to
+/// the 99th percentile, then the overflow bin (hatched colour) with the
+/// distances beyond it up to the maximum.
+fn histogram_svg(h: &Histogram) -> String {
+    let (w, ht) = (720.0, 240.0);
+    let n = h.counts.len() + usize::from(h.overflow > 0);
+    let top = (*h.counts.iter().max().unwrap_or(&1))
+        .max(h.overflow)
+        .max(1) as f64;
+    let (x0, plot_w) = (50.0, w - 70.0);
+    let bw = plot_w / n as f64;
+    let mut s = format!("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{ht}\" font-family=\"sans-serif\" font-size=\"11\">");
+    let bar = |s: &mut String, k: usize, c: usize, fill: &str, tip: String| {
+        let bh = (ht - 60.0) * c as f64 / top;
+        let _ = write!(s, "<rect x=\"{:.1}\" y=\"{:.1}\" width=\"{:.1}\" height=\"{bh:.1}\" fill=\"{fill}\"><title>{}</title></rect>", x0 + k as f64 * bw, ht - 40.0 - bh, (bw - 1.0).max(0.5), escape(&tip));
+    };
+    let width = h.bin_width();
+    for (k, &c) in h.counts.iter().enumerate() {
+        let tip = format!(
+            "{c} points in [{}, {})",
+            num(k as f64 * width),
+            num((k + 1) as f64 * width)
+        );
+        bar(&mut s, k, c, "#3b6fb6", tip);
     }
-    let _ = write!(s, "<text x=\"50\" y=\"{}\">0</text><text x=\"{}\" y=\"{}\" text-anchor=\"end\">{} data units</text><text x=\"5\" y=\"20\">{} points</text></svg>", h - 8.0, w - 10.0, h - 8.0, num(max), top as usize);
+    let top_label = if h.percentile < 100.0 {
+        format!("{} ({}th percentile)", num(h.top), h.percentile)
+    } else {
+        format!("{} (max)", num(h.top))
+    };
+    let _ = write!(s, "<text x=\"{x0}\" y=\"{}\">0</text><text x=\"{:.1}\" y=\"{}\" text-anchor=\"middle\">{}</text>", ht - 25.0, x0 + h.counts.len() as f64 * bw, ht - 25.0, escape(&top_label));
+    if h.overflow > 0 {
+        let k = h.counts.len();
+        bar(
+            &mut s,
+            k,
+            h.overflow,
+            "#c0504d",
+            format!("{} points above {}", h.overflow, num(h.top)),
+        );
+        let _ = write!(
+            s,
+            "<text x=\"{:.1}\" y=\"{}\" text-anchor=\"end\">&gt; {}: {} points, max {}</text>",
+            w - 10.0,
+            ht - 8.0,
+            escape(&num(h.top)),
+            h.overflow,
+            escape(&num(h.max))
+        );
+    }
+    let _ = write!(s, "<text x=\"5\" y=\"14\">{} points (tallest bin); {} equal bins of {} data units{}</text></svg>", top as usize, h.counts.len(), escape(&num(width)), if h.overflow > 0 { ", then the overflow bin (red)" } else { "" });
     s
 }
 

@@ -1,89 +1,28 @@
 //! `scanfit fit --chunk-points N` and `scanfit mba --chunk-points N`: the
-//! input read in chunks, in passes, over [`scanfit::pipeline::stream`].
-//! Memory depends on the model, not on the point count (text inputs; other
-//! formats are read whole, and a note says so).
-
-use std::cell::RefCell;
+//! input read in chunks, in passes ([`scanfit_io::source::FileSource`]
+//! over [`scanfit::pipeline::stream`]). Memory depends on the model, not on
+//! the point count, for the formats [`reads_in_chunks`] names (text, PLY);
+//! other formats are read whole, and a note says so. The reports are those
+//! of the in-memory commands (the same title, tables and JSON keys), plus
+//! what streaming measured.
 
 use anyhow::{bail, Result};
-use scanfit::pipeline::stream::{fit as fit_streamed, mba as mba_streamed, Chunk, PointSource};
-use scanfit_io::chunks::PointChunks;
+use scanfit::pipeline::stream::{fit as fit_streamed, mba as mba_streamed};
 use scanfit_io::json::SurfaceDoc;
-use scanfit_io::{write_all_atomic, ReadOptions};
+use scanfit_io::source::{reads_in_chunks, FileSource};
+use scanfit_io::write_all_atomic;
 
-use crate::args::option_note;
+use crate::args::{option_note, InputArgs};
 use crate::mba::MbaArgs;
 use crate::outputs::{
-    print_written, provenance, quality_doc, quality_rows, samples_json, Deviation, Picture,
+    print_written, provenance, quality_doc, samples_json, Deviation, Files, Picture,
     SurfaceOutputArgs,
 };
 use crate::progress::Progress;
-use crate::surface::{FitArgs, ParamsArg};
-use crate::table::{num, Table};
+use crate::surface::{fit_title, quality_table, FitArgs, ParamsArg};
 
 /// What the report says about the streamed measures.
 const MEASURED: &str = "errors at the parameters, orthogonal distances, eq. 17 and sample distances over all points; point spacing from the first chunk; parameterization not measured";
-
-/// A point file read in chunks, one [`PointChunks`] per pass.
-struct FileSource<'a> {
-    path: &'a std::path::Path,
-    options: ReadOptions,
-    chunk: usize,
-    uv: bool,
-    passes: usize,
-    quiet: bool,
-    /// The reader's error, kept for the message (the library sees a stand-in).
-    failure: RefCell<Option<anyhow::Error>>,
-}
-
-impl FileSource<'_> {
-    fn chunk_pass(&mut self, f: &mut dyn FnMut(Chunk<'_>) -> scanfit::Result<()>) -> Result<()> {
-        let mut chunks = PointChunks::open(self.path, &self.options, self.chunk)?;
-        if self.passes == 0 && !chunks.bounded() && !self.quiet {
-            crate::print_stderr(format_args!(
-                "note: {} is read whole (chunked reading covers text files: .xyz .csv .txt .pts .asc); memory grows with its point count",
-                self.path.display()
-            ));
-        }
-        while let Some(t) = chunks.next_chunk()? {
-            let uv: Option<Vec<[f64; 2]>> = if self.uv {
-                let (Some(u), Some(v)) = (t.column("u"), t.column("v")) else {
-                    bail!(
-                        "{} has no columns named u and v (its columns: {}); use --params uv-columns with such columns",
-                        self.path.display(),
-                        t.columns.join(", ")
-                    );
-                };
-                Some(u.iter().zip(v).map(|(&u, &v)| [u, v]).collect())
-            } else {
-                None
-            };
-            let chunk = Chunk {
-                points: &t.points,
-                uv: uv.as_deref(),
-            };
-            f(chunk).map_err(|e| match e.point_indices().first() {
-                Some(&i) => anyhow::anyhow!("{}: {e} ({})", self.path.display(), t.locate(i)),
-                None => anyhow::Error::new(e),
-            })?;
-        }
-        if self.passes == 0 {
-            crate::print_warnings(chunks.warnings());
-        }
-        self.passes += 1;
-        Ok(())
-    }
-}
-
-impl PointSource for FileSource<'_> {
-    fn pass(&mut self, f: &mut dyn FnMut(Chunk<'_>) -> scanfit::Result<()>) -> scanfit::Result<()> {
-        self.chunk_pass(f).map_err(|e| {
-            let message = e.to_string();
-            *self.failure.borrow_mut() = Some(e);
-            scanfit::Error::InvalidInput(message)
-        })
-    }
-}
 
 /// The outputs a streamed run can write: the surface documents and an OBJ
 /// mesh (the others colour the surface by per-point deviations).
@@ -98,32 +37,35 @@ fn check_outputs(out: &SurfaceOutputArgs) -> Result<()> {
     Ok(())
 }
 
-fn source<'a>(
-    input: &'a crate::args::InputArgs,
-    chunk: usize,
-    uv: bool,
-    quiet: bool,
-) -> Result<FileSource<'a>> {
+/// The file as a source of chunks; a note when it is read whole.
+fn source(input: &InputArgs, chunk: usize, uv: bool, quiet: bool) -> Result<FileSource> {
     if chunk == 0 {
         bail!("--chunk-points must be at least 1 (try 1000000)");
     }
-    Ok(FileSource {
-        path: &input.input,
-        options: input.options(),
-        chunk,
-        uv,
-        passes: 0,
-        quiet,
-        failure: RefCell::new(None),
-    })
+    let options = input.options();
+    if !quiet && !reads_in_chunks(&input.input, &options)? {
+        crate::print_stderr(format_args!(
+            "note: {} is read whole (chunked reading covers text files .xyz .csv .txt .pts .asc PLY: ascii, and binary without list properties in the vertices); memory grows with its point count",
+            input.input.display()
+        ));
+    }
+    Ok(FileSource::new(&input.input, options, chunk, uv))
 }
 
-/// The library's error, or the reader's behind it.
-fn explain(e: scanfit::Error, s: &FileSource, options: &[(&str, &str)]) -> anyhow::Error {
-    match s.failure.borrow_mut().take() {
-        Some(f) => f,
-        None => anyhow::anyhow!("{}: {e}{}", s.path.display(), option_note(&e, options)),
+/// The library's error, or the reader's behind it; the reader's warnings.
+fn finish_source(
+    r: scanfit::Result<()>,
+    s: &mut FileSource,
+    options: &[(&str, &str)],
+) -> Result<()> {
+    if let Err(e) = r {
+        return Err(match s.take_failure() {
+            Some(f) => f.into(),
+            None => anyhow::anyhow!("{}: {e}{}", s.path().display(), option_note(&e, options)),
+        });
     }
+    crate::print_warnings(s.warnings());
+    Ok(())
 }
 
 /// Runs `scanfit fit --chunk-points N`.
@@ -133,26 +75,25 @@ pub fn fit(a: &FitArgs, chunk: usize) -> Result<()> {
         bail!("--points-out writes every point's parameters and errors and needs all points at once; leave it out with --chunk-points");
     }
     let progress = Progress::spinner(a.quiet || a.json);
-    let mut s = source(
-        &a.input,
-        chunk,
-        a.params == ParamsArg::UvColumns,
-        a.quiet || a.json,
-    )?;
+    let uv = a.params == ParamsArg::UvColumns;
+    let mut s = source(&a.input, chunk, uv, a.quiet || a.json)?;
     let options = [
         ("knots", "--knots"),
         ("params", "--params"),
         ("correction_rounds", "--correct"),
         ("smoothing", "--smooth"),
     ];
-    let r = fit_streamed(&mut s, &a.config(), &progress).map_err(|e| explain(e, &s, &options))?;
+    let r = fit_streamed(&mut s, &a.config(), &progress);
+    let r = match r {
+        Ok(r) => {
+            finish_source(Ok(()), &mut s, &options)?;
+            r
+        }
+        Err(e) => return finish_source(Err(e), &mut s, &options),
+    };
     let q = &r.quality;
     let mut doc = SurfaceDoc::new(&r.surface);
-    let name = if a.params == ParamsArg::UvColumns {
-        "uv-columns"
-    } else {
-        "plane"
-    };
+    let name = if uv { "uv-columns" } else { "plane" };
     doc.provenance = Some(provenance(
         "fit (least-squares surface)",
         Some(name.into()),
@@ -177,22 +118,26 @@ pub fn fit(a: &FitArgs, chunk: usize) -> Result<()> {
     write_all_atomic(&files)?;
     progress.finish();
     let (cu, cv) = r.surface.counts();
-    let title = format!(
-        "{}: {} points -> {cu} x {cv} control points (read in chunks of {chunk} points, {} passes)",
-        a.input.input.display(),
-        q.points,
-        r.passes
-    );
-    print(
-        a.json,
-        &title,
+    let report = Report {
+        json: a.json,
+        title: fit_title(a, q.points, &r.surface, r.smoothing),
+        chunk,
+        passes: r.passes,
+        extra: serde_json::json!({
+            "input": a.input.input.display().to_string(),
+            "degree": [a.degree.0, a.degree.1],
+            "control_points": [cu, cv],
+            "parameters": name,
+            "trim": crate::cad::trim_json(None),
+        }),
+    };
+    report.print(
         q,
         &files,
         exaggeration,
-        a.out.png.as_deref(),
-        serde_json::json!({"control_points": [cu, cv], "degree": [a.degree.0, a.degree.1]}),
-        chunk,
-        r.passes,
+        &a.out,
+        "|P - S(u,v)| at the parameters (eq. 15)",
+        "",
     )
 }
 
@@ -202,25 +147,33 @@ pub fn mba(a: &MbaArgs, chunk: usize) -> Result<()> {
     if a.adjust {
         bail!("--adjust projects the knot grid onto the whole cloud (nearest points along z) and needs all points at once; leave it out with --chunk-points");
     }
-    let progress = Progress::spinner(a.quiet || a.json);
-    let mut s = source(&a.input, chunk, false, a.quiet || a.json)?;
+    let quiet = a.quiet || a.json;
+    if !quiet && !a.trim.no_trim {
+        crate::print_stderr(format_args!("note: the surface is the untrimmed rectangle: trimming to the points' outline (the in-memory default) needs all points at once (--no-trim silences this note)"));
+    }
+    let progress = Progress::spinner(quiet);
+    let mut s = source(&a.input, chunk, false, quiet)?;
     let config = a.config();
     let options = [
         ("base", "--base"),
         ("max_levels", "--levels"),
         ("tolerance", "--tolerance"),
     ];
-    let r = mba_streamed(&mut s, &config.mba, &config.assess, &progress)
-        .map_err(|e| explain(e, &s, &options))?;
+    let r = match mba_streamed(&mut s, &config.mba, &config.assess, &progress) {
+        Ok(r) => {
+            finish_source(Ok(()), &mut s, &options)?;
+            r
+        }
+        Err(e) => return finish_source(Err(e), &mut s, &options),
+    };
     let q = &r.quality;
     let mut doc = SurfaceDoc::new(&r.surface);
-    let settings = a.settings(r.levels.len(), r.cells);
     doc.provenance = Some(provenance(
         "mba (multilevel B-spline approximation)",
         Some("xy (u = x, v = y, scaled to [0, 1])".into()),
         &a.input.input,
         q.points,
-        settings,
+        a.settings(r.levels.len(), r.cells),
     ));
     doc.quality = Some(quality_doc(q, Vec::new()));
     let deviation = Deviation {
@@ -239,66 +192,97 @@ pub fn mba(a: &MbaArgs, chunk: usize) -> Result<()> {
     write_all_atomic(&files)?;
     progress.finish();
     let (m, n) = r.cells;
-    let title = format!("{}: {} points -> {} x {} control points, {} levels (read in chunks of {chunk} points, {} passes, {:.3} s)", a.input.input.display(), q.points, m + 3, n + 3, r.levels.len(), r.passes, r.seconds);
-    let levels: Vec<serde_json::Value> = r.levels.iter().map(|l| serde_json::json!({
-        "level": l.level, "control_points": [l.control_points.0, l.control_points.1],
-        "vertical_mean": l.vertical.mean, "vertical_max": l.vertical.max, "vertical_rmse": l.vertical.rmse,
-        "grid_rmse": l.grid_rmse, "seconds": l.seconds})).collect();
-    print(
-        a.json,
-        &title,
+    let report = Report {
+        json: a.json,
+        title: format!(
+            "{}: {} points -> bicubic B-spline surface, {} x {} control points ({} levels, {:.3} s)",
+            a.input.input.display(),
+            q.points,
+            m + 3,
+            n + 3,
+            r.levels.len(),
+            r.seconds
+        ),
+        chunk,
+        passes: r.passes,
+        extra: serde_json::json!({
+            "input": a.input.input.display().to_string(),
+            "control_points": [m + 3, n + 3],
+            "levels": crate::mba::rows(&r.levels),
+            "trim": crate::cad::trim_json(None),
+            "seconds": r.seconds,
+        }),
+    };
+    let levels = format!(
+        "{}(errors in data units)\n\n",
+        crate::mba::levels_table(&r.levels, false)
+    );
+    report.print(
         q,
         &files,
         exaggeration,
-        a.out.png.as_deref(),
-        serde_json::json!({"control_points": [m + 3, n + 3], "levels": levels}),
-        chunk,
-        r.passes,
+        &a.out,
+        "vertical distance |z - f(x, y)|",
+        &levels,
     )
 }
 
-/// Prints the report of a streamed run (tables, or JSON with `extra`'s keys).
-#[allow(clippy::too_many_arguments)]
-fn print(
+/// The report of a streamed run: the in-memory command's title and keys,
+/// and how the points were read.
+struct Report {
     json: bool,
-    title: &str,
-    q: &scanfit::pipeline::assess::SurfaceQuality,
-    files: &crate::outputs::Files,
-    exaggeration: f64,
-    png: Option<&std::path::Path>,
-    extra: serde_json::Value,
+    title: String,
     chunk: usize,
     passes: usize,
-) -> Result<()> {
-    if json {
-        let mut report = serde_json::json!({
-            "point_count": q.points,
-            "quality": quality_doc(q, Vec::new()),
-            "samples_to_points": samples_json(q),
-            "streamed": {"chunk_points": chunk, "passes": passes, "measured": MEASURED},
-            "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
-        });
-        if let (Some(r), Some(e)) = (report.as_object_mut(), extra.as_object()) {
-            r.extend(e.clone());
+    /// The command's own JSON keys.
+    extra: serde_json::Value,
+}
+
+impl Report {
+    /// Prints the tables (`before` ahead of the measures), or the JSON.
+    fn print(
+        self,
+        q: &scanfit::pipeline::assess::SurfaceQuality,
+        files: &Files,
+        exaggeration: f64,
+        out: &SurfaceOutputArgs,
+        at_parameters: &str,
+        before: &str,
+    ) -> Result<()> {
+        if self.json {
+            let mut report = serde_json::json!({
+                "point_count": q.points,
+                "quality": quality_doc(q, Vec::new()),
+                "samples_to_points": samples_json(q),
+                "streamed": {"chunk_points": self.chunk, "passes": self.passes, "measured": MEASURED},
+                "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
+            });
+            if let (Some(r), Some(e)) = (report.as_object_mut(), self.extra.as_object()) {
+                r.extend(e.clone());
+            }
+            out!(
+                "{}",
+                scanfit_io::json::finite_json(&report, "the JSON report")?
+            );
+            return Ok(());
         }
-        outln!("{}", serde_json::to_string_pretty(&report)?);
-        return Ok(());
+        outln!(
+            "{} (read in chunks of {} points, {} passes)\n",
+            self.title,
+            self.chunk,
+            self.passes
+        );
+        out!("{before}");
+        out!(
+            "{}",
+            quality_table(
+                "measure",
+                at_parameters,
+                q,
+                "grid points to nearest point (MBA eq. 17)"
+            )
+        );
+        outln!("\nmeasured by streaming: {MEASURED}");
+        print_written(files, out.png.as_deref(), exaggeration)
     }
-    outln!("{title}\n");
-    let mut t = Table::new(
-        &["measure", "mean", "max", "RMSE", "unit"],
-        &[true, false, false, false, true],
-    );
-    let e = &q.at_parameters;
-    t.row(vec![
-        "error at the parameters".into(),
-        num(e.mean),
-        num(e.max),
-        num(e.rmse),
-        "data units".into(),
-    ]);
-    quality_rows(&mut t, q, "grid points to nearest point (MBA eq. 17)");
-    out!("{}", t.render());
-    outln!("\nmeasured by streaming: {MEASURED}");
-    print_written(files, png, exaggeration)
 }

@@ -6,7 +6,9 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 use clap::{Args, ValueEnum};
+use scanfit::bspline::Surface;
 use scanfit::fit::surface::KnotPlacement;
+use scanfit::pipeline::assess::SurfaceQuality;
 use scanfit::pipeline::surface_fit::{run as fit, FitConfig, FitReport, ParameterSource};
 use scanfit::PointCloud;
 use scanfit_io::json::SurfaceDoc;
@@ -281,33 +283,58 @@ fn smoothing_note(given: Option<f64>, used: f64) -> String {
     }
 }
 
-fn print_report(a: &FitArgs, r: &FitReport) -> Result<()> {
-    let q = &r.assessment.quality;
-    let (p, qd) = r.surface.degrees();
-    let (cu, cv) = r.surface.counts();
-    outln!(
-        "{}: {} points -> B-spline surface of degree {p} x {qd}, {cu} x {cv} control points ({} parameters, {} knots{}{})\n",
+/// The first line of the report of `scanfit fit` (in memory and streamed).
+pub(crate) fn fit_title(a: &FitArgs, points: usize, surface: &Surface, smoothing: f64) -> String {
+    let (p, qd) = surface.degrees();
+    let (cu, cv) = surface.counts();
+    format!(
+        "{}: {} points -> B-spline surface of degree {p} x {qd}, {cu} x {cv} control points ({} parameters, {} knots{}{})",
         a.input.input.display(),
-        q.points,
+        points,
         name(&a.params),
         name(&a.knots),
-        smoothing_note(a.smooth, r.smoothing),
+        smoothing_note(a.smooth, smoothing),
         if a.periodic_u { ", periodic in u" } else { "" },
-    );
+    )
+}
+
+/// The table of a surface's measures: `at_parameters` names the errors at
+/// the points' parameters, then the orthogonal distances, eq. 17 and the
+/// samples (shared by `fit` and `mba`, in memory and streamed).
+pub(crate) fn quality_table(
+    head: &str,
+    at_parameters: &str,
+    q: &SurfaceQuality,
+    eq17: &str,
+) -> String {
     let mut t = Table::new(
-        &["measure", "mean", "max", "RMSE", "unit"],
+        &[head, "mean", "max", "RMSE", "unit"],
         &[true, false, false, false, true],
     );
     let e = &q.at_parameters;
     t.row(vec![
-        "|P - S(u,v)| at the parameters (eq. 15)".into(),
+        at_parameters.into(),
         num(e.mean),
         num(e.max),
         num(e.rmse),
         "data units".into(),
     ]);
-    quality_rows(&mut t, q, "grid points to nearest point (MBA eq. 17)");
-    out!("{}", t.render());
+    quality_rows(&mut t, q, eq17);
+    t.render()
+}
+
+fn print_report(a: &FitArgs, r: &FitReport) -> Result<()> {
+    let q = &r.assessment.quality;
+    outln!("{}\n", fit_title(a, q.points, &r.surface, r.smoothing));
+    out!(
+        "{}",
+        quality_table(
+            "measure",
+            "|P - S(u,v)| at the parameters (eq. 15)",
+            q,
+            "grid points to nearest point (MBA eq. 17)"
+        )
+    );
     let pq = &q.parameterization;
     outln!(
         "\nparameterization: {} fold-overs in {} triangles, L2 stretch {:.3} (1 = uniform), max anisotropy {}",

@@ -266,6 +266,7 @@ fn outputs(a: &TurntableArgs, cloud: &PointCloud, r: &TurntableReport) -> Result
         &a.input.input,
         &Picture {
             style: PngStyle::Deviation,
+            scale_points: Some(t.fitted.clone()),
             ..Default::default()
         },
     )?;

@@ -638,7 +638,8 @@ fn report_writes_a_self_contained_page() {
             .unwrap()
             .iter()
             .map(|c| c.as_u64().unwrap())
-            .sum::<u64>(),
+            .sum::<u64>()
+            + v["histogram"]["overflow"].as_u64().unwrap(),
         2000
     );
     let page = std::fs::read_to_string(&html).unwrap();

@@ -8,15 +8,18 @@
 //! (XYZ, CSV, TXT, PTS) are read through a buffer of 1 MiB plus one chunk
 //! of points, with exactly the rules of the one-piece reader
 //! ([`crate::xyz::parse_points_with`]: header, every line ending, empty
-//! fields, non-finite policy; errors name the file's line). Other formats
-//! are read whole and served in chunks ([`PointChunks::bounded`] says
-//! which): their memory grows with the point count.
+//! fields, non-finite policy; errors name the file's line). PLY files
+//! (binary with fixed-size vertex records, or ascii) are read a chunk of
+//! vertex records at a time by the PLY reader's own decoding
+//! (`ply_chunks.rs`). Other formats (and other PLY layouts) are read whole
+//! and served in chunks ([`PointChunks::bounded`] says which): their memory
+//! grows with the point count.
 
 use std::fs::File;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
-use crate::table::{split_lines, Format, Origin, PointTable, ReadOptions};
+use crate::table::{split_lines, Format, NonFinite, Origin, PointTable, ReadOptions};
 use crate::xyz::{TextParser, TextRows};
 use crate::{Error, Result};
 
@@ -53,6 +56,7 @@ pub struct PointChunks {
 
 enum Source {
     Text(TextSource),
+    Ply(crate::ply_read::chunks::PlyChunks, NonFinite),
     Whole(Option<PointTable>),
 }
 
@@ -91,6 +95,11 @@ impl PointChunks {
                 eof: false,
                 first: true,
             })
+        } else if format == Some(Format::Ply) {
+            match crate::ply_read::chunks::PlyChunks::open(path)? {
+                Some(p) => Source::Ply(p, options.non_finite),
+                None => Source::Whole(Some(crate::read_cloud(path, options)?)),
+            }
         } else {
             Source::Whole(Some(crate::read_cloud(path, options)?))
         };
@@ -103,10 +112,11 @@ impl PointChunks {
         })
     }
 
-    /// Whether memory is bounded by the chunk size (text files), rather than
-    /// the whole file being read at once.
+    /// Whether memory is bounded by the chunk size (text files, PLY files
+    /// in the layouts of [`crate::ply_read::chunks`]), rather than the whole
+    /// file being read at once.
     pub fn bounded(&self) -> bool {
-        matches!(self.source, Source::Text(_))
+        matches!(self.source, Source::Text(_) | Source::Ply(..))
     }
 
     /// Warnings of the reader, complete once the pass has ended.
@@ -118,6 +128,29 @@ impl PointChunks {
     pub fn next_chunk(&mut self) -> Result<Option<PointTable>> {
         let got = match &mut self.source {
             Source::Whole(table) => whole_chunk(table, self.chunk, &mut self.warnings),
+            Source::Ply(p, policy) => loop {
+                let Some(t) = p.next(self.chunk)? else {
+                    if self.points == 0 {
+                        return Err(Error::Invalid {
+                            path: self.path.clone(),
+                            message: "no points left: every point has a non-finite coordinate"
+                                .into(),
+                        });
+                    }
+                    break None;
+                };
+                // a chunk whose points were all dropped is skipped
+                let all_bad = t
+                    .points
+                    .iter()
+                    .all(|q| !q.coords.iter().all(|v| v.is_finite()));
+                if all_bad && *policy == NonFinite::Drop {
+                    continue;
+                }
+                let mut t = t.finish(*policy)?;
+                self.warnings.append(&mut t.warnings);
+                break Some(t);
+            },
             Source::Text(t) => {
                 let got = t.next(&self.path, self.chunk)?;
                 if got.is_none() {
@@ -267,7 +300,8 @@ impl TextSource {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::table::NonFinite;
+
+    type TestResult = std::result::Result<(), Box<dyn std::error::Error>>;
 
     fn all_chunks(path: &Path, options: &ReadOptions, chunk: usize) -> Result<Vec<PointTable>> {
         let mut c = PointChunks::open(path, options, chunk)?;
@@ -279,9 +313,9 @@ mod tests {
     }
 
     #[test]
-    fn chunks_concatenate_to_the_one_piece_read_for_every_line_ending() {
+    fn chunks_concatenate_to_the_one_piece_read_for_every_line_ending() -> TestResult {
         let dir = std::env::temp_dir().join(format!("scanfit-chunks-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::create_dir_all(&dir)?;
         // more than one 1 MiB block, with a header, comments and extra columns
         let mut body = String::from("\u{feff}# scan\nu,x,y,z,v\n");
         for k in 0..60_000 {
@@ -299,23 +333,23 @@ mod tests {
         }
         for (name, eol) in [("lf", "\n"), ("crlf", "\r\n"), ("cr", "\r")] {
             let path = dir.join(format!("{name}.csv"));
-            std::fs::write(&path, body.replace('\n', eol)).unwrap();
-            let whole = crate::read_cloud(&path, &ReadOptions::default()).unwrap();
+            std::fs::write(&path, body.replace('\n', eol))?;
+            let whole = crate::read_cloud(&path, &ReadOptions::default())?;
             for chunk in [1usize, 999, 60_000, 100_000] {
                 if chunk == 1 && name != "lf" {
                     continue;
                 }
-                let parts = all_chunks(&path, &ReadOptions::default(), chunk).unwrap();
+                let parts = all_chunks(&path, &ReadOptions::default(), chunk)?;
                 assert!(parts
                     .iter()
                     .all(|t| t.points.len() <= chunk && t.columns == whole.columns));
                 let points: Vec<_> = parts.iter().flat_map(|t| t.points.clone()).collect();
                 assert_eq!(points, whole.points, "{name} {chunk}");
-                let u: Vec<f64> = parts
-                    .iter()
-                    .flat_map(|t| t.column("u").unwrap().to_vec())
-                    .collect();
-                assert_eq!(u, whole.column("u").unwrap());
+                let mut u = Vec::new();
+                for t in &parts {
+                    u.extend_from_slice(t.column("u").ok_or("a chunk without column u")?);
+                }
+                assert_eq!(u, whole.column("u").ok_or("no column u")?);
                 let lines: Vec<usize> = parts
                     .iter()
                     .flat_map(|t| match &t.origin {
@@ -330,12 +364,14 @@ mod tests {
         let path = dir.join("bad.xyz");
         let mut text: String = (0..50_000).map(|k| format!("{k} 1 2\n")).collect();
         text.push_str("1 2 nan\n");
-        std::fs::write(&path, &text).unwrap();
+        std::fs::write(&path, &text)?;
         let e = all_chunks(&path, &ReadOptions::default(), 5000)
-            .unwrap_err()
+            .err()
+            .ok_or("the chunked read accepted a NaN")?
             .to_string();
         let one = crate::read_cloud(&path, &ReadOptions::default())
-            .unwrap_err()
+            .err()
+            .ok_or("the one-piece read accepted a NaN")?
             .to_string();
         assert_eq!(e, one);
         assert!(e.contains("50001"), "{e}");
@@ -343,12 +379,140 @@ mod tests {
             non_finite: NonFinite::Drop,
             ..Default::default()
         };
-        let n: usize = all_chunks(&path, &drop, 5000)
-            .unwrap()
+        let n: usize = all_chunks(&path, &drop, 5000)?
             .iter()
             .map(|t| t.points.len())
             .sum();
         assert_eq!(n, 50_000);
-        std::fs::remove_dir_all(&dir).unwrap();
+        std::fs::remove_dir_all(&dir)?;
+        Ok(())
+    }
+
+    /// A PLY file of `n` vertices (x, y, z as float/double, a uchar label
+    /// before them and a float u after), with an edge element before them.
+    fn ply(encoding: &str, n: usize) -> Vec<u8> {
+        let mut b = format!(
+            "ply\r\nformat {encoding} 1.0\r\nelement edge 2\r\nproperty int a\r\nelement vertex {n}\r\nproperty uchar label\r\nproperty double x\r\nproperty float y\r\nproperty double z\r\nproperty float u\r\nend_header\r\n"
+        )
+        .into_bytes();
+        let big = encoding.contains("big");
+        let vertex = |k: usize| {
+            (
+                k % 251,
+                k as f64 * 0.5 + 3e5,
+                (k % 97) as f32,
+                -(k as f64) / 7.0,
+                (k % 13) as f32 * 0.25,
+            )
+        };
+        if encoding == "ascii" {
+            b.extend_from_slice(b"5\r\n\r\n6\r\n");
+            for k in 0..n {
+                let (l, x, y, z, u) = vertex(k);
+                b.extend_from_slice(format!("{l} {x} {y} {z} {u}\r\n").as_bytes());
+                if k % 1000 == 0 {
+                    b.extend_from_slice(b"   \r\n");
+                }
+            }
+            b.extend_from_slice(b"3 0 1 2\r\n");
+            return b;
+        }
+        for a in [5i32, 6] {
+            b.extend(if big {
+                a.to_be_bytes()
+            } else {
+                a.to_le_bytes()
+            });
+        }
+        for k in 0..n {
+            let (l, x, y, z, u) = vertex(k);
+            b.push(l as u8);
+            if big {
+                b.extend(x.to_be_bytes());
+                b.extend(y.to_be_bytes());
+                b.extend(z.to_be_bytes());
+                b.extend(u.to_be_bytes());
+            } else {
+                b.extend(x.to_le_bytes());
+                b.extend(y.to_le_bytes());
+                b.extend(z.to_le_bytes());
+                b.extend(u.to_le_bytes());
+            }
+        }
+        b
+    }
+
+    #[test]
+    fn ply_chunks_concatenate_to_the_one_piece_read_in_bounded_memory() -> TestResult {
+        let dir = std::env::temp_dir().join(format!("scanfit-plychunks-{}", std::process::id()));
+        std::fs::create_dir_all(&dir)?;
+        for encoding in ["binary_little_endian", "binary_big_endian", "ascii"] {
+            let path = dir.join(format!("{encoding}.ply"));
+            std::fs::write(&path, ply(encoding, 25_000))?;
+            let whole = crate::read_cloud(&path, &ReadOptions::default())?;
+            for chunk in [1usize, 4096, 25_000, 30_000] {
+                let mut c = PointChunks::open(&path, &ReadOptions::default(), chunk)?;
+                assert!(c.bounded(), "{encoding}");
+                let (mut points, mut u, mut label) = (Vec::new(), Vec::new(), Vec::new());
+                while let Some(t) = c.next_chunk()? {
+                    assert!(!t.points.is_empty() && t.points.len() <= chunk);
+                    assert_eq!(t.columns, whole.columns);
+                    points.extend_from_slice(&t.points);
+                    u.extend_from_slice(t.column("u").ok_or("no u")?);
+                    label.extend_from_slice(t.column("label").ok_or("no label")?);
+                }
+                assert_eq!(points, whole.points, "{encoding} {chunk}");
+                assert_eq!(u, whole.column("u").ok_or("no u")?);
+                assert_eq!(label, whole.column("label").ok_or("no label")?);
+            }
+            // a bad value deep in the file names the same place as the one-piece reader
+            let mut bytes = ply(encoding, 25_000);
+            if encoding == "ascii" {
+                let text = String::from_utf8(bytes)?.replacen(" 310000.5 ", " nan ", 1);
+                bytes = text.into_bytes();
+            } else {
+                let at = bytes.len() - 5 * (8 + 4 + 8 + 4 + 1) + 1;
+                bytes[at..at + 8].copy_from_slice(&[0xff; 8]);
+            }
+            std::fs::write(&path, &bytes)?;
+            let one = crate::read_cloud(&path, &ReadOptions::default())
+                .err()
+                .ok_or("the one-piece read accepted a NaN")?
+                .to_string();
+            let mut c = PointChunks::open(&path, &ReadOptions::default(), 3000)?;
+            let chunked = loop {
+                match c.next_chunk() {
+                    Ok(Some(_)) => continue,
+                    Ok(None) => break None,
+                    Err(e) => break Some(e.to_string()),
+                }
+            }
+            .ok_or("the chunked read accepted a NaN")?;
+            assert_eq!(chunked, one, "{encoding}");
+        }
+        // list properties in binary vertices: read whole (and said so); in ascii ones: in chunks
+        let path = dir.join("lists.ply");
+        let mut b = b"ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nproperty list uchar int n\nend_header\n".to_vec();
+        for k in 0..2u8 {
+            for v in [1.0f32, 2.0, f32::from(k)] {
+                b.extend(v.to_le_bytes());
+            }
+            b.push(0);
+        }
+        std::fs::write(&path, b)?;
+        assert!(!PointChunks::open(&path, &ReadOptions::default(), 1)?.bounded());
+        std::fs::write(
+            &path,
+            b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nproperty list uchar int n\nend_header\n0 0 0 1 7\n1 1 1 0\n",
+        )?;
+        let mut c = PointChunks::open(&path, &ReadOptions::default(), 1)?;
+        assert!(c.bounded());
+        let mut n = 0;
+        while let Some(t) = c.next_chunk()? {
+            n += t.points.len();
+        }
+        assert_eq!(n, 2);
+        std::fs::remove_dir_all(&dir)?;
+        Ok(())
     }
 }

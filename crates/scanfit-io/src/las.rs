@@ -21,6 +21,9 @@ use scanfit::Point3;
 use crate::table::{capacity, Format, Origin, PointTable, ReadOptions};
 use crate::{Error, Result};
 
+mod layered;
+use layered::read_layered;
+
 /// Points decoded per call into the crate (fewer for long records: see
 /// [`BATCH_BYTES`]).
 const BATCH: u64 = 1 << 18;
@@ -187,7 +190,11 @@ fn precheck(path: &Path, bytes: &[u8]) -> Result<Raw> {
 /// against the bytes left, walking the chunks the way the decoder will.
 /// Without them a few-kilobyte file can make the decoder allocate
 /// gigabytes (it sizes buffers from these fields before reading).
-fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<()> {
+///
+/// Returns, for the layered compressor, what scanfit's own decoder needs
+/// ([`Layered`]); `None` for the pointwise compressor (formats 0-5, read
+/// through the `laz` crate).
+fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<Option<Layered>> {
     let binary = |offset: u64, message: String| Error::Binary {
         path: path.to_path_buf(),
         offset,
@@ -225,8 +232,12 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<()> {
         at = data + u64::from(length);
     }
     let Some((vlr_at, vlr_len)) = laz else {
-        // the crate reports a missing LASzip VLR itself
-        return Ok(());
+        // refused here: the crate may look for VLRs elsewhere (a header
+        // size below the version's makes it read them after the full
+        // header) and then trust a chunk table this walk never checked
+        return Err(binary(header_size, format!(
+            "the point format is compressed (LAZ), but none of the {vlrs} VLRs that follow the {header_size}-byte header is the LASzip VLR; the file is damaged"
+        )));
     };
     let Some(vlr) = usize::try_from(vlr_at)
         .ok()
@@ -312,8 +323,19 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<()> {
             u16_at(vlr, 38).unwrap_or(0)
         )));
     }
+    // LAZ cannot compress a record below a few bits: a count beyond this is
+    // a damaged header, not data (both decoders produce points from almost
+    // no bytes on damaged data, so this bounds their output)
+    if count / 64 > len {
+        return Err(Error::Invalid {
+            path: path.to_path_buf(),
+            message: format!(
+                "the header declares {count} points, more than {len} compressed bytes can hold; the file is damaged"
+            ),
+        });
+    }
     if compressor != 3 {
-        return Ok(());
+        return Ok(None);
     }
     if !layered_ok {
         return Err(binary(vlr_at, "the LASzip VLR uses the layered compressor with an item type it does not allow; the file is damaged".into()));
@@ -374,7 +396,24 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<()> {
         pos += head + sizes;
         chunk += 1;
     }
-    Ok(())
+    Ok(Some(Layered {
+        vlr_at,
+        vlr_len,
+        count,
+        data_end,
+        table_counts,
+    }))
+}
+
+/// A layered LAZ file (point formats 6-10) as [`laz_check`] found it.
+struct Layered {
+    vlr_at: u64,
+    vlr_len: u64,
+    count: u64,
+    /// where the chunks end: the chunk table, the first EVLR or the file's end
+    data_end: u64,
+    /// the chunk table's point counts (variable-size chunks only)
+    table_counts: Option<Vec<u64>>,
 }
 
 /// Runs `f`, turning a panic into `None` without the panic message on
@@ -402,6 +441,28 @@ fn quietly<T>(f: impl FnOnce() -> T) -> Option<T> {
         }
     }
     result
+}
+
+/// The extra columns of a point format: the fields every format has, then
+/// GPS time, colour and NIR when it has them.
+fn column_names(gps_time: bool, color: bool, nir: bool) -> Vec<&'static str> {
+    let mut names = vec![
+        "intensity",
+        "return_number",
+        "number_of_returns",
+        "classification",
+        "point_source_id",
+    ];
+    if gps_time {
+        names.push("gps_time");
+    }
+    if color {
+        names.extend(["red", "green", "blue"]);
+    }
+    if nir {
+        names.push("nir");
+    }
+    names
 }
 
 /// Columns read from the crate.
@@ -438,32 +499,7 @@ fn read_with_crate(path: &Path, bytes: Vec<u8>, raw: &Raw) -> Result<Decoded> {
             ),
         });
     }
-    // LAZ cannot compress a record below a few bits: a count beyond this is
-    // a damaged header, not data
-    if raw.compressed && n / 64 > total {
-        return Err(Error::Invalid {
-            path: path.to_path_buf(),
-            message: format!(
-                "the header declares {n} points, more than {total} compressed bytes can hold; the file is damaged"
-            ),
-        });
-    }
-    let mut names = vec![
-        "intensity",
-        "return_number",
-        "number_of_returns",
-        "classification",
-        "point_source_id",
-    ];
-    if fmt.has_gps_time {
-        names.push("gps_time");
-    }
-    if fmt.has_color {
-        names.extend(["red", "green", "blue"]);
-    }
-    if fmt.has_nir {
-        names.push("nir");
-    }
+    let names = column_names(fmt.has_gps_time, fmt.has_color, fmt.has_nir);
     let cap = capacity(n, (avail / record) as usize).min(1 << 24);
     let mut points = Vec::with_capacity(cap);
     let mut columns = vec![Vec::with_capacity(cap); names.len()];
@@ -517,16 +553,23 @@ fn read_with_crate(path: &Path, bytes: Vec<u8>, raw: &Raw) -> Result<Decoded> {
 /// Reads a LAS or LAZ file's bytes (`path` is for messages).
 pub(crate) fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<PointTable> {
     let raw = precheck(path, bytes)?;
-    if raw.compressed {
-        laz_check(path, bytes, &raw)?;
-    }
-    // the crate is third-party code: a panic on a damaged file becomes one
-    // error, without its message on stderr. Our own readers return errors
-    // and never panic on file content.
-    let decoded = quietly(|| read_with_crate(path, bytes.to_vec(), &raw)).ok_or_else(|| Error::Invalid {
-        path: path.to_path_buf(),
-        message: "the LAS/LAZ decoder failed on this file (it is damaged, or uses a variant the las crate does not handle)".into(),
-    })??;
+    let layered = if raw.compressed {
+        laz_check(path, bytes, &raw)?
+    } else {
+        None
+    };
+    let decoded = match layered {
+        // LAS 1.4 points: scanfit's own decoder (the laz crate's recursion
+        // on damaged GPS-time layers overflows the stack)
+        Some(layered) => read_layered(path, bytes, &raw, &layered)?,
+        // the crate is third-party code: a panic on a damaged file becomes
+        // one error, without its message on stderr. Our own readers return
+        // errors and never panic on file content.
+        None => quietly(|| read_with_crate(path, bytes.to_vec(), &raw)).ok_or_else(|| Error::Invalid {
+            path: path.to_path_buf(),
+            message: "the LAS/LAZ decoder failed on this file (it is damaged, or uses a variant the las crate does not handle)".into(),
+        })??,
+    };
     let n = decoded.points.len();
     if (n as u64) < decoded.declared {
         return Err(Error::Invalid {

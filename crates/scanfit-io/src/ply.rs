@@ -16,24 +16,124 @@ pub enum PlyFormat {
     Ascii,
 }
 
-/// A PLY point set: x, y, z as doubles, then each attribute as a double
-/// property with its name. Attributes must hold one value per point.
+/// The narrowest PLY type that holds every value of a column exactly.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Column {
+    /// `int`: integers in the i32 range (indices, labels, counts).
+    Int,
+    /// `float`: values an f32 holds exactly (float input stays float).
+    Float,
+    /// `double`: everything else.
+    Double,
+}
+
+impl Column {
+    /// The type of `values`; coordinates (`integers` false) are never `int`.
+    fn of(values: impl Iterator<Item = f64> + Clone, integers: bool) -> Self {
+        let int = |v: f64| {
+            v.trunc() == v
+                && (f64::from(i32::MIN)..=f64::from(i32::MAX)).contains(&v)
+                && !(v == 0.0 && v.is_sign_negative())
+        };
+        if integers && values.clone().all(int) {
+            Column::Int
+        } else if values.into_iter().all(|v| f64::from(v as f32) == v) {
+            Column::Float
+        } else {
+            Column::Double
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Column::Int => "int",
+            Column::Float => "float",
+            Column::Double => "double",
+        }
+    }
+
+    fn push(self, out: &mut Vec<u8>, v: f64, format: PlyFormat) {
+        // Debug: the shortest form that reads back exactly, with exponents
+        match (self, format) {
+            (Column::Int, PlyFormat::Binary) => out.extend_from_slice(&(v as i32).to_le_bytes()),
+            (Column::Float, PlyFormat::Binary) => out.extend_from_slice(&(v as f32).to_le_bytes()),
+            (Column::Double, PlyFormat::Binary) => out.extend_from_slice(&v.to_le_bytes()),
+            (Column::Int, PlyFormat::Ascii) => {
+                let _ = write!(Text(out), "{}", v as i32);
+            }
+            (Column::Float, PlyFormat::Ascii) => {
+                let _ = write!(Text(out), "{:?}", v as f32);
+            }
+            (Column::Double, PlyFormat::Ascii) => {
+                let _ = write!(Text(out), "{v:?}");
+            }
+        }
+    }
+}
+
+/// `fmt::Write` into a byte buffer.
+struct Text<'a>(&'a mut Vec<u8>);
+
+impl std::fmt::Write for Text<'_> {
+    fn write_str(&mut self, s: &str) -> std::fmt::Result {
+        self.0.extend_from_slice(s.as_bytes());
+        Ok(())
+    }
+}
+
+/// A PLY point set: x, y, z, then each attribute as a property with its
+/// name, each column in the narrowest type that holds all its values
+/// exactly: x, y, z as `float` when every coordinate is an f32 value (float
+/// input stays float) and `double` otherwise; an attribute as `int` when
+/// all its values are integers in the i32 range (indices, labels), else
+/// `float` or `double` likewise. Attributes must hold one value per point.
+///
+/// ```
+/// use scanfit_io::ply::{points_ply, PlyFormat};
+/// use scanfit::Point3;
+/// let pts = [Point3::new(0.5, 1.0, 2.0), Point3::new(0.25, 3.0, 0.1)];
+/// let bytes = points_ply(&pts, &[("index", &[0.0, 1.0]), ("u", &[0.1, 0.2])], PlyFormat::Binary);
+/// let head = String::from_utf8_lossy(&bytes);
+/// // z = 0.1 needs a double; the index is an int, u = 0.1 a double
+/// assert!(head.contains("property double x") && head.contains("property int index"));
+/// let end = head.find("end_header\n").unwrap() + 11;
+/// assert_eq!(bytes.len() - end, 2 * (3 * 8 + 4 + 8));
+/// ```
 pub fn points_ply(points: &[Point3], attributes: &[(&str, &[f64])], format: PlyFormat) -> Vec<u8> {
     let mut header = header_start(format);
     let _ = writeln!(header, "element vertex {}", points.len());
-    for name in ["x", "y", "z"]
+    let xyz = Column::of(points.iter().flat_map(|p| [p.x, p.y, p.z]), false);
+    let columns: Vec<Column> = attributes
         .iter()
-        .chain(attributes.iter().map(|(n, _)| n))
-    {
-        let _ = writeln!(header, "property double {name}");
+        .map(|(_, v)| Column::of(v.iter().copied(), true))
+        .collect();
+    for name in ["x", "y", "z"] {
+        let _ = writeln!(header, "property {} {name}", xyz.name());
+    }
+    for ((name, _), c) in attributes.iter().zip(&columns) {
+        let _ = writeln!(header, "property {} {name}", c.name());
     }
     header.push_str("end_header\n");
     let mut out = header.into_bytes();
+    let row: usize = 3 * if xyz == Column::Double { 8 } else { 4 }
+        + columns
+            .iter()
+            .map(|c| if *c == Column::Double { 8 } else { 4 })
+            .sum::<usize>();
+    out.reserve(row * points.len());
     for (i, p) in points.iter().enumerate() {
-        let vals = [p.x, p.y, p.z]
+        let vals = [(xyz, p.x), (xyz, p.y), (xyz, p.z)]
             .into_iter()
-            .chain(attributes.iter().map(|(_, v)| v[i]));
-        push_values(&mut out, vals, format);
+            .chain(columns.iter().zip(attributes).map(|(c, (_, v))| (*c, v[i])));
+        for (k, (c, v)) in vals.enumerate() {
+            if format == PlyFormat::Ascii && k > 0 {
+                out.push(b' ');
+            }
+            c.push(&mut out, v, format);
+        }
+        if format == PlyFormat::Ascii {
+            out.push(b'\n');
+        }
     }
     out
 }
@@ -160,18 +260,6 @@ fn header_start(format: PlyFormat) -> String {
     )
 }
 
-fn push_values(out: &mut Vec<u8>, vals: impl Iterator<Item = f64>, format: PlyFormat) {
-    match format {
-        PlyFormat::Binary => vals.for_each(|v| out.extend_from_slice(&v.to_le_bytes())),
-        PlyFormat::Ascii => {
-            // Debug: the shortest form that reads back exactly, with exponents
-            let line: Vec<String> = vals.map(|v| format!("{v:?}")).collect();
-            out.extend_from_slice(line.join(" ").as_bytes());
-            out.push(b'\n');
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -183,11 +271,72 @@ mod tests {
         let bytes = points_ply(&pts, &[("u", &u)], PlyFormat::Binary);
         let text = String::from_utf8_lossy(&bytes);
         let end = text.find("end_header\n").unwrap() + "end_header\n".len();
-        assert!(text.contains("element vertex 2") && text.contains("property double u"));
-        assert_eq!(bytes.len() - end, 2 * 4 * 8);
-        let v = f64::from_le_bytes(bytes[end + 24..end + 32].try_into().unwrap());
+        // 1e-300 is no f32: double coordinates; u is an f32 value: float
+        assert!(text.contains("element vertex 2") && text.contains("property double z"));
+        assert!(text.contains("property float u"), "{text}");
+        assert_eq!(bytes.len() - end, 2 * (3 * 8 + 4));
+        let v = f32::from_le_bytes(bytes[end + 24..end + 28].try_into().unwrap());
         assert_eq!(v, 0.25);
         let ascii = String::from_utf8(points_ply(&pts, &[("u", &u)], PlyFormat::Ascii)).unwrap();
         assert!(ascii.ends_with("-1.0 0.5 1e-300 0.75\n"), "{ascii}");
+    }
+
+    #[test]
+    fn float_input_stays_float_and_indices_are_integers() {
+        // f32 coordinates (as read from a float PLY) and an index column
+        let pts: Vec<Point3> = (0..5)
+            .map(|i| {
+                let f = |x: f32| f64::from(x);
+                Point3::new(f(0.1 * i as f32), f(1.3), f(-2.7e-3 * i as f32))
+            })
+            .collect();
+        let index: Vec<f64> = (0..5).map(|i| f64::from(i * 1000 - 2)).collect();
+        let d = [0.1, 0.2, 0.3, 0.4, 0.5];
+        let big = [1e10, 0.0, 0.0, 0.0, 0.0];
+        let neg0 = [-0.0, 1.0, 2.0, 3.0, 4.0];
+        let attrs = [
+            ("index", &index[..]),
+            ("d", &d[..]),
+            ("big", &big[..]),
+            ("neg0", &neg0[..]),
+        ];
+        let bytes = points_ply(&pts, &attrs, PlyFormat::Binary);
+        let text = String::from_utf8_lossy(&bytes);
+        for p in [
+            "property float x",
+            "property float z",
+            "property int index",
+            "property double d",
+            "property float big",
+            "property float neg0",
+        ] {
+            assert!(text.contains(p), "{p}: {text}");
+        }
+        let end = text.find("end_header\n").unwrap() + "end_header\n".len();
+        assert_eq!(bytes.len() - end, 5 * (3 * 4 + 4 + 8 + 4 + 4));
+        // every value reads back exactly
+        let row = 3 * 4 + 4 + 8 + 4 + 4;
+        for (i, p) in pts.iter().enumerate() {
+            let at = end + i * row;
+            let f = |o: usize| {
+                f64::from(f32::from_le_bytes(
+                    bytes[at + o..at + o + 4].try_into().unwrap(),
+                ))
+            };
+            assert_eq!([f(0), f(4), f(8)], [p.x, p.y, p.z]);
+            let k = i32::from_le_bytes(bytes[at + 12..at + 16].try_into().unwrap());
+            assert_eq!(f64::from(k), index[i]);
+            let dv = f64::from_le_bytes(bytes[at + 16..at + 24].try_into().unwrap());
+            assert_eq!(dv, d[i]);
+            assert_eq!(f(24), big[i]);
+            assert_eq!(f(28).to_bits(), neg0[i].to_bits());
+        }
+        let ascii = String::from_utf8(points_ply(&pts, &attrs, PlyFormat::Ascii)).unwrap();
+        let data = &ascii[ascii.find("end_header\n").unwrap() + 11..];
+        assert_eq!(
+            data.lines().nth(1),
+            Some("0.1 1.3 -0.0027 998 0.2 0.0 1.0"),
+            "{ascii}"
+        );
     }
 }

@@ -20,6 +20,9 @@ use scanfit::Point3;
 #[path = "ply_faces.rs"]
 mod faces;
 
+#[path = "ply_chunks.rs"]
+pub(crate) mod chunks;
+
 use crate::binary::{decode_column, decode_points, Column, Scalar};
 use crate::mesh::attach_normals;
 use crate::table::{capacity, split_lines, Format, Origin, PointTable, ReadOptions, MAX_COLUMNS};
@@ -250,6 +253,7 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
 
 /// The plan for the vertex element: which property gives x, y, z and which
 /// go to extra columns.
+#[derive(Clone)]
 struct Plan {
     xyz: [usize; 3],
     extra: Vec<usize>,

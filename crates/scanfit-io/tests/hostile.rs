@@ -295,3 +295,20 @@ fn layered_items_need_the_layered_compressor() {
         "{e}"
     );
 }
+
+/// Fuzz finding (laz target, 2 December 2026, after the laz14 decoder): a
+/// 720-byte LAS 1.2 file whose header size (156) is below the version's
+/// 227. The VLR walk from byte 156 found no LASzip VLR, the check stepped
+/// aside, and the las crate (which reads the VLRs after the full header)
+/// found one and reserved 27 GB for an unchecked chunk table.
+#[test]
+fn a_compressed_file_needs_its_laszip_vlr_where_the_header_says() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fuzz/regressions/laz/header-size-hides-the-laszip-vlr.laz");
+    let bytes = std::fs::read(path).unwrap();
+    let e = read("f.laz", &bytes).unwrap_err();
+    assert!(
+        e.contains("none of the 1 VLRs that follow the 156-byte header is the LASzip VLR"),
+        "{e}"
+    );
+}

@@ -25,6 +25,7 @@ pub mod curves;
 pub mod geometry;
 pub mod reconstruct;
 pub mod report;
+pub mod sums;
 pub mod surfaces;
 
 /// The native module `scanfit._scanfit`; the package `scanfit` re-exports it.
@@ -49,5 +50,6 @@ fn _scanfit(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(curves::fit_curve, m)?)?;
     m.add_function(wrap_pyfunction!(curves::compare_curves, m)?)?;
     m.add_function(wrap_pyfunction!(reconstruct::reconstruct, m)?)?;
+    sums::register(m)?;
     Ok(())
 }

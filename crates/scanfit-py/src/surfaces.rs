@@ -9,7 +9,7 @@ use scanfit::base::turntable::{AxisChoice, Ends};
 use scanfit::base::{BoundaryFit, CoonsProjection};
 use scanfit::fit::surface::{KnotPlacement, SurfaceFitConfig};
 use scanfit::mba::adjust::AdjustConfig;
-use scanfit::mba::ControlFormula;
+use scanfit::mba::{ControlFormula, MbaConfig};
 use scanfit::pde::PdeConfig;
 use scanfit::pipeline::coons::{run as run_coons, CoonsConfig, CoonsRoute};
 use scanfit::pipeline::mba::{run as run_mba, MbaRunConfig};
@@ -40,6 +40,65 @@ fn put_uv(d: &Bound<'_, PyDict>, uv: &[[f64; 2]]) -> PyResult<()> {
     let (u, v) = uv_arrays(d.py(), uv);
     d.set_item("u", u)?;
     d.set_item("v", v)
+}
+
+/// The settings of `fit_surface` from its keywords (shared with the
+/// distributed fit, `scanfit.sums.NormalEquations`).
+pub fn fit_config(
+    ctrl: Option<&Bound<'_, PyAny>>,
+    degree: Option<&Bound<'_, PyAny>>,
+    params: &str,
+    knots: &str,
+    smooth: Option<f64>,
+    periodic_u: bool,
+    correct: usize,
+) -> PyResult<FitConfig> {
+    let mut cfg = FitConfig::default();
+    if let Some(c) = ctrl {
+        cfg.fit.ctrl = pair(c, "ctrl")?;
+        cfg.ctrl_from_density = false;
+    }
+    if let Some(l) = smooth {
+        cfg.fit.smoothing = l;
+        cfg.relative_smoothing = None;
+    }
+    if let Some(g) = degree {
+        cfg.fit.degree = pair(g, "degree")?;
+    }
+    cfg.params = match params {
+        "plane" => ParameterSource::Plane,
+        "uv" => ParameterSource::uv_attributes(),
+        o => return Err(bad_choice("params", o, &["plane", "uv"])),
+    };
+    cfg.fit.knots = match knots {
+        "distribution" => KnotPlacement::Distribution,
+        "uniform" => KnotPlacement::Uniform,
+        o => return Err(bad_choice("knots", o, &["distribution", "uniform"])),
+    };
+    cfg.fit.periodic_u = periodic_u;
+    cfg.correction_rounds = correct;
+    Ok(cfg)
+}
+
+/// The level loop's settings of `mba` from its keywords (shared with the
+/// distributed MBA, `scanfit.sums.MbaLevels`).
+pub fn mba_config(
+    levels: usize,
+    base: Option<&Bound<'_, PyAny>>,
+    tolerance: Option<f64>,
+    hjelle: bool,
+) -> PyResult<MbaConfig> {
+    let c = MbaConfig {
+        base: base.map(|b| pair(b, "base")).transpose()?,
+        max_levels: levels,
+        tolerance,
+        formula: if hjelle {
+            ControlFormula::Hjelle
+        } else {
+            ControlFormula::LeeWolbergShin
+        },
+    };
+    Ok(c)
 }
 
 /// Least-squares B-spline surface through scattered points (``scanfit fit``).
@@ -95,23 +154,15 @@ pub fn fit_surface<'py>(
     correct: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut cloud = cloud_arg(points, "points")?;
-    let mut cfg = FitConfig::default();
-    if let Some(c) = ctrl {
-        cfg.fit.ctrl = pair(&c, "ctrl")?;
-        cfg.ctrl_from_density = false;
-    }
-    if let Some(l) = smooth {
-        cfg.fit.smoothing = l;
-        cfg.relative_smoothing = None;
-    }
-    if let Some(g) = degree {
-        cfg.fit.degree = pair(&g, "degree")?;
-    }
-    cfg.params = match params {
-        "plane" => ParameterSource::Plane,
-        "uv" => ParameterSource::uv_attributes(),
-        o => return Err(bad_choice("params", o, &["plane", "uv"])),
-    };
+    let mut cfg = fit_config(
+        ctrl.as_ref(),
+        degree.as_ref(),
+        params,
+        knots,
+        smooth,
+        periodic_u,
+        correct,
+    )?;
     if let Some(uv) = uv {
         let n = cloud.get().len();
         let (u, v) = uv_columns(&uv, n)?;
@@ -119,13 +170,6 @@ pub fn fit_surface<'py>(
         cloud = CloudArg::Owned(c.with_attribute("v", v).map_err(err)?);
         cfg.params = ParameterSource::uv_attributes();
     }
-    cfg.fit.knots = match knots {
-        "distribution" => KnotPlacement::Distribution,
-        "uniform" => KnotPlacement::Uniform,
-        o => return Err(bad_choice("knots", o, &["distribution", "uniform"])),
-    };
-    cfg.fit.periodic_u = periodic_u;
-    cfg.correction_rounds = correct;
     let c = cloud.get();
     let r = py.detach(|| run_fit(c, &cfg, &NoProgress)).map_err(err)?;
     let d = PyDict::new(py);
@@ -197,14 +241,7 @@ pub fn mba<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let cloud = cloud_arg(points, "points")?;
     let mut cfg = MbaRunConfig::default();
-    cfg.mba.base = base.map(|b| pair(&b, "base")).transpose()?;
-    cfg.mba.max_levels = levels;
-    cfg.mba.tolerance = tolerance;
-    cfg.mba.formula = if hjelle {
-        ControlFormula::Hjelle
-    } else {
-        ControlFormula::LeeWolbergShin
-    };
+    cfg.mba = mba_config(levels, base.as_ref(), tolerance, hjelle)?;
     let weight = weight_of(weight)?;
     cfg.adjust = adjust.then(|| AdjustConfig {
         alpha,

@@ -1,5 +1,5 @@
 //! MBA benchmarks: multilevel B-spline approximation of 10^6 scattered
-//! points (8 levels, 259 x 259 control points) and the projection
+//! points (8 levels on a 1 x 1 base lattice: 131 x 131 control points) and the projection
 //! adjustment of the 35 x 35 terrain surface (50 000 points).
 //! Run: `cargo bench -p scanfit --bench mba -- --sample-size 10`.
 

@@ -24,7 +24,8 @@
 //!   queries, normals, hidden point removal, boundary loops, corners.
 //! * [`mba`]: multilevel B-spline approximation of 2.5D data (Lee, Wolberg &
 //!   Shin 1997) and [MBA18]'s projection adjustment of control points.
-//! * [`metrics`]: surface error measures and parameterization quality.
+//! * [`metrics`]: surface error measures and parameterization quality;
+//!   [`distribution`]: percentiles and histograms of such measures.
 //! * [`project`]: point inversion (orthogonal projection onto surfaces).
 //! * [`pipeline`]: every pipeline of the command line as one call (config,
 //!   progress, report), e.g. [`pipeline::reconstruct`] (a segmented cloud to
@@ -44,6 +45,7 @@ pub mod base;
 pub mod bspline;
 pub mod centring;
 pub mod cloud;
+pub mod distribution;
 mod error;
 pub mod fit;
 mod geom;
@@ -62,6 +64,7 @@ pub mod surface;
 pub mod testdata;
 pub mod topology;
 pub mod trim;
+pub mod wire;
 
 pub use cloud::PointCloud;
 pub use error::{Error, Result};

@@ -318,6 +318,42 @@ impl<A: Send> BlockSum<A> {
         self.items += items;
     }
 
+    /// The state, for sending it elsewhere ([`crate::wire`]): the total of
+    /// the complete blocks, the open block and its item count (0 without
+    /// one), the block size and the items added.
+    pub fn parts(&self) -> (&A, Option<&A>, usize, usize, u64) {
+        (
+            &self.total,
+            self.open.as_ref(),
+            self.open_len,
+            self.block,
+            self.items,
+        )
+    }
+
+    /// A sum from the [`parts`](Self::parts) of another; `None` when they
+    /// cannot be a sum's (an open block of 0 items or of a whole block or
+    /// more, or more open items than items).
+    pub fn from_parts(
+        total: A,
+        open: Option<(A, usize)>,
+        block: usize,
+        items: u64,
+    ) -> Option<Self> {
+        let block = block.max(1);
+        let open_len = open.as_ref().map_or(0, |o| o.1);
+        if open.is_some() && (open_len == 0 || open_len >= block || open_len as u64 > items) {
+            return None;
+        }
+        Some(Self {
+            total,
+            open: open.map(|o| o.0),
+            open_len,
+            block,
+            items,
+        })
+    }
+
     /// The total.
     pub fn finish(mut self, mut merge: impl FnMut(&mut A, A)) -> A {
         if let Some(open) = self.open.take() {

@@ -50,8 +50,11 @@ pub enum Orientation {
 /// Normal estimation settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NormalsConfig {
-    /// Neighbours per point, the point itself excluded (default 16, as
-    /// Open3D's and PCL's common setting; at least 2).
+    /// Neighbours per point, the point itself excluded: the covariance is
+    /// over the point and its `k` nearest others (default 16; at least 2).
+    /// Open3D's `KDTreeSearchParamKNN(knn)` and PCL's `setKSearch(k)`
+    /// count the point itself, so scanfit's `k` is their `k - 1`: the
+    /// default 16 equals their 17, and their 30 is scanfit's 29.
     pub k: usize,
     /// Sign choice (default: spanning tree with hint +z).
     pub orientation: Orientation,

@@ -21,6 +21,7 @@ use faer::{Mat, Side};
 use super::gram;
 use crate::bspline::{BasisWorkspace, KnotVector, Surface};
 use crate::par::BlockSum;
+use crate::wire::{read_pair_sums, write_pair_sums, Reader, Writer};
 use crate::{Error, Point3, Result};
 
 /// How the knots of a least-squares surface are placed.
@@ -459,6 +460,55 @@ impl NormalEquations {
         Surface::with_options(ku, kv, ctrl, None, l.periodic, false)
     }
 
+    /// The equations as bytes ([`crate::wire`]), exact: equations read back
+    /// with [`from_bytes`](Self::from_bytes) continue, merge and solve bit
+    /// for bit as these.
+    ///
+    /// ```
+    /// use scanfit::bspline::KnotVector;
+    /// use scanfit::fit::surface::NormalEquations;
+    /// use scanfit::Point3;
+    /// let k = KnotVector::uniform_clamped(3, 5)?;
+    /// let mut a = NormalEquations::new(k.clone(), k, false)?;
+    /// let uv: Vec<[f64; 2]> = (0..400).map(|i| [(i % 20) as f64 / 19.0, (i / 20) as f64 / 19.0]).collect();
+    /// let p: Vec<Point3> = uv.iter().map(|t| Point3::new(t[0], t[1], t[0] * t[1])).collect();
+    /// a.add(&p, &uv, None)?;
+    /// let b = NormalEquations::from_bytes(&a.to_bytes())?;
+    /// assert_eq!(b.finish(0.0)?, a.finish(0.0)?);
+    /// # Ok::<(), scanfit::Error>(())
+    /// ```
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut w = Writer::new(NORMAL_TAG);
+        w.u64(u64::from(self.layout.periodic));
+        for k in [&self.ku, &self.kv] {
+            w.usize(k.degree());
+            w.f64s(k.as_slice());
+        }
+        write_pair_sums(&mut w, &self.sums);
+        w.finish()
+    }
+
+    /// Reads what [`to_bytes`](Self::to_bytes) wrote; errors for bytes of
+    /// another type, cut short or inconsistent.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
+        let mut r = Reader::new(bytes, NORMAL_TAG, "least-squares normal equations")?;
+        let periodic = match r.u64()? {
+            0 => false,
+            1 => true,
+            x => return Err(r.corrupt(&format!("periodicity flag {x}"))),
+        };
+        let mut knots = || -> Result<KnotVector> {
+            let degree = r.usize()?;
+            KnotVector::new(r.f64s()?, degree)
+        };
+        let (ku, kv) = (knots()?, knots()?);
+        let mut eq = Self::new(ku, kv, periodic)?;
+        let rows = eq.layout.nu * eq.layout.nv;
+        eq.sums = read_pair_sums(&mut r, (rows * eq.layout.slots(), rows * 3), ASSEMBLY_CHUNK)?;
+        r.end()?;
+        Ok(eq)
+    }
+
     /// [`add`](Self::add) without the checks (the caller made them).
     fn add_checked(&mut self, points: &[Point3], uv: &[[f64; 2]], weights: Option<&[f64]>) {
         let l = &self.layout;
@@ -473,6 +523,9 @@ impl NormalEquations {
         );
     }
 }
+
+/// Tag of the byte record of [`NormalEquations`] ([`crate::wire`]).
+const NORMAL_TAG: &[u8; 8] = b"SFNORMQ1";
 
 /// Bytes of partial sums that may exist at a time during an assembly.
 const PARTIAL_BUDGET: usize = 256 << 20;

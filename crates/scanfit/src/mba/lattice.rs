@@ -61,6 +61,15 @@ pub struct Lattice {
     pub phi: Vec<f64>,
 }
 
+/// The cell `(i, j)` of a point and its basis values along x and y.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Basis {
+    pub(crate) i: usize,
+    pub(crate) j: usize,
+    pub(crate) bs: [f64; 4],
+    pub(crate) bt: [f64; 4],
+}
+
 /// Span index and local coordinate of `x` in `[0, cells]`: `x = cells`
 /// belongs to the last cell (with `s = 1`).
 #[inline]
@@ -108,9 +117,28 @@ impl Lattice {
     /// `f(x, y)` at lattice coordinates (eq. 1); points outside `[0, m] x
     /// [0, n]` are clamped to it.
     pub fn eval(&self, x: f64, y: f64) -> f64 {
+        self.eval_at(&self.basis(x, y))
+    }
+
+    /// The cell and the basis values of lattice coordinates `(x, y)`
+    /// (clamped to `[0, m] x [0, n]`), for evaluating several lattices of
+    /// the same size at one point.
+    #[inline]
+    pub(crate) fn basis(&self, x: f64, y: f64) -> Basis {
         let (i, s) = locate(x.clamp(0.0, self.m as f64), self.m);
         let (j, t) = locate(y.clamp(0.0, self.n as f64), self.n);
-        let (bs, bt) = (uniform_cubic_basis(s), uniform_cubic_basis(t));
+        Basis {
+            i,
+            j,
+            bs: uniform_cubic_basis(s),
+            bt: uniform_cubic_basis(t),
+        }
+    }
+
+    /// Eq. 1 at a point of [`basis`](Self::basis) (of a lattice of this size).
+    #[inline]
+    pub(crate) fn eval_at(&self, b: &Basis) -> f64 {
+        let (i, j, bs, bt) = (b.i, b.j, &b.bs, &b.bt);
         let st = self.stride();
         let mut f = 0.0;
         for k in 0..4 {

@@ -23,16 +23,22 @@
 
 use crate::metrics::ErrorStats;
 use crate::par::BlockSum;
+use crate::wire::{read_pair_sums, write_pair_sums, Reader, Writer};
 use crate::{validate_points, Error, Point3, Result};
 
 use super::lattice::{locate, uniform_cubic_basis, ControlFormula, Lattice};
 use super::Frame;
 
 /// Fewest points per block of the BA sums.
-const BA_BLOCK: usize = 16_384;
+pub(super) const BA_BLOCK: usize = 16_384;
+
+/// Tags of the byte records ([`crate::wire`]).
+const BA_TAG: &[u8; 8] = b"SFBASUM1";
+const FRAME_TAG: &[u8; 8] = b"SFFRAME1";
+const RESIDUAL_TAG: &[u8; 8] = b"SFRESID1";
 
 /// Bytes of partial sums that may exist at a time while a chunk is summed.
-const PARTIAL_BUDGET: usize = 256 << 20;
+pub(super) const PARTIAL_BUDGET: usize = 256 << 20;
 
 /// The BA sums of one lattice ([LWS97] eq. 4, [MBA18] eqs. 3-4): for every
 /// control value the numerator `sum_c w_c^2 phi_c` and the denominator
@@ -115,7 +121,7 @@ impl BaAccumulator {
         }
         let (m, n, formula) = (self.m, self.n, self.formula);
         let len = (m + 3) * (n + 3);
-        let partials = (PARTIAL_BUDGET / self.bytes()).clamp(1, 16);
+        let partials = self.partials();
         self.sums.add(
             xy.len(),
             partials,
@@ -170,21 +176,101 @@ impl BaAccumulator {
         Ok(())
     }
 
+    /// The sums as bytes ([`crate::wire`]), exact: an accumulator read back
+    /// with [`from_bytes`](Self::from_bytes) continues, merges and finishes
+    /// bit for bit as this one.
+    ///
+    /// ```
+    /// use scanfit::mba::{BaAccumulator, ControlFormula};
+    /// let mut a = BaAccumulator::new(4, 2, ControlFormula::LeeWolbergShin)?;
+    /// a.add(&[[0.5, 1.0], [3.2, 0.1]], &[1.0, -2.0])?;
+    /// let b = BaAccumulator::from_bytes(&a.to_bytes())?;
+    /// assert_eq!(b.points(), 2);
+    /// assert_eq!(b.finish(), a.finish());
+    /// # Ok::<(), scanfit::Error>(())
+    /// ```
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut w = Writer::new(BA_TAG);
+        w.usize(self.m);
+        w.usize(self.n);
+        w.u64(u64::from(self.formula == ControlFormula::Hjelle));
+        write_pair_sums(&mut w, &self.sums);
+        w.finish()
+    }
+
+    /// Reads what [`to_bytes`](Self::to_bytes) wrote; errors for bytes of
+    /// another type, cut short or inconsistent.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
+        let mut r = Reader::new(bytes, BA_TAG, "the BA sums of an MBA level")?;
+        let (m, n) = (r.usize()?, r.usize()?);
+        let formula = match r.u64()? {
+            0 => ControlFormula::LeeWolbergShin,
+            1 => ControlFormula::Hjelle,
+            x => return Err(r.corrupt(&format!("control formula {x}"))),
+        };
+        let mut acc = Self::new(m, n, formula)?;
+        let len = (m + 3) * (n + 3);
+        acc.sums = read_pair_sums(&mut r, (len, len), BA_BLOCK.max(len))?;
+        r.end()?;
+        Ok(acc)
+    }
+
     /// The lattice: each control value the ratio of its sums (eq. 4), 0
     /// where no point reached it.
     pub fn finish(self) -> Lattice {
         let (num, den) = self.sums.finish(merge_sums);
-        let phi = num
-            .iter()
-            .zip(&den)
-            .map(|(nu, de)| if *de > 0.0 { nu / de } else { 0.0 })
-            .collect();
-        Lattice {
-            m: self.m,
-            n: self.n,
-            phi,
-        }
+        ratio_lattice(self.m, self.n, &num, &den)
     }
+
+    /// The number of partial sums alive at a time while a chunk is summed
+    /// (bounded by memory, never by the thread count).
+    pub(super) fn partials(&self) -> usize {
+        (PARTIAL_BUDGET / self.bytes()).clamp(1, 16)
+    }
+
+    /// Points per block of the sums.
+    pub(super) fn block(&self) -> usize {
+        BA_BLOCK.max((self.m + 3) * (self.n + 3))
+    }
+
+    /// The control formula.
+    pub(super) fn formula(&self) -> ControlFormula {
+        self.formula
+    }
+}
+
+/// The lattice of `m x n` cells from BA sums: each control value the ratio
+/// of its sums (eq. 4), 0 where no point reached it.
+pub(super) fn ratio_lattice(m: usize, n: usize, num: &[f64], den: &[f64]) -> Lattice {
+    let phi = num
+        .iter()
+        .zip(den)
+        .map(|(nu, de)| if *de > 0.0 { nu / de } else { 0.0 })
+        .collect();
+    Lattice { m, n, phi }
+}
+
+/// The statistics of the absolute residuals `|z - z0 - sum_k f_k(x, y)|`
+/// of `points` after `levels` (evaluated as [`BaAccumulator::add_residuals`]
+/// does): the vertical errors of the approximation so far, for a measuring
+/// pass after the last level. Errors for a non-finite coordinate.
+///
+/// ```
+/// use scanfit::mba::sums::residuals;
+/// use scanfit::mba::Frame;
+/// use scanfit::Point3;
+/// let p = [Point3::new(0.0, 0.0, 1.0), Point3::new(1.0, 1.0, 3.0)];
+/// let r = residuals(&Frame::of(&p)?, &[], &p)?; // no level: |z - mean z|
+/// assert_eq!((r.count, r.max), (2, 1.0));
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+pub fn residuals(frame: &Frame, levels: &[Lattice], points: &[Point3]) -> Result<ResidualSums> {
+    validate_points(points)?;
+    let mut stats = ResidualSums::default();
+    for p in points {
+        stats.push(residual(frame, levels, p, frame.unit(p)).abs());
+    }
+    Ok(stats)
 }
 
 /// The residual `z - z0 - sum_k f_k` of `p` (unit coordinates `u`) after
@@ -199,7 +285,7 @@ pub(crate) fn residual(frame: &Frame, levels: &[Lattice], p: &Point3, u: [f64; 2
 
 /// Eqs. 3-4 for one point: its candidates and weights added to the sums.
 #[inline]
-fn add_point(
+pub(super) fn add_point(
     num: &mut [f64],
     den: &mut [f64],
     m: usize,
@@ -208,27 +294,84 @@ fn add_point(
     p: [f64; 2],
     zc: f64,
 ) {
+    add_point_values(&mut [num], den, m, n, formula, p, [zc]);
+}
+
+/// Eqs. 3-4 of one point in factored form. With `w_kl = B_k(s) B_l(t)`,
+/// `sum_kl w_kl^2 = (sum_k B_k(s)^2)(sum_l B_l(t)^2)`, and eq. 3's candidate
+/// `phi_c = w z / sum w^2` times eq. 4's weight `w^2` is
+/// `(z / sum w^2) fs_k ft_l` with `fs_k = B_k(s)^3`, `ft_l = B_l(t)^3`,
+/// the weight itself `ds_k dt_l` with `ds_k = B_k(s)^2` (Hjelle's weight
+/// `w`: `fs = B^2`, `ds = B`): one division per value instead of 16.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct BaFactors {
+    /// Factors along x of the numerator terms.
+    pub(super) fs: [f64; 4],
+    /// Factors along y of the numerator terms.
+    pub(super) ft: [f64; 4],
+    /// Factors along x of the weights.
+    pub(super) ds: [f64; 4],
+    /// Factors along y of the weights.
+    pub(super) dt: [f64; 4],
+    /// `sum_kl w_kl^2`.
+    pub(super) sum2: f64,
+}
+
+impl BaFactors {
+    /// The factors at local coordinates `(s, t)` of a cell.
+    #[inline]
+    pub(super) fn new(s: f64, t: f64, formula: ControlFormula) -> Self {
+        let (bs, bt) = (uniform_cubic_basis(s), uniform_cubic_basis(t));
+        let (s2, t2) = (bs.map(|b| b * b), bt.map(|b| b * b));
+        let sum2 = s2.iter().sum::<f64>() * t2.iter().sum::<f64>();
+        match formula {
+            ControlFormula::LeeWolbergShin => Self {
+                fs: std::array::from_fn(|k| s2[k] * bs[k]),
+                ft: std::array::from_fn(|l| t2[l] * bt[l]),
+                ds: s2,
+                dt: t2,
+                sum2,
+            },
+            ControlFormula::Hjelle => Self {
+                fs: s2,
+                ft: t2,
+                ds: bs,
+                dt: bt,
+                sum2,
+            },
+        }
+    }
+}
+
+/// [`add_point`] for `K` value sets at once (one numerator each, the
+/// denominator shared: it depends on the point's position only).
+#[inline]
+pub(super) fn add_point_values<const K: usize>(
+    num: &mut [&mut [f64]; K],
+    den: &mut [f64],
+    m: usize,
+    n: usize,
+    formula: ControlFormula,
+    p: [f64; 2],
+    zc: [f64; K],
+) {
     let st = n + 3;
     let (i, s) = locate(p[0].clamp(0.0, m as f64), m);
     let (j, t) = locate(p[1].clamp(0.0, n as f64), n);
-    let (bs, bt) = (uniform_cubic_basis(s), uniform_cubic_basis(t));
-    let mut sum2 = 0.0;
-    for bk in bs {
-        for bl in bt {
-            sum2 += (bk * bl) * (bk * bl);
-        }
-    }
+    let f = BaFactors::new(s, t, formula);
+    let q = zc.map(|z| z / f.sum2);
     for k in 0..4 {
-        for l in 0..4 {
-            let w = bs[k] * bt[l];
-            let phi_c = w * zc / sum2; // eq. 3
-            let at = (i + k) * st + j + l;
-            let weight = match formula {
-                ControlFormula::LeeWolbergShin => w * w,
-                ControlFormula::Hjelle => w,
-            };
-            num[at] += weight * phi_c; // eq. 4 numerator
-            den[at] += weight;
+        // the 4 values of row i + k (one bounds check per row)
+        let row = (i + k) * st + j..(i + k) * st + j + 4;
+        for (nu, q) in num.iter_mut().zip(q) {
+            let a = q * f.fs[k];
+            for (nu, ft) in nu[row.clone()].iter_mut().zip(f.ft) {
+                *nu += a * ft; // eqs. 3-4 numerator
+            }
+        }
+        let d = f.ds[k];
+        for (de, dt) in den[row].iter_mut().zip(f.dt) {
+            *de += d * dt;
         }
     }
 }
@@ -289,6 +432,39 @@ impl ResidualSums {
         self.sum += other.sum;
         self.sum2 += other.sum2;
         self.count += other.count;
+    }
+
+    /// The sums as bytes ([`crate::wire`], exact).
+    ///
+    /// ```
+    /// use scanfit::mba::ResidualSums;
+    /// let mut a = ResidualSums::default();
+    /// a.push(0.25);
+    /// assert_eq!(ResidualSums::from_bytes(&a.to_bytes())?, a);
+    /// # Ok::<(), scanfit::Error>(())
+    /// ```
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut w = Writer::new(RESIDUAL_TAG);
+        w.u64(self.count);
+        w.f64(self.sum);
+        w.f64(self.sum2);
+        w.f64(self.max);
+        w.u64(self.max_index);
+        w.finish()
+    }
+
+    /// Reads what [`to_bytes`](Self::to_bytes) wrote.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
+        let mut r = Reader::new(bytes, RESIDUAL_TAG, "residual statistics")?;
+        let s = Self {
+            count: r.u64()?,
+            sum: r.f64()?,
+            sum2: r.f64()?,
+            max: r.f64()?,
+            max_index: r.u64()?,
+        };
+        r.end()?;
+        Ok(s)
     }
 
     /// Mean, maximum and RMSE.
@@ -364,6 +540,49 @@ impl FrameSums {
         self.count
     }
 
+    /// The sums as bytes ([`crate::wire`], exact).
+    ///
+    /// ```
+    /// use scanfit::mba::FrameSums;
+    /// use scanfit::Point3;
+    /// let mut s = FrameSums::default();
+    /// s.add(&[Point3::new(0.0, 0.0, 1.0), Point3::new(2.0, 1.0, 3.0)])?;
+    /// assert_eq!(FrameSums::from_bytes(&s.to_bytes())?, s);
+    /// # Ok::<(), scanfit::Error>(())
+    /// ```
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut w = Writer::new(FRAME_TAG);
+        w.u64(self.count);
+        let lo = self.lo.unwrap_or([f64::NAN; 2]);
+        for x in [lo[0], lo[1], self.hi[0], self.hi[1], self.zsum] {
+            w.f64(x);
+        }
+        w.finish()
+    }
+
+    /// Reads what [`to_bytes`](Self::to_bytes) wrote.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
+        let mut r = Reader::new(bytes, FRAME_TAG, "the frame sums of an MBA")?;
+        let count = r.u64()?;
+        let lo = [r.f64()?, r.f64()?];
+        let hi = [r.f64()?, r.f64()?];
+        let zsum = r.f64()?;
+        r.end()?;
+        Ok(Self {
+            lo: (count > 0).then_some(lo),
+            hi,
+            zsum,
+            count,
+        })
+    }
+
+    /// The mean height of the points added (`None` without points): the
+    /// frame's `z0`, for a frame over a given domain instead of the data's
+    /// bounding box.
+    pub fn mean_z(&self) -> Option<f64> {
+        (self.count > 0).then(|| self.zsum / self.count as f64)
+    }
+
     /// The frame; errors for fewer than 2 points or data without extent in
     /// x or y.
     pub fn finish(&self) -> Result<Frame> {
@@ -402,6 +621,40 @@ mod tests {
     use super::*;
     use crate::mba::{mba, MbaConfig, MbaLevels};
     use crate::testdata::franke;
+
+    #[test]
+    fn sums_sent_as_bytes_continue_bit_for_bit_and_damaged_bytes_are_refused() -> Result<()> {
+        let p = cloud(50_000);
+        let frame = Frame::of(&p)?;
+        let mut once = BaAccumulator::new(16, 8, ControlFormula::LeeWolbergShin)?;
+        once.add_residuals(&frame, &[], &p)?;
+        // stopped mid-block (20_000 is not a multiple of the block), sent, continued
+        let mut a = BaAccumulator::new(16, 8, ControlFormula::LeeWolbergShin)?;
+        a.add_residuals(&frame, &[], &p[..20_000])?;
+        let bytes = a.to_bytes();
+        let mut b = BaAccumulator::from_bytes(&bytes)?;
+        b.add_residuals(&frame, &[], &p[20_000..])?;
+        assert_eq!(b.points(), 50_000);
+        assert_eq!(b.finish(), once.finish());
+        // every truncation and a flipped tag are errors, never a panic
+        for cut in (0..bytes.len()).step_by(97) {
+            assert!(BaAccumulator::from_bytes(&bytes[..cut]).is_err(), "{cut}");
+        }
+        let mut other = bytes.clone();
+        other[0] = b'X';
+        let e = BaAccumulator::from_bytes(&other).unwrap_err().to_string();
+        assert!(e.contains("BA sums"), "{e}");
+        // a record of another type is named as such
+        let f = FrameSums::default().to_bytes();
+        assert!(BaAccumulator::from_bytes(&f).is_err());
+        let mut fs = FrameSums::default();
+        fs.add(&p[..10])?;
+        assert_eq!(
+            FrameSums::from_bytes(&fs.to_bytes())?.finish()?,
+            Frame::of(&p[..10])?
+        );
+        Ok(())
+    }
 
     fn cloud(n: usize) -> Vec<Point3> {
         let mut rng = crate::testdata::Lcg::new(17);

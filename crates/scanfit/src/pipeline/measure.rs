@@ -5,13 +5,15 @@
 //! the one assessment ([`assess_projected`]: orthogonal distances, eq. 17,
 //! surface samples to points, the fold-overs of the projected parameters),
 //! plus the distribution of the orthogonal distances: median, 95th
-//! percentile and a histogram.
+//! percentile and a histogram over the 99th percentile with an overflow bin
+//! ([`Histogram`]: a few stray points do not squeeze the bulk into one bin).
 
 use crate::bspline::Surface;
 use crate::centring::{Centring, Translate};
+use crate::distribution::{percentile_sorted, Histogram};
 use crate::pipeline::assess::{assess_projected, AssessConfig, Assessment};
 use crate::progress::Progress;
-use crate::{Error, Point3, Result};
+use crate::{Point3, Result};
 
 /// Settings of [`run`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -19,8 +21,11 @@ use crate::{Error, Point3, Result};
 pub struct MeasureConfig {
     /// The assessment (default [`AssessConfig::default`]).
     pub assess: AssessConfig,
-    /// Bins of the distance histogram over `[0, max]` (default 24).
+    /// Bins of the distance histogram over `[0, top]` (default 24).
     pub bins: usize,
+    /// The percentile that is the histogram's `top` (default 99; the
+    /// distances above it are counted in the overflow bin).
+    pub histogram_percentile: f64,
 }
 
 impl Default for MeasureConfig {
@@ -28,6 +33,7 @@ impl Default for MeasureConfig {
         Self {
             assess: AssessConfig::default(),
             bins: 24,
+            histogram_percentile: 99.0,
         }
     }
 }
@@ -43,9 +49,9 @@ pub struct MeasureReport {
     pub median: f64,
     /// 95th percentile of the orthogonal distances.
     pub p95: f64,
-    /// Counts of the orthogonal distances in `bins` equal bins over
-    /// `[0, max]` (the maximum in the last bin).
-    pub histogram: Vec<usize>,
+    /// The orthogonal distances in `bins` equal bins over `[0, top]`, `top`
+    /// their `histogram_percentile`-th percentile, plus an overflow bin.
+    pub histogram: Histogram,
 }
 
 /// Measures `points` against `surface` (see the module documentation).
@@ -69,7 +75,7 @@ pub struct MeasureReport {
 /// let r = run(&s, &pts, &MeasureConfig::default(), &NoProgress)?;
 /// assert!((r.assessment.quality.orthogonal.max - 0.099).abs() < 1e-9);
 /// assert!((r.median - 0.050).abs() < 1e-9);
-/// assert_eq!(r.histogram.iter().sum::<usize>(), 100);
+/// assert_eq!(r.histogram.counts.iter().sum::<usize>() + r.histogram.overflow, 100);
 /// # Ok::<(), scanfit::Error>(())
 /// ```
 pub fn run(
@@ -78,13 +84,8 @@ pub fn run(
     config: &MeasureConfig,
     progress: &dyn Progress,
 ) -> Result<MeasureReport> {
-    if config.bins == 0 || config.bins > 100_000 {
-        return Err(Error::InvalidSetting {
-            setting: "bins",
-            value: config.bins.to_string(),
-            hint: "give 1 to 100000 histogram bins".into(),
-        });
-    }
+    // the histogram's settings checked before the work
+    Histogram::over_percentile(&[], config.bins, config.histogram_percentile)?;
     progress.stage(&format!("projecting {} points", points.len()), None);
     // relative to the points' centre (issue 14): surface and points moved
     // exactly, the foot points moved back
@@ -97,26 +98,12 @@ pub fn run(
         let pts = centring.points(points);
         centring.restore(assess_projected(&local, &pts, &config.assess)?)
     };
-    let max = assessment.quality.orthogonal.max;
     let mut sorted = assessment.distances();
     sorted.sort_by(f64::total_cmp);
     // nearest-rank percentiles; `assess_projected` refused an empty set
-    let pct = |f: f64| {
-        sorted
-            .get(((sorted.len() - 1) as f64 * f).round() as usize)
-            .copied()
-            .unwrap_or(0.0)
-    };
+    let pct = |f: f64| percentile_sorted(&sorted, f).unwrap_or(0.0);
     let (median, p95) = (pct(0.5), pct(0.95));
-    let mut histogram = vec![0usize; config.bins];
-    for &d in &sorted {
-        let b = if max > 0.0 {
-            ((d / max) * config.bins as f64) as usize
-        } else {
-            0
-        };
-        histogram[b.min(config.bins - 1)] += 1;
-    }
+    let histogram = Histogram::over_percentile(&sorted, config.bins, config.histogram_percentile)?;
     Ok(MeasureReport {
         assessment,
         median,

@@ -337,25 +337,7 @@ pub fn fit(
     config: &FitConfig,
     progress: &dyn Progress,
 ) -> Result<StreamedFit> {
-    let refuse = |setting: &'static str, value: String, why: &str| Error::InvalidSetting {
-        setting,
-        value,
-        hint: format!("{why}; points read in chunks need settings computable per point"),
-    };
-    if config.params == ParameterSource::Plane {
-        return Err(refuse(
-            "params",
-            "plane".into(),
-            "parameters from the best-fit plane need the whole cloud (its minimum-area rectangle); give the parameters as u and v columns",
-        ));
-    }
-    if config.correction_rounds > 0 {
-        return Err(refuse(
-            "correction_rounds",
-            config.correction_rounds.to_string(),
-            "parameter correction re-projects every point in each round and keeps their parameters; leave it out",
-        ));
-    }
+    check_fit(config)?;
     let (centring, count) = centring_pass(source)?;
     let source = &mut Centred { source, centring };
     let fit_config = config.resolved_fit(count);
@@ -379,6 +361,43 @@ pub fn fit(
         passes: 3,
         smoothing: fit_config.smoothing,
     })
+}
+
+/// Refuses the settings of `config` that need all points at once (with the
+/// reason): parameters from the best-fit plane and parameter correction.
+/// Knots from the parameter distribution are refused when the equations
+/// are made ([`crate::fit::surface::SurfaceFitConfig::uniform_equations`]).
+/// Drivers of their own (a cluster) call it before the first pass.
+///
+/// ```
+/// use scanfit::pipeline::stream::check_fit;
+/// use scanfit::pipeline::surface_fit::{FitConfig, ParameterSource};
+/// let mut cfg = FitConfig::default();
+/// assert!(check_fit(&cfg).is_err()); // the plane needs the whole cloud
+/// cfg.params = ParameterSource::uv_attributes();
+/// assert!(check_fit(&cfg).is_ok());
+/// ```
+pub fn check_fit(config: &FitConfig) -> Result<()> {
+    let refuse = |setting: &'static str, value: String, why: &str| Error::InvalidSetting {
+        setting,
+        value,
+        hint: format!("{why}; points read in chunks need settings computable per point"),
+    };
+    if config.params == ParameterSource::Plane {
+        return Err(refuse(
+            "params",
+            "plane".into(),
+            "parameters from the best-fit plane need the whole cloud (its minimum-area rectangle); give the parameters as u and v columns",
+        ));
+    }
+    if config.correction_rounds > 0 {
+        return Err(refuse(
+            "correction_rounds",
+            config.correction_rounds.to_string(),
+            "parameter correction re-projects every point in each round and keeps their parameters; leave it out",
+        ));
+    }
+    Ok(())
 }
 
 /// The parameters of a chunk, an error when the source gave none.

@@ -1,11 +1,26 @@
 //! Software rendering of surfaces to PNG: no GPU, no window, no system fonts.
 //!
-//! An orthographic camera looks at the object from an azimuth and elevation
-//! (z up) and fits it into the image; triangles are rasterised with a depth
-//! buffer, shaded (two-sided Lambert plus ambient) and coloured by height,
-//! by a per-vertex scalar (viridis, with a colour bar) or by per-vertex RGB
-//! colours (categories such as patches), with darker iso-parameter lines; input
-//! points can be drawn on top where they are not hidden by the surface.
+//! An orthographic camera ([`Camera`]) looks at the object from an azimuth
+//! and elevation around the up axis ([`Up`]: x, y or z; named views in
+//! [`ViewPreset`]) and fits it into the image; triangles are rasterised with
+//! a depth buffer, shaded (two-sided Lambert plus ambient) and coloured by
+//! height, by a per-vertex scalar (viridis, on a [`ColourScale`] clipped at
+//! a percentile) or by per-vertex RGB colours (categories such as patches),
+//! with darker iso-parameter lines; input points can be drawn on top where
+//! they are not hidden by the surface.
+//!
+//! The [`Layout`] reserves the caption's rows (wrapped to the width, never
+//! cut off) and the colour bar's column before the drawing is fitted into
+//! what is left, so neither is drawn over the object.
+
+mod camera;
+mod legend;
+
+pub use camera::{Camera, Up, ViewPreset};
+pub use legend::{
+    format_value, text_width, wrap_text, BarLabels, BarLayout, Clip, ColourScale, Fit, Layout,
+    DEVIATION_PERCENTILE, GLYPH, LINE,
+};
 
 use scanfit::bspline::Mesh;
 use scanfit::{Point3, Vector3};
@@ -15,14 +30,15 @@ use crate::{Error, Result};
 /// What the surface colour shows.
 #[derive(Debug, Clone, Copy)]
 pub enum Colouring<'a> {
-    /// The height (world z), low = dark blue, high = yellow.
+    /// The height (along the up axis), low = dark blue, high = yellow, with a
+    /// colour bar in [`RenderOptions::units`].
     Height,
-    /// One value per mesh vertex over `range` (e.g. deviation).
+    /// One value per mesh vertex on `scale` (e.g. deviation), with a colour bar.
     Scalar {
         /// values per vertex
         values: &'a [f64],
-        /// value range mapped onto the colour map
-        range: (f64, f64),
+        /// what the colours mean: range, clipping, name with units
+        scale: &'a ColourScale,
     },
     /// One colour per mesh vertex (e.g. one per patch), interpolated across
     /// each triangle; no colour bar, since the colours are categories, not
@@ -37,29 +53,54 @@ pub struct RenderOptions {
     pub width: u32,
     /// Image height in pixels (default 900).
     pub height: u32,
-    /// Camera azimuth around z, degrees (default -60).
+    /// Camera azimuth around the up axis, degrees (default -60).
     pub azimuth: f64,
-    /// Camera elevation above the xy plane, degrees (default 35).
+    /// Camera elevation above the plane across the up axis, degrees (default 35).
     pub elevation: f64,
+    /// The world axis that is up (default z).
+    pub up: Up,
+    /// Length unit of the data for the height bar, e.g. "m" (default "data units").
+    pub units: String,
     /// Iso-parameter lines per direction (default 10; 0 = none).
     pub iso_lines: usize,
-    /// Lines of text drawn at the top left (title, figures).
+    /// Lines of text drawn at the top left (title, figures); wrapped to the
+    /// width. A picture with a vertical exaggeration gets a line saying so.
     pub legend: Vec<String>,
-    /// Vertical exaggeration: z is multiplied by this before drawing (default 1;
-    /// see [`auto_exaggeration`] for flat data such as terrain).
+    /// Vertical exaggeration: the up axis is multiplied by this before
+    /// drawing (default 1; see [`auto_exaggeration`] for flat data such as
+    /// terrain).
     pub z_scale: f64,
 }
 
+impl RenderOptions {
+    /// The caption: [`Self::legend`] and, when the picture is exaggerated,
+    /// a line with the factor and the axis.
+    pub fn caption(&self) -> Vec<String> {
+        let mut c = self.legend.clone();
+        if self.z_scale != 1.0 && self.z_scale > 0.0 && self.z_scale.is_finite() {
+            c.push(format!(
+                "vertical exaggeration {}x along {} (up)",
+                self.z_scale,
+                self.up.name()
+            ));
+        }
+        c
+    }
+}
+
 /// A vertical exaggeration that makes the relief of flat data visible: the
-/// factor that brings the z range to 20% of the larger horizontal extent,
-/// rounded to one significant digit; 1 when the data are not flat.
-pub fn auto_exaggeration(points: &[Point3]) -> f64 {
+/// factor that brings the range along `up` to 20% of the larger extent
+/// across it, rounded to one significant digit; 1 when the data are not flat.
+pub fn auto_exaggeration(points: &[Point3], up: Up) -> f64 {
     let (lo, hi) = points.iter().fold(
         (
             Vector3::repeat(f64::INFINITY),
             Vector3::repeat(f64::NEG_INFINITY),
         ),
-        |(lo, hi), p| (lo.inf(&p.coords), hi.sup(&p.coords)),
+        |(lo, hi), p| {
+            let c = up.to_frame(&p.coords);
+            (lo.inf(&c), hi.sup(&c))
+        },
     );
     let ext = hi - lo;
     let horizontal = ext.x.max(ext.y);
@@ -78,6 +119,8 @@ impl Default for RenderOptions {
             height: 900,
             azimuth: -60.0,
             elevation: 35.0,
+            up: Up::Z,
+            units: "data units".into(),
             iso_lines: 10,
             legend: Vec::new(),
             z_scale: 1.0,
@@ -145,7 +188,8 @@ pub struct PointScene<'a> {
 }
 
 /// Renders a [`PointScene`] with an orthographic camera that fits points,
-/// lines and markers into the frame; returns the PNG bytes.
+/// lines and markers into the frame; returns the PNG bytes. Points coloured
+/// by height get a colour bar clipped at their 1st and 99th percentiles.
 pub fn render_scene_png(scene: &PointScene, opts: &RenderOptions) -> Result<Vec<u8>> {
     let (w, h) = (opts.width.max(16) as usize, opts.height.max(16) as usize);
     if let Some(c) = scene.colours {
@@ -160,19 +204,8 @@ pub fn render_scene_png(scene: &PointScene, opts: &RenderOptions) -> Result<Vec<
             });
         }
     }
-    let (az, el) = (opts.azimuth.to_radians(), opts.elevation.to_radians());
-    let d = Vector3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
-    let right = Vector3::new(-az.sin(), az.cos(), 0.0);
-    let up = d.cross(&right);
-    let zs = if opts.z_scale > 0.0 && opts.z_scale.is_finite() {
-        opts.z_scale
-    } else {
-        1.0
-    };
-    let view = |p: &Point3| {
-        let c = Vector3::new(p.x, p.y, p.z * zs);
-        (c.dot(&right), c.dot(&up), c.dot(&d))
-    };
+    let camera = Camera::new(opts);
+    let view = |p: &Point3| camera.project(p);
     let sp: Vec<(f64, f64, f64)> = scene.points.iter().map(view).collect();
     let mut img = vec![255u8; w * h * 3];
     let extra = scene
@@ -182,7 +215,17 @@ pub fn render_scene_png(scene: &PointScene, opts: &RenderOptions) -> Result<Vec<
         .chain(scene.markers.iter().map(|m| &m.at))
         .map(view);
     let all: Vec<(f64, f64, f64)> = sp.iter().copied().chain(extra).collect();
+    let heights: Vec<f64> = scene.points.iter().map(|p| camera.height(p)).collect();
+    let scale = scene.colours.is_none().then(|| {
+        ColourScale::two_sided(
+            format!("height ({}) [{}]", opts.up.name(), opts.units),
+            &heights,
+            DEVIATION_PERCENTILE,
+        )
+    });
+    let layout = Layout::new(w, h, &opts.caption(), scale.as_ref());
     if all.is_empty() {
+        layout.draw(&mut img);
         return encode_png(&img, w as u32, h as u32);
     }
     let (mut x0, mut x1, mut y0, mut y1) = (
@@ -194,39 +237,31 @@ pub fn render_scene_png(scene: &PointScene, opts: &RenderOptions) -> Result<Vec<
     for &(x, y, _) in &all {
         (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
     }
-    let (z0, z1) = scene
-        .points
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
-            (a.min(p.z), b.max(p.z))
-        });
-    let top = 14.0 * opts.legend.len() as f64;
-    let usable_h = h as f64 - top;
-    let scale =
-        (w as f64 * 0.9 / (x1 - x0).max(1e-300)).min(usable_h * 0.9 / (y1 - y0).max(1e-300));
-    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+    let fit = layout.fit(x0, x1, y0, y1);
     let pixel = |x: f64, y: f64| {
-        (
-            (w as f64 / 2.0 + (x - cx) * scale) as isize,
-            (top + usable_h / 2.0 - (y - cy) * scale) as isize,
-        )
+        let (px, py) = fit.pixel(x, y);
+        (px as isize, py as isize)
     };
     let mut depth = vec![f64::NEG_INFINITY; w * h];
     // splat size: points cover the picture of a surface (about half of the
     // projected box, twice over for the front of a closed body), so nearer
     // points hide farther ones
-    let area = (x1 - x0) * (y1 - y0) * scale * scale;
+    let area = (x1 - x0) * (y1 - y0) * fit.scale * fit.scale;
     let spacing_px = (2.0 * area / sp.len().max(1) as f64).sqrt();
     let r = (0.5 * spacing_px).round().clamp(0.0, 4.0) as isize;
     // visibility in two passes: the depth of the front surface with wider
     // splats (so it has no holes), then the colours of the points within a
     // few point spacings of that front (the back of a closed body stays hidden)
     let wide = (2 * r + 2).min(10);
-    let tolerance = (2.0 * (wide as f64 + 1.0) + 3.0 * spacing_px.max(1.0)) / scale;
+    let tolerance = (2.0 * (wide as f64 + 1.0) + 3.0 * spacing_px.max(1.0)) / fit.scale;
     let footprint = |px: isize, py: isize, r: isize| {
         (-r..=r).flat_map(move |dy| (-r..=r).map(move |dx| (px + dx, py + dy)))
     };
-    let inside = |qx: isize, qy: isize| qx >= 0 && qy >= 0 && qx < w as isize && qy < h as isize;
+    // splats stay inside the drawing's area (off the caption and the bar)
+    let (ax0, ay0, ax1, ay1) = layout.area;
+    let inside = |qx: isize, qy: isize| {
+        qx >= ax0 as isize && qy >= ay0 as isize && qx < ax1 as isize && qy < ay1 as isize
+    };
     for &(x, y, z) in &sp {
         let (px, py) = pixel(x, y);
         for (qx, qy) in footprint(px, py, wide) {
@@ -239,10 +274,10 @@ pub fn render_scene_png(scene: &PointScene, opts: &RenderOptions) -> Result<Vec<
     let mut drawn = vec![f64::NEG_INFINITY; w * h];
     for (i, &(x, y, z)) in sp.iter().enumerate() {
         let (px, py) = pixel(x, y);
-        let col = match scene.colours {
-            Some(c) => c[i],
-            None => viridis(((scene.points[i].z - z0) / (z1 - z0).max(1e-300)).clamp(0.0, 1.0))
-                .map(|c| (c * 255.0).round() as u8),
+        let col = match (scene.colours, &scale) {
+            (Some(c), _) => c[i],
+            (None, Some(s)) => viridis(s.position(heights[i])).map(|c| (c * 255.0).round() as u8),
+            (None, None) => [0, 0, 0],
         };
         for (qx, qy) in footprint(px, py, r) {
             if !inside(qx, qy) {
@@ -255,32 +290,25 @@ pub fn render_scene_png(scene: &PointScene, opts: &RenderOptions) -> Result<Vec<
             }
         }
     }
-    draw_overlay(&mut img, w, h, &scene.polylines, &scene.markers, |p| {
+    draw_overlay(&mut img, &layout, &scene.polylines, &scene.markers, |p| {
         let (x, y, _) = view(p);
-        let (px, py) = pixel(x, y);
-        (px as f64, py as f64)
+        fit.pixel(x, y)
     });
-    let mut canvas = Canvas {
-        rgb: &mut img,
-        width: w,
-        height: h,
-    };
-    for (k, line) in opts.legend.iter().enumerate() {
-        draw_text(&mut canvas, 8, 6 + 14 * k, line, 1, [20, 20, 20]);
-    }
+    layout.draw(&mut img);
     encode_png(&img, w as u32, h as u32)
 }
 
 /// Draws `lines` (2-pixel wide) and labelled `markers` over an image, with
-/// `to_pixel` mapping a world point to pixel coordinates.
+/// `to_pixel` mapping a world point to pixel coordinates; a label that would
+/// run out of the layout's drawing area is written on the marker's left.
 fn draw_overlay(
     img: &mut [u8],
-    w: usize,
-    h: usize,
+    layout: &Layout,
     lines: &[Polyline],
     markers: &[Marker],
     to_pixel: impl Fn(&Point3) -> (f64, f64),
 ) {
+    let (w, h) = (layout.width, layout.height);
     let put = |x: isize, y: isize, rgb: [u8; 3], img: &mut [u8]| {
         if x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h {
             let k = (y as usize * w + x as usize) * 3;
@@ -316,6 +344,13 @@ fn draw_overlay(
             }
         }
         if !m.label.is_empty() {
+            let lw = text_width(&m.label, 2) as isize;
+            let right = layout.area.2 as isize;
+            let lx = if px + 10 + lw > right {
+                px - 10 - lw
+            } else {
+                px + 10
+            };
             let mut canvas = Canvas {
                 rgb: img,
                 width: w,
@@ -323,8 +358,8 @@ fn draw_overlay(
             };
             draw_text(
                 &mut canvas,
-                (px + 10).max(0) as usize,
-                (py - 16).max(0) as usize,
+                lx.max(0) as usize,
+                (py - 16).max(layout.area.1 as isize) as usize,
                 &m.label,
                 2,
                 [0, 0, 0],
@@ -334,14 +369,14 @@ fn draw_overlay(
 }
 
 /// Camera angles `(azimuth, elevation)` in degrees that look along `-n`,
-/// i.e. from the side `n` points to (z up): a top view of a patch with
-/// normal `n`.
-pub fn angles_facing(n: &Vector3) -> (f64, f64) {
+/// i.e. from the side `n` points to (with `up` the up axis): a top view of
+/// a patch with normal `n`.
+pub fn angles_facing(n: &Vector3, up: Up) -> (f64, f64) {
     let len = n.norm();
     if !(len > 0.0 && len.is_finite()) {
         return (-60.0, 35.0);
     }
-    let n = n / len;
+    let n = up.to_frame(&(n / len));
     let el = n.z.clamp(-1.0, 1.0).asin().to_degrees();
     let az = if n.x.abs() + n.y.abs() < 1e-12 {
         -90.0
@@ -379,7 +414,7 @@ pub fn render_surface_scene_png(
     markers: &[Marker],
     opts: &RenderOptions,
 ) -> Result<Vec<u8>> {
-    let img = render_rgb_with(mesh, points, colouring, lines, markers, opts);
+    let (img, _, _) = render_rgb_with(mesh, points, colouring, lines, markers, opts);
     encode_png(&img, opts.width, opts.height)
 }
 
@@ -390,9 +425,35 @@ pub fn render_rgb(
     colouring: Colouring,
     opts: &RenderOptions,
 ) -> Vec<u8> {
-    render_rgb_with(mesh, points, colouring, &[], &[], opts)
+    render_rgb_with(mesh, points, colouring, &[], &[], opts).0
 }
 
+/// The scale of the colours of `mesh` under `colouring`: a height scale
+/// over the mesh's heights (its own range: a surface has no stray points),
+/// the given scale, or none for category colours.
+fn surface_scale(mesh: &Mesh, colouring: &Colouring, opts: &RenderOptions) -> Option<ColourScale> {
+    match colouring {
+        Colouring::Height => {
+            let (lo, hi) = mesh
+                .vertices
+                .iter()
+                .map(|p| opts.up.height(p))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), z| {
+                    (a.min(z), b.max(z))
+                });
+            let range = if lo <= hi { (lo, hi) } else { (0.0, 0.0) };
+            Some(ColourScale::new(
+                format!("height ({}) [{}]", opts.up.name(), opts.units),
+                range,
+            ))
+        }
+        Colouring::Scalar { scale, .. } => Some((*scale).clone()),
+        Colouring::Rgb(_) => None,
+    }
+}
+
+/// The picture and its layout; pixels of the surface have a finite depth in
+/// the returned buffer.
 fn render_rgb_with(
     mesh: &Mesh,
     points: Option<&[Point3]>,
@@ -400,23 +461,12 @@ fn render_rgb_with(
     lines: &[Polyline],
     markers: &[Marker],
     opts: &RenderOptions,
-) -> Vec<u8> {
+) -> (Vec<u8>, Layout, Vec<f64>) {
     let (w, h) = (opts.width.max(16) as usize, opts.height.max(16) as usize);
-    let (az, el) = (opts.azimuth.to_radians(), opts.elevation.to_radians());
-    // towards the camera, right, up
-    let d = Vector3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
-    let right = Vector3::new(-az.sin(), az.cos(), 0.0);
-    let up = d.cross(&right);
+    let camera = Camera::new(opts);
+    let (d, right, up) = (camera.toward, camera.right, camera.up);
     let light = (d + 0.4 * up - 0.3 * right).normalize();
-    let zs = if opts.z_scale > 0.0 && opts.z_scale.is_finite() {
-        opts.z_scale
-    } else {
-        1.0
-    };
-    let proj = |p: &Point3| {
-        let c = Vector3::new(p.x, p.y, p.z * zs);
-        (c.dot(&right), c.dot(&up), c.dot(&d))
-    };
+    let proj = |p: &Point3| camera.project(p);
     let sv: Vec<(f64, f64, f64)> = mesh.vertices.iter().map(proj).collect();
     let sp: Vec<(f64, f64, f64)> = points.unwrap_or(&[]).iter().map(proj).collect();
     let overlay: Vec<(f64, f64, f64)> = lines
@@ -440,35 +490,26 @@ fn render_rgb_with(
         z0 = z0.min(z);
         z1 = z1.max(z);
     }
+    let scale = surface_scale(mesh, &colouring, opts);
+    let layout = Layout::new(w, h, &opts.caption(), scale.as_ref());
     let mut img = vec![255u8; w * h * 3];
+    let mut depth = vec![f64::NEG_INFINITY; w * h];
     if !(x1 > x0 || y1 > y0) {
-        return img;
+        layout.draw(&mut img);
+        return (img, layout, depth);
     }
-    let margin = 0.05;
-    let scale = ((w as f64) * (1.0 - 2.0 * margin) / (x1 - x0).max(1e-300))
-        .min((h as f64) * (1.0 - 2.0 * margin) / (y1 - y0).max(1e-300));
-    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-    let to_px = |x: f64, y: f64| {
-        (
-            w as f64 / 2.0 + (x - cx) * scale,
-            h as f64 / 2.0 - (y - cy) * scale,
-        )
-    };
-    let heights: Vec<f64> = mesh.vertices.iter().map(|p| p.z).collect();
-    let (vals, (lo, hi)) = match colouring {
-        Colouring::Height => {
-            let lo = heights.iter().cloned().fold(f64::INFINITY, f64::min);
-            let hi = heights.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
-            (heights.as_slice(), (lo, hi))
-        }
-        Colouring::Scalar { values, range } => (values, range),
-        Colouring::Rgb(_) => (heights.as_slice(), (0.0, 1.0)),
+    let fit = layout.fit(x0, x1, y0, y1);
+    let to_px = |x: f64, y: f64| fit.pixel(x, y);
+    let heights: Vec<f64> = mesh.vertices.iter().map(|p| camera.height(p)).collect();
+    let vals = match colouring {
+        Colouring::Scalar { values, .. } => values,
+        _ => heights.as_slice(),
     };
     let rgb_of = |k: usize| match colouring {
         Colouring::Rgb(c) => c.get(k).map(|c| c.map(|x| x as f64 / 255.0)),
         _ => None,
     };
-    let span = if hi > lo { hi - lo } else { 1.0 };
+    let position = |v: f64| scale.as_ref().map_or(0.0, |s| s.position(v));
     let ((u0, u1), (v0, v1)) = mesh.uv.iter().fold(
         (
             (f64::INFINITY, f64::NEG_INFINITY),
@@ -476,7 +517,8 @@ fn render_rgb_with(
         ),
         |((a, b), (c, e)), t| ((a.min(t[0]), b.max(t[0])), (c.min(t[1]), e.max(t[1]))),
     );
-    let mut depth = vec![f64::NEG_INFINITY; w * h];
+    let normals: Vec<Vector3> = mesh.normals.iter().map(|n| camera.normal(n)).collect();
+    let (ax0, ay0, ax1, ay1) = layout.area;
     for t in &mesh.triangles {
         let [a, b, c] = t.map(|k| k as usize);
         let (pa, pb, pc) = (
@@ -488,10 +530,11 @@ fn render_rgb_with(
         if area.abs() < 1e-12 {
             continue;
         }
-        let xmin = pa.0.min(pb.0).min(pc.0).floor().max(0.0) as usize;
-        let xmax = (pa.0.max(pb.0).max(pc.0).ceil() as usize).min(w - 1);
-        let ymin = pa.1.min(pb.1).min(pc.1).floor().max(0.0) as usize;
-        let ymax = (pa.1.max(pb.1).max(pc.1).ceil() as usize).min(h - 1);
+        // pixels inside the drawing's area only (off the caption and the bar)
+        let xmin = pa.0.min(pb.0).min(pc.0).floor().max(ax0 as f64) as usize;
+        let xmax = (pa.0.max(pb.0).max(pc.0).ceil().max(0.0) as usize).min(ax1 - 1);
+        let ymin = pa.1.min(pb.1).min(pc.1).floor().max(ay0 as f64) as usize;
+        let ymax = (pa.1.max(pb.1).max(pc.1).ceil().max(0.0) as usize).min(ay1 - 1);
         for py in ymin..=ymax {
             for px in xmin..=xmax {
                 let (x, y) = (px as f64 + 0.5, py as f64 + 0.5);
@@ -507,8 +550,7 @@ fn render_rgb_with(
                     continue;
                 }
                 depth[k] = z;
-                let mut n = mesh.normals[a] * w0 + mesh.normals[b] * w1 + mesh.normals[c] * w2;
-                n.z /= zs; // normals transform with the inverse transpose of the scaling
+                let n = normals[a] * w0 + normals[b] * w1 + normals[c] * w2;
                 let nn = n.norm();
                 let lambert = if nn > 0.0 {
                     (n.dot(&light) / nn).abs()
@@ -521,7 +563,7 @@ fn render_rgb_with(
                     (Some(ca), Some(cb), Some(cc)) => {
                         [0, 1, 2].map(|ch| w0 * ca[ch] + w1 * cb[ch] + w2 * cc[ch])
                     }
-                    _ => viridis(((value - lo) / span).clamp(0.0, 1.0)),
+                    _ => viridis(position(value)),
                 };
                 if opts.iso_lines > 0 {
                     let u = w0 * mesh.uv[a][0] + w1 * mesh.uv[b][0] + w2 * mesh.uv[c][0];
@@ -552,7 +594,7 @@ fn render_rgb_with(
         let (px, py) = (px as isize, py as isize);
         for &(dx, dy) in dot {
             let (qx, qy) = (px + dx, py + dy);
-            if qx < 0 || qy < 0 || qx >= w as isize || qy >= h as isize {
+            if qx < ax0 as isize || qy < ay0 as isize || qx >= ax1 as isize || qy >= ay1 as isize {
                 continue;
             }
             let k = qy as usize * w + qx as usize;
@@ -561,22 +603,12 @@ fn render_rgb_with(
             }
         }
     }
-    draw_overlay(&mut img, w, h, lines, markers, |p| {
+    draw_overlay(&mut img, &layout, lines, markers, |p| {
         let (x, y, _) = proj(p);
         to_px(x, y)
     });
-    if let Colouring::Scalar { range, .. } = colouring {
-        colour_bar(&mut img, w, h, range);
-    }
-    let mut canvas = Canvas {
-        rgb: &mut img,
-        width: w,
-        height: h,
-    };
-    for (k, line) in opts.legend.iter().enumerate() {
-        draw_text(&mut canvas, 8, 6 + 14 * k, line, 1, [20, 20, 20]);
-    }
-    img
+    layout.draw(&mut img);
+    (img, layout, depth)
 }
 
 /// An RGB8 image being drawn on (row-major, top row first).
@@ -616,56 +648,6 @@ pub fn draw_text(canvas: &mut Canvas, x: usize, y: usize, text: &str, scale: usi
     }
 }
 
-/// A vertical viridis bar at the right edge with its range written beside it.
-fn colour_bar(img: &mut [u8], w: usize, h: usize, range: (f64, f64)) {
-    let (x0, x1) = (w.saturating_sub(110), w.saturating_sub(90));
-    let (y0, y1) = (h / 6, h - h / 6);
-    for y in y0..y1 {
-        let t = 1.0 - (y - y0) as f64 / (y1 - y0).max(1) as f64;
-        let c = viridis(t).map(|v| (v * 255.0).round() as u8);
-        for x in x0..x1 {
-            img[(y * w + x) * 3..(y * w + x) * 3 + 3].copy_from_slice(&c);
-        }
-    }
-    let label = |v: f64| {
-        if v != 0.0 && !(1e-3..1e5).contains(&v.abs()) {
-            format!("{v:.2e}")
-        } else {
-            format!("{v:.4}")
-        }
-    };
-    let (lo, hi) = range;
-    let mut c = Canvas {
-        rgb: img,
-        width: w,
-        height: h,
-    };
-    draw_text(
-        &mut c,
-        x1 + 6,
-        y0.saturating_sub(4),
-        &label(hi),
-        1,
-        [20, 20, 20],
-    );
-    draw_text(
-        &mut c,
-        x1 + 6,
-        (y0 + y1) / 2 - 4,
-        &label(0.5 * (lo + hi)),
-        1,
-        [20, 20, 20],
-    );
-    draw_text(
-        &mut c,
-        x1 + 6,
-        y1.saturating_sub(4),
-        &label(lo),
-        1,
-        [20, 20, 20],
-    );
-}
-
 /// The viridis colour map (matplotlib), linear between 9 stops.
 pub fn viridis(t: f64) -> [f64; 3] {
     const STOPS: [[f64; 3]; 9] = [
@@ -690,8 +672,8 @@ mod tests {
     use super::*;
     use scanfit::bspline::{tessellate, KnotVector, Surface};
 
-    #[test]
-    fn a_rendered_surface_fills_the_frame_and_is_not_blank() {
+    /// A bumpy 5 x 5 patch over `[0, 4] x [0, sy]`, tessellated 40 x 40.
+    fn bumpy(sy: f64) -> Mesh {
         let ku = KnotVector::uniform_clamped(3, 5).unwrap();
         let kv = KnotVector::uniform_clamped(3, 5).unwrap();
         let mut c = Vec::new();
@@ -699,22 +681,199 @@ mod tests {
             for j in 0..5 {
                 c.push(Point3::new(
                     i as f64,
-                    j as f64,
+                    j as f64 * sy / 4.0,
                     ((i + j) as f64 * 0.8).sin(),
                 ));
             }
         }
-        let s = Surface::new(ku, kv, c).unwrap();
-        let mesh = tessellate(&s, 40, 40);
+        tessellate(&Surface::new(ku, kv, c).unwrap(), 40, 40)
+    }
+
+    #[test]
+    fn the_colour_bar_and_caption_are_never_drawn_over_the_surface() {
+        // a wide patch (it would fill the width) with a corner marker at the
+        // right end, coloured by a clipped scale with a long name
+        let mesh = bumpy(1.0);
+        let values: Vec<f64> = mesh.vertices.iter().map(|p| p.x * 0.01).collect();
+        let scale = ColourScale::deviation(
+            "orthogonal distance of the nearest input point [data units]",
+            &values,
+            99.0,
+        );
+        let right_end =
+            mesh.vertices
+                .iter()
+                .copied()
+                .fold(Point3::new(f64::MIN, 0.0, 0.0), |a, p| {
+                    if p.x > a.x {
+                        p
+                    } else {
+                        a
+                    }
+                });
+        let marker = Marker {
+            at: right_end,
+            rgb: [255, 255, 255],
+            label: "C3".into(),
+        };
+        for (w, h) in [(1200u32, 900u32), (400, 300)] {
+            let opts = RenderOptions {
+                width: w,
+                height: h,
+                azimuth: -90.0,
+                elevation: 60.0,
+                legend: vec!["a caption ".repeat(30)],
+                ..Default::default()
+            };
+            let colouring = Colouring::Scalar {
+                values: &values,
+                scale: &scale,
+            };
+            let (img, layout, depth) = render_rgb_with(
+                &mesh,
+                None,
+                colouring,
+                &[],
+                std::slice::from_ref(&marker),
+                &opts,
+            );
+            let bar = layout.bar.as_ref().unwrap();
+            let (bx0, bx1) = bar.columns;
+            let w = w as usize;
+            let surface: Vec<(usize, usize)> = (0..depth.len())
+                .filter(|&k| depth[k].is_finite())
+                .map(|k| (k % w, k / w))
+                .collect();
+            assert!(surface.len() > depth.len() / 20, "{}", surface.len());
+            let (sx0, sx1) = surface
+                .iter()
+                .fold((usize::MAX, 0), |(a, b), &(x, _)| (a.min(x), b.max(x)));
+            let sy0 = surface.iter().map(|&(_, y)| y).min().unwrap();
+            // the surface's columns end before the bar's begin, and it starts
+            // below the caption's last line
+            assert!(sx1 < bx0, "surface columns {sx0}..={sx1}, bar {bx0}..{bx1}");
+            assert!(
+                sy0 >= layout.area.1,
+                "surface from row {sy0}, caption to {}",
+                layout.area.1
+            );
+            assert!(layout.caption.len() > 1);
+            // the bar is drawn: its middle row holds viridis(0.5)
+            let (cx, cy) = (
+                (bar.bar_columns.0 + bar.bar_columns.1) / 2,
+                (bar.rows.0 + bar.rows.1) / 2,
+            );
+            let px = &img[(cy * w + cx) * 3..(cy * w + cx) * 3 + 3];
+            let mid = viridis(0.5).map(|c| (c * 255.0).round() as u8);
+            assert!(
+                px.iter().zip(&mid).all(|(a, b)| a.abs_diff(*b) <= 3),
+                "{px:?}"
+            );
+            // nothing black (marker labels, outlines) inside the bar's strip
+            // left of its labels
+            for y in 0..h as usize {
+                for x in bx0..bar.bar_columns.1 {
+                    let px = &img[(y * w + x) * 3..(y * w + x) * 3 + 3];
+                    if y < bar.rows.0.saturating_sub(LINE) || y > bar.rows.1 + LINE {
+                        continue;
+                    }
+                    assert_ne!(px, [0, 0, 0], "ink at ({x}, {y}) in the bar");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn y_up_data_with_up_y_is_the_same_picture_as_the_z_up_data() {
+        let mesh = bumpy(3.0);
+        let points: Vec<Point3> = mesh
+            .vertices
+            .iter()
+            .step_by(7)
+            .map(|p| p + Vector3::new(0.0, 0.0, 0.01))
+            .collect();
+        // the same object stored y-up: (x, y, z) -> (x, z, -y)
+        let turn = |p: &Point3| Point3::new(p.x, p.z, -p.y);
+        let turned = Mesh {
+            vertices: mesh.vertices.iter().map(turn).collect(),
+            normals: mesh
+                .normals
+                .iter()
+                .map(|n| Vector3::new(n.x, n.z, -n.y))
+                .collect(),
+            uv: mesh.uv.clone(),
+            triangles: mesh.triangles.clone(),
+        };
+        let turned_points: Vec<Point3> = points.iter().map(turn).collect();
+        let z_up = RenderOptions {
+            width: 300,
+            height: 200,
+            z_scale: 3.0,
+            legend: vec!["caption".into()],
+            ..Default::default()
+        };
+        let y_up = RenderOptions {
+            up: Up::Y,
+            ..z_up.clone()
+        };
+        let (a, la, _) = render_rgb_with(&mesh, Some(&points), Colouring::Height, &[], &[], &z_up);
+        let (b, lb, _) = render_rgb_with(
+            &turned,
+            Some(&turned_points),
+            Colouring::Height,
+            &[],
+            &[],
+            &y_up,
+        );
+        assert_eq!(la.area, lb.area);
+        // pixel-equal in the drawing (caption and bar title name the axis)
+        let (x0, y0, x1, y1) = la.area;
+        let drawing = |img: &[u8]| -> Vec<u8> {
+            (y0..y1)
+                .flat_map(|y| img[(y * 300 + x0) * 3..(y * 300 + x1) * 3].to_vec())
+                .collect()
+        };
+        assert_eq!(drawing(&a), drawing(&b));
+        assert!(drawing(&a).iter().filter(|&&c| c != 255).count() > 10_000);
+        assert_eq!(z_up.caption()[1], "vertical exaggeration 3x along z (up)");
+        assert_eq!(y_up.caption()[1], "vertical exaggeration 3x along y (up)");
+        // seen unturned (z up), the y-up data are another picture
+        let c = render_rgb(&turned, Some(&turned_points), Colouring::Height, &z_up);
+        assert!(a.iter().zip(&c).filter(|(x, y)| x != y).count() > a.len() / 20);
+        // point pictures too
+        let decode = |png: Vec<u8>| {
+            let mut r = png::Decoder::new(std::io::Cursor::new(png))
+                .read_info()
+                .unwrap();
+            let mut buf = vec![0; r.output_buffer_size().unwrap()];
+            r.next_frame(&mut buf).unwrap();
+            buf
+        };
+        let scene = |p| PointScene {
+            points: p,
+            ..Default::default()
+        };
+        let pa = decode(render_scene_png(&scene(&points), &z_up).unwrap());
+        let pb = decode(render_scene_png(&scene(&turned_points), &y_up).unwrap());
+        assert_eq!(drawing(&pa), drawing(&pb));
+        assert!(drawing(&pa).iter().filter(|&&c| c != 255).count() > 1000);
+    }
+
+    #[test]
+    fn a_rendered_surface_fills_the_frame_and_is_not_blank() {
+        let mesh = bumpy(4.0);
         let opts = RenderOptions {
             width: 200,
             height: 150,
             ..Default::default()
         };
-        let img = render_rgb(&mesh, None, Colouring::Height, &opts);
-        let painted = img.chunks(3).filter(|p| p != &[255, 255, 255]).count();
-        assert!(painted > 200 * 150 / 4, "{painted}");
-        // nothing drawn in the 2-pixel border (object inside the frame)
+        let (img, layout, depth) = render_rgb_with(&mesh, None, Colouring::Height, &[], &[], &opts);
+        // the surface covers more than a sixth of the drawing's area (wide
+        // object, width-bound)
+        let (x0, y0, x1, y1) = layout.area;
+        let covered = depth.iter().filter(|d| d.is_finite()).count();
+        assert!(covered > (x1 - x0) * (y1 - y0) / 6, "{covered}");
+        // nothing drawn in the top row (object inside the frame)
         for x in 0..200 {
             assert_eq!(&img[x * 3..x * 3 + 3], &[255, 255, 255]);
         }

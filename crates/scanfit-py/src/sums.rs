@@ -1,0 +1,901 @@
+//! The accumulators of a chunked or distributed fit (module `scanfit.sums`,
+//! driven by `scanfit.dask`): the sums over points behind MBA ([LWS97]
+//! eqs. 3-4, per level) and behind the least-squares surface (the normal
+//! equations, [NURBS97] eq. 9.63), each created empty, fed chunks of points,
+//! merged with another, finished, and picklable (an exact bytes round trip,
+//! `scanfit::wire`), so that workers can return them to a client.
+//!
+//! * `Centring`: the translation of the data's bounding box the in-memory
+//!   pipelines compute relative to (`scanfit::centring`); every chunk is
+//!   moved by it before it is summed.
+//! * `FrameSums`: the MBA frame (bounding box in x, y and the mean height).
+//! * `MbaLevels`: the level loop on the client; `state()` is what is
+//!   broadcast per level (`MbaState`: frame, the level lattices so far,
+//!   the centring), `accumulator()` the level's empty `BaSums`.
+//! * `BaSums`: one level's BA sums; `add(state, points)` evaluates the
+//!   levels so far at the points and adds their residuals.
+//! * `ResidualSums`: mergeable error statistics (count, mean, max, RMSE).
+//! * `NormalEquations`: the least-squares surface's normal equations with
+//!   uniform knots, configured by `fit_surface`'s keywords.
+
+use numpy::PyUntypedArrayMethods;
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict, PyList, PyTuple};
+use scanfit::centring::Centring;
+use scanfit::fit::surface::NormalEquations;
+use scanfit::mba::sums::residuals;
+use scanfit::mba::{
+    lattice_surface, BaAccumulator, ControlFormula, Frame, FrameSums, Lattice, MbaLevels,
+    ResidualSums,
+};
+use scanfit::pipeline::stream::check_fit;
+use scanfit::wire::{Reader, Writer};
+use scanfit::{Point3, Vector3};
+
+use crate::convert::{err, float_array, points, uv_columns, value_err, vec3};
+use crate::geometry::PySurface;
+use crate::report::stats;
+use crate::surfaces::{fit_config, mba_config};
+
+/// The points of a chunk: an `(N, 3)` array, `N = 0` allowed (an empty
+/// chunk adds nothing).
+fn chunk(obj: &Bound<'_, PyAny>) -> PyResult<Vec<Point3>> {
+    let a = float_array(obj, "points")?;
+    if a.shape() == [0, 3] {
+        return Ok(Vec::new());
+    }
+    points(obj, "points")
+}
+
+/// `(cls_restore, (kind, bytes))` for `__reduce__`: pickled as the exact
+/// bytes, restored by `scanfit.sums._restore`.
+fn reduce<'py>(py: Python<'py>, kind: &str, bytes: &[u8]) -> PyResult<Bound<'py, PyTuple>> {
+    let restore = py.import("scanfit.sums")?.getattr("_restore")?;
+    let args = PyTuple::new(
+        py,
+        [
+            kind.into_pyobject(py)?.into_any(),
+            PyBytes::new(py, bytes).into_any(),
+        ],
+    )?;
+    PyTuple::new(py, [restore, args.into_any()])
+}
+
+/// Reads a Python record: the tag, then `f` on the reader, then the end.
+fn read<T>(
+    bytes: &[u8],
+    tag: &[u8; 8],
+    what: &'static str,
+    f: impl FnOnce(&mut Reader<'_>) -> scanfit::Result<T>,
+) -> PyResult<T> {
+    let mut r = Reader::new(bytes, tag, what).map_err(err)?;
+    let t = f(&mut r).map_err(err)?;
+    r.end().map_err(err)?;
+    Ok(t)
+}
+
+/// The translation that moves the data's bounding box to the origin (as
+/// the in-memory pipelines compute), from the box's corners.
+///
+/// Example::
+///
+///     >>> c = scanfit.sums.Centring((6e5, 5e6, 0.0), (6.1e5, 5.01e6, 30.0))
+///     >>> c.centre
+///     (605000.0, 5005000.0, 0.0)
+#[pyclass(name = "Centring", module = "scanfit.sums", frozen)]
+#[derive(Clone)]
+pub struct PyCentring {
+    lo: Vector3,
+    hi: Vector3,
+    inner: Centring,
+}
+
+impl PyCentring {
+    fn of(lo: Vector3, hi: Vector3) -> Self {
+        let inner = Centring::of(&[Point3::from(lo), Point3::from(hi)]);
+        Self { lo, hi, inner }
+    }
+
+    fn write(&self, w: &mut Writer) {
+        for x in self.lo.iter().chain(self.hi.iter()) {
+            w.f64(*x);
+        }
+    }
+
+    fn read(r: &mut Reader<'_>) -> scanfit::Result<Self> {
+        let mut v = [0.0; 6];
+        for x in &mut v {
+            *x = r.f64()?;
+        }
+        Ok(Self::of(
+            Vector3::new(v[0], v[1], v[2]),
+            Vector3::new(v[3], v[4], v[5]),
+        ))
+    }
+
+    /// `points` moved by `-centre`.
+    fn apply(&self, points: Vec<Point3>) -> Vec<Point3> {
+        if self.inner.is_identity() {
+            points
+        } else {
+            self.inner.points(&points)
+        }
+    }
+}
+
+const CENTRING_TAG: &[u8; 8] = b"SFPYCEN1";
+
+#[pymethods]
+impl PyCentring {
+    /// The centring of data whose bounding box has corners `lo` and `hi`.
+    #[new]
+    fn new(lo: &Bound<'_, PyAny>, hi: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let (lo, hi) = (vec3(lo, "lo")?, vec3(hi, "hi")?);
+        if !(lo.iter().chain(hi.iter()).all(|x| x.is_finite())) || (0..3).any(|k| lo[k] > hi[k]) {
+            return Err(value_err(format!(
+                "the bounding box ({}, {}, {}) - ({}, {}, {}) is not one: corners must be finite with lo <= hi",
+                lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
+            )));
+        }
+        Ok(Self::of(lo, hi))
+    }
+
+    /// The translation subtracted from every point (0 where none is needed).
+    #[getter]
+    fn centre(&self) -> (f64, f64, f64) {
+        let c = self.inner.centre();
+        (c.x, c.y, c.z)
+    }
+
+    /// The exact bytes (see ``from_bytes``).
+    fn to_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
+        let mut w = Writer::new(CENTRING_TAG);
+        self.write(&mut w);
+        PyBytes::new(py, &w.finish())
+    }
+
+    /// The centring whose ``to_bytes`` gave ``data``.
+    #[staticmethod]
+    fn from_bytes(data: &[u8]) -> PyResult<Self> {
+        read(data, CENTRING_TAG, "a centring", Self::read)
+    }
+
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        reduce(py, "Centring", self.to_bytes(py).as_bytes())
+    }
+
+    fn __repr__(&self) -> String {
+        let c = self.centre();
+        format!("Centring(centre=({}, {}, {}))", c.0, c.1, c.2)
+    }
+}
+
+/// The sums behind the MBA frame: bounding box in x and y and the sum of
+/// the heights, of centred points.
+///
+/// Example::
+///
+///     >>> c = scanfit.sums.Centring(pts.min(axis=0), pts.max(axis=0))
+///     >>> f = scanfit.sums.FrameSums()
+///     >>> f.add(pts[:500], c); g = scanfit.sums.FrameSums(); g.add(pts[500:], c)
+///     >>> f.merge(g); f.points == len(pts)
+///     True
+#[pyclass(name = "FrameSums", module = "scanfit.sums")]
+#[derive(Clone, Default)]
+pub struct PyFrameSums {
+    inner: FrameSums,
+}
+
+#[pymethods]
+impl PyFrameSums {
+    /// Empty sums.
+    #[new]
+    fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds an ``(N, 3)`` chunk (``N = 0`` allowed), moved by ``centring``.
+    fn add(
+        &mut self,
+        py: Python<'_>,
+        points: &Bound<'_, PyAny>,
+        centring: &PyCentring,
+    ) -> PyResult<()> {
+        let p = centring.apply(chunk(points)?);
+        py.detach(|| self.inner.add(&p)).map_err(err)
+    }
+
+    /// An independent copy.
+    fn copy(&self) -> Self {
+        self.clone()
+    }
+
+    /// Adds the sums of other points.
+    fn merge(&mut self, other: &PyFrameSums) {
+        self.inner.merge(&other.inner);
+    }
+
+    /// Points added.
+    #[getter]
+    fn points(&self) -> u64 {
+        self.inner.points()
+    }
+
+    /// The exact bytes (see ``from_bytes``).
+    fn to_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
+        PyBytes::new(py, &self.inner.to_bytes())
+    }
+
+    /// The sums whose ``to_bytes`` gave ``data``.
+    #[staticmethod]
+    fn from_bytes(data: &[u8]) -> PyResult<Self> {
+        Ok(Self {
+            inner: FrameSums::from_bytes(data).map_err(err)?,
+        })
+    }
+
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        reduce(py, "FrameSums", &self.inner.to_bytes())
+    }
+
+    fn __repr__(&self) -> String {
+        format!("FrameSums(points={})", self.inner.points())
+    }
+}
+
+/// Mergeable statistics of absolute errors: count, mean, max (and the
+/// index of the largest over all values, in merge order) and RMSE.
+///
+/// Example::
+///
+///     >>> s = scanfit.sums.ResidualSums(); s.add(np.array([0.5, 2.0]))
+///     >>> s.stats()["max"]
+///     2.0
+#[pyclass(name = "ResidualSums", module = "scanfit.sums")]
+#[derive(Clone, Default)]
+pub struct PyResidualSums {
+    inner: ResidualSums,
+}
+
+#[pymethods]
+impl PyResidualSums {
+    /// No values.
+    #[new]
+    fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds the absolute values of a one-dimensional array.
+    fn add(&mut self, values: &Bound<'_, PyAny>) -> PyResult<()> {
+        let a = float_array(values, "values")?;
+        if a.ndim() != 1 {
+            return Err(value_err(format!(
+                "values must be one-dimensional; got {} dimensions",
+                a.ndim()
+            )));
+        }
+        for x in a.as_array().iter() {
+            if !x.is_finite() {
+                return Err(value_err(format!("values holds {x}; give finite values")));
+            }
+            self.inner.push(x.abs());
+        }
+        Ok(())
+    }
+
+    /// An independent copy.
+    fn copy(&self) -> Self {
+        self.clone()
+    }
+
+    /// Adds the statistics of values that come after these.
+    fn merge(&mut self, other: &PyResidualSums) {
+        self.inner.merge(&other.inner);
+    }
+
+    /// Values added.
+    #[getter]
+    fn count(&self) -> u64 {
+        self.inner.count
+    }
+
+    /// ``count``, ``mean``, ``max``, ``max_index``, ``rmse``.
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        stats(py, &self.inner.stats())
+    }
+
+    /// The exact bytes (see ``from_bytes``).
+    fn to_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
+        PyBytes::new(py, &self.inner.to_bytes())
+    }
+
+    /// The statistics whose ``to_bytes`` gave ``data``.
+    #[staticmethod]
+    fn from_bytes(data: &[u8]) -> PyResult<Self> {
+        Ok(Self {
+            inner: ResidualSums::from_bytes(data).map_err(err)?,
+        })
+    }
+
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        reduce(py, "ResidualSums", &self.inner.to_bytes())
+    }
+
+    fn __repr__(&self) -> String {
+        let s = self.inner.stats();
+        format!(
+            "ResidualSums(count={}, rmse={}, max={})",
+            s.count, s.rmse, s.max
+        )
+    }
+}
+
+/// What an MBA level broadcasts to the workers: the frame, the lattices of
+/// the levels so far and the centring (bytes: the lattice sizes, never the
+/// point count).
+#[pyclass(name = "MbaState", module = "scanfit.sums", frozen)]
+#[derive(Clone)]
+pub struct PyMbaState {
+    centring: PyCentring,
+    frame: Frame,
+    levels: Vec<Lattice>,
+    /// Cells of the next level's lattice and its control formula.
+    next: (usize, usize, ControlFormula),
+}
+
+const STATE_TAG: &[u8; 8] = b"SFPYMBS1";
+
+impl PyMbaState {
+    fn encode(&self) -> Vec<u8> {
+        let mut w = Writer::new(STATE_TAG);
+        self.centring.write(&mut w);
+        let f = &self.frame;
+        for x in [f.x0, f.y0, f.width, f.height, f.z0] {
+            w.f64(x);
+        }
+        w.usize(self.next.0);
+        w.usize(self.next.1);
+        w.u64(u64::from(self.next.2 == ControlFormula::Hjelle));
+        w.usize(self.levels.len());
+        for l in &self.levels {
+            w.usize(l.m);
+            w.usize(l.n);
+            w.f64s(&l.phi);
+        }
+        w.finish()
+    }
+}
+
+#[pymethods]
+impl PyMbaState {
+    /// The statistics of the vertical residuals ``|z - f(x, y)|`` of an
+    /// ``(N, 3)`` chunk after the levels so far.
+    fn residuals(&self, py: Python<'_>, points: &Bound<'_, PyAny>) -> PyResult<PyResidualSums> {
+        let p = self.centring.apply(chunk(points)?);
+        let inner = py
+            .detach(|| residuals(&self.frame, &self.levels, &p))
+            .map_err(err)?;
+        Ok(PyResidualSums { inner })
+    }
+
+    /// Empty BA sums of the next level (what each worker fills).
+    fn accumulator(&self) -> PyResult<PyBaSums> {
+        let (m, n, formula) = self.next;
+        Ok(PyBaSums {
+            inner: BaAccumulator::new(m, n, formula).map_err(err)?,
+        })
+    }
+
+    /// Levels so far.
+    #[getter]
+    fn levels(&self) -> usize {
+        self.levels.len()
+    }
+
+    /// Bytes of the lattices (what is sent to each worker per level).
+    #[getter]
+    fn nbytes(&self) -> usize {
+        self.levels.iter().map(|l| 8 * l.phi.len()).sum()
+    }
+
+    /// The exact bytes (see ``from_bytes``).
+    fn to_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
+        PyBytes::new(py, &self.encode())
+    }
+
+    /// The state whose ``to_bytes`` gave ``data``.
+    #[staticmethod]
+    fn from_bytes(data: &[u8]) -> PyResult<Self> {
+        read(data, STATE_TAG, "an MBA level state", |r| {
+            let centring = PyCentring::read(r)?;
+            let frame = Frame {
+                x0: r.f64()?,
+                y0: r.f64()?,
+                width: r.f64()?,
+                height: r.f64()?,
+                z0: r.f64()?,
+            };
+            let (m, n) = (r.usize()?, r.usize()?);
+            let formula = match r.u64()? {
+                0 => ControlFormula::LeeWolbergShin,
+                1 => ControlFormula::Hjelle,
+                x => return Err(r.corrupt(&format!("control formula {x}"))),
+            };
+            let count = r.usize()?;
+            let mut levels = Vec::new();
+            for _ in 0..count {
+                let (m, n, phi) = (r.usize()?, r.usize()?, r.f64s()?);
+                if m.checked_add(3)
+                    .zip(n.checked_add(3))
+                    .and_then(|(a, b)| a.checked_mul(b))
+                    != Some(phi.len())
+                {
+                    return Err(r.corrupt(&format!("a {m} x {n} lattice of {} values", phi.len())));
+                }
+                levels.push(Lattice { m, n, phi });
+            }
+            Ok(Self {
+                centring,
+                frame,
+                levels,
+                next: (m, n, formula),
+            })
+        })
+    }
+
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        reduce(py, "MbaState", &self.encode())
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "MbaState(levels={}, nbytes={})",
+            self.levels.len(),
+            self.nbytes()
+        )
+    }
+}
+
+/// The BA sums of one MBA level ([LWS97] eqs. 3-4): per control value the
+/// numerator and denominator of eq. 4. Made by ``MbaLevels.accumulator()``.
+///
+/// Example::
+///
+///     >>> acc = run.accumulator()
+///     >>> stats = acc.add(run.state(), pts)   # the residuals of the level before
+///     >>> run.push(acc)
+#[pyclass(name = "BaSums", module = "scanfit.sums")]
+#[derive(Clone)]
+pub struct PyBaSums {
+    inner: BaAccumulator,
+}
+
+#[pymethods]
+impl PyBaSums {
+    /// Adds the residuals of an ``(N, 3)`` chunk (``N = 0`` allowed) after
+    /// the levels of ``state``; returns their statistics (the residuals of
+    /// the level before, for its report).
+    fn add(
+        &mut self,
+        py: Python<'_>,
+        state: &PyMbaState,
+        points: &Bound<'_, PyAny>,
+    ) -> PyResult<PyResidualSums> {
+        let p = state.centring.apply(chunk(points)?);
+        let inner = py
+            .detach(|| self.inner.add_residuals(&state.frame, &state.levels, &p))
+            .map_err(err)?;
+        Ok(PyResidualSums { inner })
+    }
+
+    /// An independent copy (tasks copy a broadcast value before changing it).
+    fn copy(&self) -> Self {
+        self.clone()
+    }
+
+    /// Adds the sums of other points (the same level).
+    fn merge(&mut self, other: &PyBaSums) -> PyResult<()> {
+        self.inner.merge(other.inner.clone()).map_err(err)
+    }
+
+    /// Points added.
+    #[getter]
+    fn points(&self) -> u64 {
+        self.inner.points()
+    }
+
+    /// Cells ``(m, n)`` of the level's lattice.
+    #[getter]
+    fn cells(&self) -> (usize, usize) {
+        self.inner.cells()
+    }
+
+    /// Bytes of one set of sums (2 values per control value).
+    #[getter]
+    fn nbytes(&self) -> usize {
+        self.inner.bytes()
+    }
+
+    /// The exact bytes (see ``from_bytes``).
+    fn to_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
+        PyBytes::new(py, &self.inner.to_bytes())
+    }
+
+    /// The sums whose ``to_bytes`` gave ``data``.
+    #[staticmethod]
+    fn from_bytes(data: &[u8]) -> PyResult<Self> {
+        Ok(Self {
+            inner: BaAccumulator::from_bytes(data).map_err(err)?,
+        })
+    }
+
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        reduce(py, "BaSums", &self.inner.to_bytes())
+    }
+
+    fn __repr__(&self) -> String {
+        let (m, n) = self.inner.cells();
+        format!("BaSums(cells=({m}, {n}), points={})", self.inner.points())
+    }
+}
+
+/// The MBA level loop on the client (``scanfit.mba``'s keywords ``levels``,
+/// ``base``, ``tolerance``, ``hjelle``): per level, ``state()`` is
+/// broadcast, the workers return ``BaSums`` of their points, merged and
+/// ``push``-ed; ``finish()`` gives the surface.
+///
+/// ``frame`` holds the sums of the centred points; ``domain=(x0, y0, x1,
+/// y1)`` (data units) replaces their bounding box in x and y by that
+/// rectangle (points outside it are clamped to its border).
+///
+/// Example::
+///
+///     >>> run = scanfit.sums.MbaLevels(frame, centring, levels=4)
+///     >>> while not run.done:
+///     ...     acc = run.accumulator(); acc.add(run.state(), pts); run.push(acc)
+///     >>> run.finish()["surface"]
+#[pyclass(name = "MbaLevels", module = "scanfit.sums")]
+pub struct PyMbaLevels {
+    run: Option<MbaLevels>,
+    centring: PyCentring,
+    formula: ControlFormula,
+}
+
+impl PyMbaLevels {
+    fn run(&self) -> PyResult<&MbaLevels> {
+        self.run
+            .as_ref()
+            .ok_or_else(|| value_err("this MbaLevels has finished; make a new one".into()))
+    }
+}
+
+#[pymethods]
+impl PyMbaLevels {
+    /// The loop over the data summed in ``frame`` (centred by ``centring``).
+    #[new]
+    #[pyo3(signature = (frame, centring, levels = 6, base = None, tolerance = None, hjelle = false, domain = None))]
+    fn new(
+        frame: &PyFrameSums,
+        centring: &PyCentring,
+        levels: usize,
+        base: Option<Bound<'_, PyAny>>,
+        tolerance: Option<f64>,
+        hjelle: bool,
+        domain: Option<(f64, f64, f64, f64)>,
+    ) -> PyResult<Self> {
+        if levels == 0 {
+            return Err(value_err("levels must be at least 1".into()));
+        }
+        let config = mba_config(levels, base.as_ref(), tolerance, hjelle)?;
+        let f = match domain {
+            None => frame.inner.finish().map_err(err)?,
+            Some((x0, y0, x1, y1)) => {
+                let c = centring.inner.centre();
+                if !([x0, y0, x1, y1].iter().all(|v| v.is_finite()) && x1 > x0 && y1 > y0) {
+                    return Err(value_err(format!(
+                        "domain ({x0}, {y0}, {x1}, {y1}) is not a rectangle (x0, y0, x1, y1) with x0 < x1 and y0 < y1"
+                    )));
+                }
+                let z0 = frame.inner.mean_z().ok_or_else(|| {
+                    value_err("the frame sums hold no point; no point was read".into())
+                })?;
+                Frame {
+                    x0: x0 - c.x,
+                    y0: y0 - c.y,
+                    width: x1 - x0,
+                    height: y1 - y0,
+                    z0,
+                }
+            }
+        };
+        Ok(Self {
+            run: Some(MbaLevels::new(f, &config).map_err(err)?),
+            centring: centring.clone(),
+            formula: config.formula,
+        })
+    }
+
+    /// Whether every level is done.
+    #[getter]
+    fn done(&self) -> PyResult<bool> {
+        Ok(self.run()?.done())
+    }
+
+    /// Cells ``(m, n)`` of the next level.
+    #[getter]
+    fn next_cells(&self) -> PyResult<(usize, usize)> {
+        Ok(self.run()?.next_cells())
+    }
+
+    /// What the workers need for the next level (frame, lattices so far,
+    /// centring).
+    fn state(&self) -> PyResult<PyMbaState> {
+        let run = self.run()?;
+        let (m, n) = run.next_cells();
+        Ok(PyMbaState {
+            centring: self.centring.clone(),
+            frame: run.frame(),
+            levels: run.levels().to_vec(),
+            next: (m, n, self.formula),
+        })
+    }
+
+    /// Empty BA sums of the next level.
+    fn accumulator(&self) -> PyResult<PyBaSums> {
+        Ok(PyBaSums {
+            inner: self.run()?.accumulator().map_err(err)?,
+        })
+    }
+
+    /// Finishes the next level from its merged sums.
+    fn push(&mut self, sums: &PyBaSums) -> PyResult<()> {
+        self.run
+            .as_mut()
+            .ok_or_else(|| value_err("this MbaLevels has finished; make a new one".into()))?
+            .push(sums.inner.clone())
+            .map_err(err)
+    }
+
+    /// Records the residual statistics after the last level pushed (what
+    /// the next level's ``BaSums.add`` calls returned, merged in point
+    /// order); returns whether they meet the tolerance (stop).
+    fn record_residual(&mut self, sums: &PyResidualSums) -> PyResult<bool> {
+        Ok(self
+            .run
+            .as_mut()
+            .ok_or_else(|| value_err("this MbaLevels has finished; make a new one".into()))?
+            .record_residual(sums.inner.stats()))
+    }
+
+    /// The approximation: a dict with ``surface`` (in data coordinates, as
+    /// ``scanfit.mba``'s), ``cells`` and ``levels`` (``level``,
+    /// ``control_points``, ``vertical`` statistics as recorded, ``seconds``).
+    fn finish<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let run = self
+            .run
+            .take()
+            .ok_or_else(|| value_err("this MbaLevels has finished; make a new one".into()))?;
+        let r = run.finish();
+        let surface = lattice_surface(&r.frame, &r.lattice).map_err(err)?;
+        let d = PyDict::new(py);
+        d.set_item(
+            "surface",
+            PySurface::new(self.centring.inner.restore(surface)),
+        )?;
+        d.set_item("cells", (r.lattice.m, r.lattice.n))?;
+        let rows = PyList::empty(py);
+        for l in &r.reports {
+            let e = PyDict::new(py);
+            e.set_item("level", l.level)?;
+            e.set_item("control_points", (l.cells.0 + 3, l.cells.1 + 3))?;
+            e.set_item("vertical", stats(py, &l.residual)?)?;
+            e.set_item("seconds", l.seconds)?;
+            rows.append(e)?;
+        }
+        d.set_item("levels", rows)?;
+        Ok(d)
+    }
+}
+
+/// The normal equations of the least-squares surface with uniform knots,
+/// configured by ``fit_surface``'s keywords for ``count`` points (the net
+/// from the density and the smoothing scaled to the data exactly as
+/// ``fit_surface`` resolves them); settings that need all points at once
+/// (``params="plane"``, ``knots="distribution"``, ``correct > 0``) are a
+/// ``ScanfitError`` saying why.
+///
+/// Example::
+///
+///     >>> eq = scanfit.sums.NormalEquations(len(pts), centring, ctrl=(8, 8), params="uv", knots="uniform")
+///     >>> eq.add(pts, uv); eq.finish()
+#[pyclass(name = "NormalEquations", module = "scanfit.sums")]
+#[derive(Clone)]
+pub struct PyNormalEquations {
+    inner: NormalEquations,
+    smoothing: f64,
+    centring: PyCentring,
+}
+
+const NORMAL_TAG: &[u8; 8] = b"SFPYNEQ1";
+
+impl PyNormalEquations {
+    fn encode(&self) -> Vec<u8> {
+        let mut w = Writer::new(NORMAL_TAG);
+        self.centring.write(&mut w);
+        w.f64(self.smoothing);
+        let inner = self.inner.to_bytes();
+        w.usize(inner.len());
+        let mut bytes = w.finish();
+        bytes.extend_from_slice(&inner);
+        bytes
+    }
+}
+
+#[pymethods]
+impl PyNormalEquations {
+    /// Empty equations (see the class documentation).
+    #[new]
+    #[pyo3(signature = (count, centring, ctrl = None, degree = None, params = "plane", knots = "distribution", smooth = None, periodic_u = false, correct = 0))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        count: usize,
+        centring: &PyCentring,
+        ctrl: Option<Bound<'_, PyAny>>,
+        degree: Option<Bound<'_, PyAny>>,
+        params: &str,
+        knots: &str,
+        smooth: Option<f64>,
+        periodic_u: bool,
+        correct: usize,
+    ) -> PyResult<Self> {
+        let cfg = fit_config(
+            ctrl.as_ref(),
+            degree.as_ref(),
+            params,
+            knots,
+            smooth,
+            periodic_u,
+            correct,
+        )?;
+        check_fit(&cfg).map_err(err)?;
+        let fit = cfg.resolved_fit(count);
+        Ok(Self {
+            inner: fit.uniform_equations().map_err(err)?,
+            smoothing: fit.smoothing,
+            centring: centring.clone(),
+        })
+    }
+
+    /// Adds an ``(N, 3)`` chunk (``N = 0`` allowed) with its ``(N, 2)``
+    /// parameters.
+    fn add(
+        &mut self,
+        py: Python<'_>,
+        points: &Bound<'_, PyAny>,
+        uv: &Bound<'_, PyAny>,
+    ) -> PyResult<()> {
+        let p = self.centring.apply(chunk(points)?);
+        if p.is_empty() {
+            return Ok(());
+        }
+        let (u, v) = uv_columns(uv, p.len())?;
+        let uv: Vec<[f64; 2]> = u.into_iter().zip(v).map(|(u, v)| [u, v]).collect();
+        py.detach(|| self.inner.add(&p, &uv, None)).map_err(err)
+    }
+
+    /// An independent copy (tasks copy a broadcast value before changing it).
+    fn copy(&self) -> Self {
+        self.clone()
+    }
+
+    /// Adds the equations of other points.
+    fn merge(&mut self, other: &PyNormalEquations) -> PyResult<()> {
+        self.inner.merge(other.inner.clone()).map_err(err)
+    }
+
+    /// Points added.
+    #[getter]
+    fn points(&self) -> u64 {
+        self.inner.points()
+    }
+
+    /// The thin-plate weight ``finish`` uses (as ``fit_surface`` resolves it).
+    #[getter]
+    fn smoothing(&self) -> f64 {
+        self.smoothing
+    }
+
+    /// Bytes of the equations (matrix band and right-hand sides).
+    #[getter]
+    fn nbytes(&self) -> usize {
+        self.inner.bytes()
+    }
+
+    /// Solves for the surface (in data coordinates).
+    fn finish(&self, py: Python<'_>) -> PyResult<PySurface> {
+        let eq = self.inner.clone();
+        let s = py.detach(|| eq.finish(self.smoothing)).map_err(err)?;
+        Ok(PySurface::new(self.centring.inner.restore(s)))
+    }
+
+    /// The exact bytes (see ``from_bytes``).
+    fn to_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
+        PyBytes::new(py, &self.encode())
+    }
+
+    /// The equations whose ``to_bytes`` gave ``data``.
+    #[staticmethod]
+    fn from_bytes(data: &[u8]) -> PyResult<Self> {
+        let mut r = Reader::new(data, NORMAL_TAG, "least-squares normal equations").map_err(err)?;
+        let centring = PyCentring::read(&mut r).map_err(err)?;
+        let smoothing = r.f64().map_err(err)?;
+        let len = r.usize().map_err(err)?;
+        let start = 8 + 6 * 8 + 8 + 8;
+        if data.len() != start + len {
+            return Err(err(r.corrupt(&format!("an inner record of {len} bytes"))));
+        }
+        Ok(Self {
+            inner: NormalEquations::from_bytes(&data[start..]).map_err(err)?,
+            smoothing,
+            centring,
+        })
+    }
+
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        reduce(py, "NormalEquations", &self.encode())
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "NormalEquations(points={}, smoothing={})",
+            self.inner.points(),
+            self.smoothing
+        )
+    }
+}
+
+/// The errors ``|p - S(u, v)|`` of an ``(N, 3)`` chunk at its ``(N, 2)``
+/// parameters on ``surface``, as mergeable statistics (``N = 0`` allowed).
+#[pyfunction]
+pub fn surface_errors(
+    py: Python<'_>,
+    surface: &PySurface,
+    points: &Bound<'_, PyAny>,
+    uv: &Bound<'_, PyAny>,
+) -> PyResult<PyResidualSums> {
+    let p = chunk(points)?;
+    let mut inner = ResidualSums::default();
+    if p.is_empty() {
+        return Ok(PyResidualSums { inner });
+    }
+    let (u, v) = uv_columns(uv, p.len())?;
+    let s = &surface.inner;
+    let ((u0, u1), (v0, v1)) = s.domain();
+    if let Some(i) =
+        (0..p.len()).find(|&i| !(u0..=u1).contains(&u[i]) || !(v0..=v1).contains(&v[i]))
+    {
+        return Err(value_err(format!(
+            "uv: row {i} is ({}, {}), outside the surface's domain [{u0}, {u1}] x [{v0}, {v1}]",
+            u[i], v[i]
+        )));
+    }
+    py.detach(|| {
+        for (k, q) in p.iter().enumerate() {
+            inner.push((q - s.point(u[k], v[k])).norm());
+        }
+    });
+    Ok(PyResidualSums { inner })
+}
+
+/// Adds the classes and functions of `scanfit.sums` to the native module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyCentring>()?;
+    m.add_class::<PyFrameSums>()?;
+    m.add_class::<PyResidualSums>()?;
+    m.add_class::<PyMbaState>()?;
+    m.add_class::<PyBaSums>()?;
+    m.add_class::<PyMbaLevels>()?;
+    m.add_class::<PyNormalEquations>()?;
+    m.add_function(wrap_pyfunction!(surface_errors, m)?)?;
+    Ok(())
+}
