@@ -316,7 +316,11 @@ pub fn run(a: CoonsArgs) -> Result<()> {
                     ("export_tolerance", "--export-tolerance"),
                     (
                         "corners",
-                        "--corners I,J,K,L with loop positions from `scanfit cloud boundary`, or --force-corners",
+                        "--corners I,J,K,L with loop positions from `scanfit cloud boundary`, or --force-corners; a rounded outline is better fitted by `scanfit fit` or `scanfit mba`, trimmed to it",
+                    ),
+                    (
+                        "alpha_factor",
+                        "--alpha-factor, about twice the value above, or --corners I,J,K,L with loop positions from `scanfit cloud boundary --alpha-factor F --png loop.png`; an outline that is not four-sided is better fitted by `scanfit fit` or `scanfit mba`, trimmed to it",
                     ),
                 ],
             );

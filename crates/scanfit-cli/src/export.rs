@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use scanfit::bspline::{Curve, Surface};
+use scanfit::trim::TrimmedSurface;
 use scanfit_io::iges::iges_file_with;
 use scanfit_io::json::{read_curve, read_surface};
 use scanfit_io::step::{step_file_with, CadItem};
@@ -19,7 +20,9 @@ const EXAMPLES: &str = "Examples:
 
 Each input is a curve or surface document written by scanfit (-o SURFACE.json);
 every surface becomes a face of one open shell in the STEP file (and an entity
-128 in the IGES file), every curve a B-spline curve (entity 126).";
+128 in the IGES file), every curve a B-spline curve (entity 126). A surface
+saved trimmed (its document has a `trim` section) stays trimmed: a face bounded
+by its loops in STEP, entity 144 with 142 in IGES.";
 
 /// Arguments of `scanfit export`.
 #[derive(Args, Debug)]
@@ -45,6 +48,18 @@ pub struct ExportArgs {
 enum Item {
     Curve(Curve),
     Surface(Surface),
+    /// A surface whose document carries trimming loops.
+    Trimmed(Box<TrimmedSurface>),
+}
+
+/// The surface of the document at `path`, trimmed when it says so.
+fn read_face(path: &Path) -> Result<Item> {
+    let (doc, surface) = read_surface(path)?;
+    Ok(match doc.trimmed(&surface) {
+        Ok(Some(t)) => Item::Trimmed(Box::new(t)),
+        Ok(None) => Item::Surface(surface),
+        Err(e) => bail!("{}: {e}", path.display()),
+    })
 }
 
 fn read_item(path: &Path) -> Result<Item> {
@@ -55,11 +70,8 @@ fn read_item(path: &Path) -> Result<Item> {
         .and_then(|v| v.get("type").and_then(|k| k.as_str()).map(String::from));
     match kind.as_deref() {
         Some("bspline_curve") => Ok(Item::Curve(read_curve(path)?.1)),
-        Some("bspline_surface") => Ok(Item::Surface(read_surface(path)?.1)),
-        _ => {
-            // let the surface reader say what is wrong with the document
-            Ok(Item::Surface(read_surface(path)?.1))
-        }
+        // otherwise let the surface reader say what is wrong with the document
+        _ => read_face(path),
     }
 }
 
@@ -86,6 +98,7 @@ pub fn run(a: ExportArgs) -> Result<()> {
         .map(|i| match i {
             Item::Curve(c) => CadItem::Curve(c),
             Item::Surface(s) => CadItem::Surface(s),
+            Item::Trimmed(t) => CadItem::Trimmed(t),
         })
         .collect();
     let name = a.name.clone().unwrap_or_else(|| {
@@ -108,12 +121,15 @@ pub fn run(a: ExportArgs) -> Result<()> {
         ));
     }
     write_all_atomic(&files)?;
-    let (nc, ns) = items.iter().fold((0, 0), |(c, s), i| match i {
-        Item::Curve(_) => (c + 1, s),
-        Item::Surface(_) => (c, s + 1),
-    });
+    let count = |f: fn(&Item) -> bool| items.iter().filter(|i| f(i)).count();
+    let nc = count(|i| matches!(i, Item::Curve(_)));
+    let ns = count(|i| !matches!(i, Item::Curve(_)));
+    let nt = count(|i| matches!(i, Item::Trimmed(_)));
     for (p, _) in &files {
-        outln!("wrote {} ({nc} curves, {ns} surfaces)", p.display());
+        outln!(
+            "wrote {} ({nc} curves, {ns} surfaces, {nt} of them trimmed)",
+            p.display()
+        );
     }
     Ok(())
 }

@@ -219,6 +219,10 @@ impl SurfaceOutputArgs {
     ) -> Result<(Files, f64)> {
         let mut files: Files = Vec::new();
         if let Some(o) = &self.output {
+            // the document carries the trimming loops, so `export` and
+            // `report` of the saved surface keep the trimmed face
+            let mut doc = doc.clone();
+            doc.set_trim(trimmed);
             files.push((o.clone(), doc.to_json()?.into_bytes()));
         }
         let item = trimmed.map_or(CadItem::Surface(surface), CadItem::Trimmed);

@@ -11,6 +11,7 @@ use scanfit::bspline::{tessellate, Surface};
 use scanfit::distribution::Histogram;
 use scanfit::metrics::nearest_points;
 use scanfit::pipeline::measure::{run as measure, MeasureConfig, MeasureReport};
+use scanfit::trim::TrimmedSurface;
 use scanfit::Point3;
 use scanfit_io::json::{read_surface, SurfaceDoc};
 use scanfit_io::render::{
@@ -104,11 +105,17 @@ struct Pictures {
 fn pictures(
     a: &ReportArgs,
     surface: &Surface,
+    trimmed: Option<&TrimmedSurface>,
     pts: &[Point3],
     r: &MeasureReport,
 ) -> Result<Pictures> {
     let (cu, cv) = surface.counts();
-    let mesh = tessellate(surface, (cu * 4).clamp(32, 300), (cv * 4).clamp(32, 300));
+    let (nu, nv) = ((cu * 4).clamp(32, 300), (cv * 4).clamp(32, 300));
+    // a face saved trimmed is shown trimmed
+    let mesh = match trimmed {
+        Some(t) => t.tessellate(nu, nv),
+        None => tessellate(surface, nu, nv),
+    };
     let near = nearest_points(pts, &mesh.vertices)?;
     let inv = &r.assessment.inversions;
     let local: Vec<f64> = near.iter().map(|&(i, _)| inv[i].distance).collect();
@@ -272,11 +279,14 @@ pub fn run(a: ReportArgs) -> Result<()> {
     let progress = Progress::spinner(a.quiet);
     progress.stage("reading");
     let (doc, surface) = read_surface(&a.surface)?;
+    let trimmed = doc
+        .trimmed(&surface)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", a.surface.display()))?;
     let table = a.input.table(false)?;
     let pts = &table.points;
     let r = measure(&surface, pts, &MeasureConfig::default(), &progress)?;
     progress.stage("rendering");
-    let pic = pictures(&a, &surface, pts, &r)?;
+    let pic = pictures(&a, &surface, trimmed.as_ref(), pts, &r)?;
     progress.finish();
     write_atomic(&out, page(&a, &doc, &surface, &r, &pic).as_bytes())?;
     let q = &r.assessment.quality;
@@ -290,6 +300,7 @@ pub fn run(a: ReportArgs) -> Result<()> {
             "unconverged": q.unconverged,
             "histogram": histogram_json(&r.histogram),
             "samples_to_points": crate::outputs::samples_json(q),
+            "trim": crate::cad::trim_json(trimmed.as_ref()),
             "report": out.display().to_string(),
         });
         out!("{}", scanfit_io::json::finite_json(&v, "the JSON report")?);
@@ -312,6 +323,7 @@ pub fn run(a: ReportArgs) -> Result<()> {
     }
     out!("{}", t.render());
     outln!("{}", samples_line(&r));
+    crate::cad::print_trim(trimmed.as_ref())?;
     if q.unconverged > 0 {
         outln!("note: {} point inversions did not converge", q.unconverged);
     }

@@ -269,3 +269,101 @@ fn units_are_declared_and_opencascade_reads_the_trimmed_face() {
     assert!((dx - 100_000.0).abs() < 500.0, "x extent {dx} mm");
     std::fs::remove_dir_all(&d).ok();
 }
+
+#[test]
+fn a_saved_trimmed_surface_stays_trimmed_through_export_and_report() {
+    let d = tmpdir("saved");
+    let input = d.join("panel.xyz");
+    holed_panel(&input);
+    let p = |f: &str| d.join(f).to_str().unwrap().to_string();
+    fn s(x: &str) -> &str {
+        x
+    }
+    let (json, stp, igs) = (p("panel.json"), p("direct.stp"), p("direct.igs"));
+    run(&[
+        "mba",
+        s(&p("panel.xyz")),
+        "-o",
+        s(&json),
+        "--step",
+        s(&stp),
+        "--iges",
+        s(&igs),
+        "-q",
+    ]);
+    // the document carries the loops: one hole, and its curves are full curve documents
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let holes = doc["trim"]["holes"].as_array().unwrap();
+    assert_eq!(holes.len(), 1);
+    assert_eq!(holes[0]["uv"]["type"], "bspline_curve");
+    assert_eq!(holes[0]["uv"]["periodic"], true);
+    // export of the saved surface writes byte for byte the files the fit wrote
+    let (e_stp, e_igs) = (p("export.stp"), p("export.igs"));
+    run(&[
+        "export",
+        s(&json),
+        "--step",
+        s(&e_stp),
+        "--iges",
+        s(&e_igs),
+        "--name",
+        "panel",
+    ]);
+    assert_eq!(std::fs::read(&stp).unwrap(), std::fs::read(&e_stp).unwrap());
+    assert_eq!(std::fs::read(&igs).unwrap(), std::fs::read(&e_igs).unwrap());
+    let iges = std::fs::read_to_string(&e_igs).unwrap();
+    let entity_144 = |t: &str| t.lines().any(|l| l.starts_with("     144 "));
+    assert!(entity_144(&iges), "no trimmed surface entity");
+    // the typed document reads back exactly: writing it again gives the same text
+    let (sdoc, surface) = scanfit_io::json::read_surface(Path::new(&json)).unwrap();
+    let t = sdoc.trimmed(&surface).unwrap().unwrap();
+    assert_eq!((t.outer.is_some(), t.holes.len()), (false, 1));
+    assert_eq!(
+        sdoc.to_json().unwrap(),
+        std::fs::read_to_string(&json).unwrap()
+    );
+    // report shows the trimmed face
+    let o = run(&[
+        "report",
+        s(&json),
+        s(&p("panel.xyz")),
+        "-o",
+        s(&p("r.html")),
+        "--json",
+        "-q",
+    ]);
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(r["trim"]["trimmed"], true);
+    assert_eq!(r["trim"]["holes"].as_array().unwrap().len(), 1);
+    // an older document without "trim" still reads, as the untrimmed rectangle
+    let mut old = doc.clone();
+    old.as_object_mut().unwrap().remove("trim");
+    let old_json = p("old.json");
+    std::fs::write(&old_json, serde_json::to_string(&old).unwrap()).unwrap();
+    run(&["export", s(&old_json), "--iges", s(&p("old.igs"))]);
+    assert!(!entity_144(&std::fs::read_to_string(p("old.igs")).unwrap()));
+    let o = run(&[
+        "report",
+        s(&old_json),
+        s(&p("panel.xyz")),
+        "-o",
+        s(&p("r2.html")),
+        "--json",
+        "-q",
+    ]);
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(r["trim"]["trimmed"], false);
+    // a damaged loop is named
+    let mut bad = doc.clone();
+    bad["trim"]["holes"][0]["uv"]["degree"] = 0.into();
+    let bad_json = p("bad.json");
+    std::fs::write(&bad_json, serde_json::to_string(&bad).unwrap()).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_scanfit"))
+        .args(["export", s(&bad_json), "--step", s(&p("bad.stp"))])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("trim hole 0 uv curve"), "{err}");
+}

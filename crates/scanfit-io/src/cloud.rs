@@ -36,7 +36,12 @@ pub fn parse_cloud(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<P
     let format = match options.format {
         Some(f) => f,
         None => match Format::from_path(path)? {
-            Some(Format::Text) => match Format::magic(bytes) {
+            // a text name on a file whose content says otherwise: by its
+            // magic, or an OBJ's first statement (`v`, `o`, ...), which no
+            // text point file starts with
+            Some(Format::Text) => match Format::magic(bytes)
+                .or_else(|| crate::obj::sniff(bytes).then_some(Format::Obj))
+            {
                 Some(f) => {
                     note = Some(format!(
                         "{}: the content is {} (by its first bytes), not text; read as {}",

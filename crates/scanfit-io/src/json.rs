@@ -19,7 +19,8 @@
 //! Surfaces (`"type": "bspline_surface"`) carry `degree_u`, `degree_v`,
 //! `periodic_u`, `periodic_v`, `knots_u`, `knots_v`, `count_u`, `count_v` and
 //! `control_points` row-major with `u` slow (`P_ij` at `i * count_v + j`), the
-//! same `weights`, `provenance`, and a `quality` section ([`SurfaceQualityDoc`]).
+//! same `weights`, `provenance`, and a `quality` section ([`SurfaceQualityDoc`]);
+//! a trimmed face also its trimming loops (`trim`, [`TrimDoc`]).
 //!
 //! A periodic curve lists all `n + p` control points (the last `p` repeat the
 //! first `p`) and its unclamped knots. Numbers are written in the shortest form
@@ -33,6 +34,7 @@ use scanfit::quality::CurveQuality;
 use scanfit::Point3;
 use serde::{Deserialize, Serialize};
 
+use crate::json_trim::TrimDoc;
 use crate::{Error, Result};
 
 /// Pretty JSON text of `value` (with a final newline), refusing any number
@@ -249,6 +251,14 @@ impl CurveDoc {
         finite_json(self, "the curve document")
     }
 
+    /// [`CurveDoc::curve`] after the degree check of [`parse_curve`] (a
+    /// degree no knot vector can carry is refused before anything is built),
+    /// the error as one line.
+    pub fn checked_curve(&self) -> std::result::Result<Curve, String> {
+        check_degree(self.degree, self.knots.len(), "degree", "knots")?;
+        self.curve().map_err(|e| e.to_string())
+    }
+
     /// The curve this document describes (validated).
     pub fn curve(&self) -> scanfit::Result<Curve> {
         let kv = KnotVector::new(self.knots.clone(), self.degree)?;
@@ -370,6 +380,10 @@ pub struct SurfaceDoc {
     /// Error and parameterization measures.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub quality: Option<SurfaceQualityDoc>,
+    /// The trimming loops of a trimmed face; absent (older documents,
+    /// untrimmed faces): the whole parameter rectangle.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub trim: Option<TrimDoc>,
 }
 
 impl SurfaceDoc {
@@ -397,7 +411,34 @@ impl SurfaceDoc {
             weights: surface.weights().map(|w| w.to_vec()),
             provenance: None,
             quality: None,
+            trim: None,
         }
+    }
+
+    /// Records the trimming loops of `trimmed` (none: the untrimmed
+    /// rectangle).
+    pub fn set_trim(&mut self, trimmed: Option<&scanfit::trim::TrimmedSurface>) {
+        self.trim = trimmed.map(TrimDoc::new);
+    }
+
+    /// The trimmed face of `surface` (this document's surface) when the
+    /// document has trimming loops.
+    ///
+    /// ```
+    /// use std::path::Path;
+    /// let text = r#"{"schema":"scanfit/1","type":"bspline_surface","degree_u":1,"degree_v":1,
+    ///   "periodic_u":false,"periodic_v":false,"knots_u":[0,0,1,1],"knots_v":[0,0,1,1],
+    ///   "count_u":2,"count_v":2,"control_points":[[0,0,0],[0,1,0],[1,0,0],[1,1,1]]}"#;
+    /// let (doc, surface) = scanfit_io::json::parse_surface(Path::new("s.json"), text)?;
+    /// // an older document (or an untrimmed face) has no trimming loops
+    /// assert!(doc.trimmed(&surface).unwrap().is_none());
+    /// # Ok::<(), scanfit_io::Error>(())
+    /// ```
+    pub fn trimmed(
+        &self,
+        surface: &Surface,
+    ) -> std::result::Result<Option<scanfit::trim::TrimmedSurface>, String> {
+        self.trim.as_ref().map(|t| t.trimmed(surface)).transpose()
     }
 
     /// Pretty JSON text; an error if a number is not finite ([`finite_json`]).
@@ -487,6 +528,8 @@ pub fn parse_surface(path: &Path, text: &str) -> Result<(SurfaceDoc, Surface)> {
         path: path.to_path_buf(),
         error,
     })?;
+    // the trimming loops are checked here, so readers can rely on them
+    doc.trimmed(&surface).map_err(invalid)?;
     Ok((doc, surface))
 }
 

@@ -17,6 +17,7 @@ pub mod fuzz;
 pub mod gltf;
 pub mod iges;
 pub mod json;
+pub mod json_trim;
 mod las;
 pub mod laz14;
 mod mesh;

@@ -115,6 +115,32 @@ fn bad_faces_are_a_warning_and_detection_is_by_content() {
         t.warnings[0].contains("the content is STL (by its first bytes)"),
         "{:?}",
         t.warnings
+    ); // every magic-detectable format named .xyz (or .csv, .txt) is read as what
+       // it is: a PLY, a binary STL, an OBJ (by its first statement)
+    let ply = b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 2 3\n".to_vec();
+    for (name, bytes, want, n) in [
+        ("p.xyz", &ply, Format::Ply, 2),
+        ("b.csv", &bin, Format::Stl, 4),
+        ("o.txt", &obj, Format::Obj, 4),
+    ] {
+        let t = parse_cloud(Path::new(name), bytes, &ReadOptions::default()).unwrap();
+        assert_eq!((t.format, t.points.len()), (want, n), "{name}");
+        assert!(
+            t.warnings[0].contains(&format!("the content is {}", want.name())),
+            "{:?}",
+            t.warnings
+        );
+    }
+    // a real text file stays text, with no warning
+    let t = parse_cloud(
+        Path::new("t.xyz"),
+        b"x y z\n0 0 0\n1 1 1\n",
+        &ReadOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(
+        (t.format, t.points.len(), t.warnings.len()),
+        (Format::Text, 2, 0)
     );
 }
 

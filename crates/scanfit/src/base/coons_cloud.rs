@@ -72,6 +72,11 @@ pub struct CoonsFromCloud {
     /// The strength of each corner: how far the outline turns there, `pi -`
     /// its angle (radians; `pi / 2` at a rectangle's corner).
     pub corner_strengths: Vec<f64>,
+    /// Whether each corner turns outward (convex, as a patch corner must):
+    /// the loop's signed area over the corner's neighbourhood (the
+    /// criterion's offset either side) is positive about the plane normal.
+    /// `false` marks a notch the outline bites inward.
+    pub corner_convex: Vec<bool>,
     /// Each side's share of the loop's length.
     pub side_shares: Vec<f64>,
     /// The points of each side, in loop order, corner to corner.
@@ -98,6 +103,16 @@ pub fn coons_from_cloud(points: &[Point3], cfg: &CoonsFromCloudConfig) -> Result
     }
     let boundary = boundary_loops(points, &cfg.boundary)?;
     let outer = boundary.outer_loop().to_vec();
+    if let Some((a, b)) = pinch(&outer) {
+        return Err(ragged(
+            &boundary,
+            format!(
+                "the outer boundary loop ({} points) touches itself at input point {} (loop positions {a} and {b}): two parts of the cloud meet at one point",
+                outer.len(),
+                outer[a]
+            ),
+        ));
+    }
     let loop_points: Vec<Point3> = outer.iter().map(|&i| points[i]).collect();
     let corners = match &cfg.corner_positions {
         Some(c) => {
@@ -138,8 +153,22 @@ pub fn coons_from_cloud(points: &[Point3], cfg: &CoonsFromCloudConfig) -> Result
     let corner_angles: Vec<f64> = corners.corners.iter().map(|&k| angles[k]).collect();
     let corner_strengths: Vec<f64> = corner_angles.iter().map(|a| PI - a).collect();
     let side_shares = side_shares(&loop_points, &corners.sides);
+    let normal = boundary.plane.normal;
+    let corner_convex: Vec<bool> = corners
+        .corners
+        .iter()
+        .map(|&k| turns_outward(&loop_points, k, corners.offset, &normal))
+        .collect();
     if cfg.corner_positions.is_none() && !cfg.force_corners {
-        check_corners(cfg, outer.len(), &corner_strengths, &side_shares)?;
+        let found = Found {
+            loop_len: outer.len(),
+            positions: &corners.corners,
+            strengths: &corner_strengths,
+            convex: &corner_convex,
+            shares: &side_shares,
+            alpha: (boundary.alpha, boundary.spacing),
+        };
+        check_corners(cfg, &found)?;
     }
     let side_points: Vec<Vec<Point3>> = corners
         .sides
@@ -155,6 +184,7 @@ pub fn coons_from_cloud(points: &[Point3], cfg: &CoonsFromCloudConfig) -> Result
         corners,
         corner_angles,
         corner_strengths,
+        corner_convex,
         side_shares,
         side_points,
         curves,
@@ -178,25 +208,98 @@ fn side_shares(loop_points: &[Point3], sides: &[Vec<usize>]) -> Vec<f64> {
         .collect()
 }
 
-/// Refuses detected corners that are not clearly corners: too flat (turning
-/// by less than `pi - max_corner_angle`) or crowded (one side longer than
-/// `max_side_share` of the loop).
-fn check_corners(
-    cfg: &CoonsFromCloudConfig,
+/// Whether the closed loop turns outward (counter-clockwise about
+/// `normal`) at position `k`: the signed area of the polygon
+/// `P[k-m] .. P[k+m]` (closed by the chord) is positive. A convex corner of
+/// a counter-clockwise outer loop turns outward; a notch turns inward.
+fn turns_outward(points: &[Point3], k: usize, m: usize, normal: &crate::Vector3) -> bool {
+    let n = points.len();
+    let m = m.clamp(1, (n.saturating_sub(1) / 2).max(1));
+    let at = |j: isize| points[(k as isize + j).rem_euclid(n as isize) as usize];
+    let apex = at(0);
+    let (first, last) = (at(-(m as isize)) - apex, at(m as isize) - apex);
+    let arc: f64 = (-(m as isize)..m as isize)
+        .map(|j| (at(j) - apex).cross(&(at(j + 1) - apex)).dot(normal))
+        .sum();
+    // the chord from P[k+m] back to P[k-m] closes the polygon
+    arc + last.cross(&first).dot(normal) > 0.0
+}
+
+/// The first pair of loop positions that hold the same input point (a
+/// pinch: the loop touches itself), if any.
+fn pinch(outer: &[usize]) -> Option<(usize, usize)> {
+    let mut seen = std::collections::HashMap::with_capacity(outer.len());
+    outer
+        .iter()
+        .enumerate()
+        .find_map(|(k, &i)| seen.insert(i, k).map(|first| (first, k)))
+}
+
+/// [`ragged_error`] for `boundary`.
+fn ragged(boundary: &Boundary, what: String) -> Error {
+    ragged_error((boundary.alpha, boundary.spacing), what)
+}
+
+/// The refusal of a ragged boundary (`what` it did), with alpha and the
+/// median spacing: notches or pinches are where sparse points' gaps exceed
+/// alpha, or a true outline that is not four-sided.
+fn ragged_error((alpha, spacing): (f64, f64), what: String) -> Error {
+    let factor = alpha / spacing.max(f64::MIN_POSITIVE);
+    Error::InvalidSetting {
+        setting: "alpha_factor",
+        value: format!("{factor:.2} (alpha {alpha:.4}, median spacing {spacing:.4})"),
+        hint: format!(
+            "{what}. Either the boundary is ragged (where the points thin out, their gaps are wider than the alpha radius and the loop runs into the cloud: give an alpha factor about twice as large) or the outline is not four-sided (give the corners' loop positions, or split the cloud into four-sided patches, a layout)"
+        ),
+    }
+}
+
+/// The detected corners [`check_corners`] judges.
+struct Found<'a> {
     loop_len: usize,
-    strengths: &[f64],
-    shares: &[f64],
-) -> Result<()> {
+    positions: &'a [usize],
+    strengths: &'a [f64],
+    convex: &'a [bool],
+    shares: &'a [f64],
+    /// The alpha radius and the median spacing of the boundary.
+    alpha: (f64, f64),
+}
+
+/// Refuses detected corners that are not clearly corners: notches (the
+/// outline turns inward there, which a patch corner cannot: the patch would
+/// fold), too flat (turning by less than `pi - max_corner_angle`) or crowded
+/// (one side longer than `max_side_share` of the loop).
+fn check_corners(cfg: &CoonsFromCloudConfig, f: &Found) -> Result<()> {
     let min_turn = PI - cfg.max_corner_angle;
-    let weak = strengths.iter().filter(|&&s| s < min_turn).count();
-    let longest = shares.iter().copied().fold(0.0, f64::max);
-    if weak == 0 && longest <= cfg.max_side_share {
+    let weak = f.strengths.iter().filter(|&&s| s < min_turn).count();
+    let longest = f.shares.iter().copied().fold(0.0, f64::max);
+    let notches: Vec<String> = f
+        .positions
+        .iter()
+        .zip(f.convex)
+        .filter(|(_, &c)| !c)
+        .map(|(p, _)| p.to_string())
+        .collect();
+    if notches.is_empty() && weak == 0 && longest <= cfg.max_side_share {
         return Ok(());
     }
-    let turns: Vec<String> = strengths
+    let turns: Vec<String> = f
+        .strengths
         .iter()
         .map(|s| format!("{:.0}", s.to_degrees()))
         .collect();
+    let count = f.strengths.len();
+    let loop_len = f.loop_len;
+    if !notches.is_empty() {
+        return Err(ragged_error(
+            f.alpha,
+            format!(
+                "the {count} strongest corners of the boundary ({loop_len} points, turning by {} degrees) include notches where the outline turns inward (loop positions {}), which no patch corner does",
+                turns.join(", "),
+                notches.join(", "),
+            ),
+        ));
+    }
     let why = if weak > 0 {
         format!(
             "{weak} of them turn by less than {:.0} degrees",
@@ -214,8 +317,7 @@ fn check_corners(
         setting: "corners",
         value: format!("turning angles {} degrees", turns.join(", ")),
         hint: format!(
-            "the {} strongest corners of the boundary ({loop_len} points) are not clearly corners: {why}. The outline looks rounded, and a patch on these corners would fold; give the corners' loop positions, or split the cloud into four-sided patches (a layout), or force the detected corners",
-            strengths.len()
+            "the {count} strongest corners of the boundary ({loop_len} points) are not clearly corners: {why}. The outline looks rounded, and a patch on these corners would fold; give the corners' loop positions, or split the cloud into four-sided patches (a layout), or force the detected corners"
         ),
     })
 }
@@ -280,5 +382,43 @@ mod tests {
             m.contains("not clearly corners") && m.contains("turn by less than 30 degrees"),
             "{m}"
         );
+    }
+
+    #[test]
+    fn a_notch_in_the_outline_is_no_corner() {
+        // the panel with a deep V bitten into its long lower side: the notch
+        // tip turns sharply (inward) and would be picked as a corner
+        let pts: Vec<Point3> = panel(30)
+            .into_iter()
+            .filter(|p| p.y > 0.9 - 4.0 * (p.x - 1.0).abs())
+            .collect();
+        let e = coons_from_cloud(&pts, &CoonsFromCloudConfig::default()).unwrap_err();
+        let m = e.to_string();
+        assert!(
+            m.starts_with("alpha_factor = 2.50")
+                && m.contains("notches where the outline turns inward"),
+            "{m}"
+        );
+        // forced, the picks are reported, the notch tip among them and not convex
+        let forced = CoonsFromCloudConfig {
+            force_corners: true,
+            ..Default::default()
+        };
+        let r = coons_from_cloud(&pts, &forced).unwrap();
+        let loop_pts: Vec<Point3> = r.boundary.outer_loop().iter().map(|&i| pts[i]).collect();
+        let tip = r
+            .corners
+            .corners
+            .iter()
+            .position(|&k| (loop_pts[k].x - 1.0).abs() < 0.1 && loop_pts[k].y > 0.6)
+            .expect("the notch tip is a pick");
+        assert!(!r.corner_convex[tip], "{:?}", r.corner_convex);
+        assert_eq!(r.corner_convex.iter().filter(|c| !**c).count(), 1);
+    }
+
+    #[test]
+    fn a_rectangle_s_corners_all_turn_outward() {
+        let r = coons_from_cloud(&panel(30), &CoonsFromCloudConfig::default()).unwrap();
+        assert_eq!(r.corner_convex, vec![true; 4]);
     }
 }

@@ -711,10 +711,16 @@ pub fn clean(
     if let Some(o) = config.outliers {
         progress.stage("outliers", None);
         let r = statistical_outliers(&current, &o)?;
-        let detail = format!(
+        let mut detail = format!(
             "mean distance to {} neighbours > {:.6} (mean {:.6} + {} x std {:.6})",
             o.k, r.threshold, r.mean, o.n_sigma, r.std
         );
+        if o.local_ratio > 0.0 {
+            detail += &format!(
+                " and > {} x their kept neighbours' ({} sparse points beyond the first bound kept)",
+                o.local_ratio, r.kept_local
+            );
+        }
         apply("outliers", r.keep, detail, &mut current)?;
     }
     if let Some(f) = config.fragments {
