@@ -97,6 +97,8 @@ pub fn mba_config(
         } else {
             ControlFormula::LeeWolbergShin
         },
+        // the mean: the only start the distributed level loop keeps exact
+        start: scanfit::mba::Start::Mean,
     };
     Ok(c)
 }
