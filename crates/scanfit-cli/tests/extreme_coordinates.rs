@@ -62,6 +62,13 @@ fn write_shifted(sample: &str, offset: f64, back: bool, out: &Path) -> f64 {
 
 /// Every `control_points` triple in a document, in order.
 fn control_points(v: &Value, out: &mut Vec<[f64; 3]>) {
+    collect_control_points(v, out, &mut Vec::new());
+}
+
+/// Every control point below `v`, model space into `space` and the trim
+/// loops' parameter-space curves (`uv`, which do not move with the data)
+/// into `uv`.
+fn collect_control_points(v: &Value, space: &mut Vec<[f64; 3]>, uv: &mut Vec<[f64; 3]>) {
     match v {
         Value::Object(m) => {
             for (k, x) in m {
@@ -69,16 +76,18 @@ fn control_points(v: &Value, out: &mut Vec<[f64; 3]>) {
                     if let Value::Array(rows) = x {
                         for r in rows {
                             if let Some(a) = r.as_array().filter(|a| a.len() == 3) {
-                                out.push([0, 1, 2].map(|j| a[j].as_f64().unwrap()));
+                                space.push([0, 1, 2].map(|j| a[j].as_f64().unwrap()));
                             }
                         }
                     }
+                } else if k == "uv" {
+                    collect_control_points(x, uv, &mut Vec::new());
                 } else {
-                    control_points(x, out);
+                    collect_control_points(x, space, uv);
                 }
             }
         }
-        Value::Array(a) => a.iter().for_each(|x| control_points(x, out)),
+        Value::Array(a) => a.iter().for_each(|x| collect_control_points(x, space, uv)),
         _ => {}
     }
 }
@@ -167,8 +176,19 @@ fn same_far_away(name: &str, sample: &str, args: &[&str]) {
         let (near_rep, near_doc) = run(args, &near_in, &d.join("near.json"));
         let (far_rep, far_doc) = run(args, &far_in, &d.join("far.json"));
         let (mut a, mut b) = (Vec::new(), Vec::new());
-        control_points(&near_doc, &mut a);
-        control_points(&far_doc, &mut b);
+        let (mut a_uv, mut b_uv) = (Vec::new(), Vec::new());
+        collect_control_points(&near_doc, &mut a, &mut a_uv);
+        collect_control_points(&far_doc, &mut b, &mut b_uv);
+        assert_eq!(a_uv.len(), b_uv.len(), "{name} at {offset:e}: trim curves");
+        let worst_uv = a_uv
+            .iter()
+            .zip(&b_uv)
+            .flat_map(|(p, q)| (0..3).map(move |k| (q[k] - p[k]).abs()))
+            .fold(0.0, f64::max);
+        assert!(
+            worst_uv <= 1e-9,
+            "{name} at {offset:e}: trim curves in (u, v) differ by {worst_uv:e}"
+        );
         assert!(
             !a.is_empty() && a.len() == b.len(),
             "{name} at {offset:e}: {} vs {} control points",

@@ -412,9 +412,13 @@ fn trim_curve(
 /// between the fitted samples, or until it has a control point per 4 samples
 /// of a dense sampling. Returns it and its measured deviation.
 fn space_curve(s: &Surface, uv: &Curve, start: usize, tol: f64) -> Result<(Curve, f64)> {
+    // evaluated and solved about the first control point, so that data far
+    // from the origin keep their digits (issue 14 item 6)
+    let o = s.control_points()[0];
+    let centred = s.translated(-o.coords);
     let image = |t: f64| {
         let q = uv.point(t);
-        s.point(q.x, q.y)
+        centred.point(q.x, q.y)
     };
     let mut count = start;
     loop {
@@ -431,17 +435,25 @@ fn space_curve(s: &Surface, uv: &Curve, start: usize, tol: f64) -> Result<(Curve
             &LeastSquaresOptions::default(),
             true,
         )?;
-        let mut ctrl: Vec<Point3> = x.chunks(3).map(|c| Point3::new(c[0], c[1], c[2])).collect();
-        for j in 0..3 {
-            ctrl.push(ctrl[j]);
-        }
-        let c = Curve::new_periodic(kv, ctrl, None)?;
+        let net = |shift: &Point3| -> Vec<Point3> {
+            let mut ctrl: Vec<Point3> = x
+                .chunks(3)
+                .map(|c| Point3::new(c[0] + shift.x, c[1] + shift.y, c[2] + shift.z))
+                .collect();
+            for j in 0..3 {
+                ctrl.push(ctrl[j]);
+            }
+            ctrl
+        };
+        // the deviation is measured about the centre too (far from the
+        // origin, the rounding of the coordinates would hide the fit's error)
+        let centred_curve = Curve::new_periodic(kv.clone(), net(&Point3::origin()), None)?;
         let dev = (0..m)
             .flat_map(|k| [t[k], 0.5 * (t[k] + t[k + 1])])
-            .map(|x| (c.point(x) - image(x)).norm())
+            .map(|x| (centred_curve.point(x) - image(x)).norm())
             .fold(0.0, f64::max);
         if dev <= tol || count * 2 > 4096 {
-            return Ok((c, dev));
+            return Ok((Curve::new_periodic(kv, net(&o), None)?, dev));
         }
         count *= 2;
     }

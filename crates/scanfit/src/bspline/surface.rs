@@ -34,6 +34,15 @@ pub enum Direction {
 }
 
 impl Surface {
+    /// The same surface moved by `by` (every control point; weights, knots
+    /// and periodicity kept): used to evaluate far from the origin about a
+    /// nearby centre without losing digits.
+    pub(crate) fn translated(&self, by: nalgebra::Vector3<f64>) -> Self {
+        let mut s = self.clone();
+        s.ctrl.iter_mut().for_each(|p| *p += by);
+        s
+    }
+
     /// A non-rational surface.
     pub fn new(knots_u: KnotVector, knots_v: KnotVector, ctrl: Vec<Point3>) -> Result<Self> {
         Self::with_options(knots_u, knots_v, ctrl, None, false, false)
