@@ -60,11 +60,6 @@ fn write_shifted(sample: &str, offset: f64, back: bool, out: &Path) -> f64 {
     (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt()
 }
 
-/// Every `control_points` triple in a document, in order.
-fn control_points(v: &Value, out: &mut Vec<[f64; 3]>) {
-    collect_control_points(v, out, &mut Vec::new());
-}
-
 /// Every control point below `v`, model space into `space` and the trim
 /// loops' parameter-space curves (`uv`, which do not move with the data)
 /// into `uv`.
