@@ -129,10 +129,9 @@ impl PointCloud {
         Ok(rows(tree, queries, &order, kq, k))
     }
 
-    /// The `k` nearest *other* points of every point of the cloud (the point
-    /// itself excluded), in parallel: the neighbour graph that normals,
-    /// spacing statistics and orientation use.
-    pub fn knn_graph(&self, k: usize) -> Result<Neighbourhoods> {
+    /// The neighbour count of a graph: `k` checked, and at most the number
+    /// of other points.
+    fn graph_k(&self, k: usize) -> Result<usize> {
         if self.points.len() < 2 {
             return Err(Error::TooFewPoints {
                 got: self.points.len(),
@@ -140,7 +139,14 @@ impl PointCloud {
                 what: "a neighbour graph".into(),
             });
         }
-        let k = checked_k(k)?.get().min(self.points.len() - 1);
+        Ok(checked_k(k)?.get().min(self.points.len() - 1))
+    }
+
+    /// The `k` nearest *other* points of every point of the cloud (the point
+    /// itself excluded), in parallel: the neighbour graph that normals,
+    /// spacing statistics and orientation use.
+    pub fn knn_graph(&self, k: usize) -> Result<Neighbourhoods> {
+        let k = self.graph_k(k)?;
         let (indices, distances) = self.tree()?.graph_rows(k);
         Ok(Neighbourhoods {
             k,
@@ -162,14 +168,7 @@ impl PointCloud {
     /// # Ok::<(), scanfit::Error>(())
     /// ```
     pub fn knn_graph_indices(&self, k: usize) -> Result<Neighbourhoods> {
-        if self.points.len() < 2 {
-            return Err(Error::TooFewPoints {
-                got: self.points.len(),
-                needed: 2,
-                what: "a neighbour graph".into(),
-            });
-        }
-        let k = checked_k(k)?.get().min(self.points.len() - 1);
+        let k = self.graph_k(k)?;
         Ok(Neighbourhoods {
             k,
             indices: self.tree()?.graph_indices(k),
