@@ -12,6 +12,7 @@ use scanfit::mba::{ControlFormula, Start};
 use scanfit::pipeline::mba::{run as mba, LevelRow, MbaReport, MbaRunConfig};
 use scanfit::project::{DirectedConfig, WeightFactor};
 use scanfit_io::json::SurfaceDoc;
+use scanfit_io::render::Up;
 use scanfit_io::write_all_atomic;
 
 use crate::args::{choice, option_note, InputArgs, NXM};
@@ -35,7 +36,9 @@ points at the knots onto the data along z (directed projection, weight factor
 MBA paper, sections 2.2-2.4), never accepting a step that raises the eq. 17 RMSE;
 with --tolerance, the next level runs only while that RMSE is above it.
 The table's vertical error is |z - f(x, y)| at the data points; eq. 17 is the RMSE
-of the distances from the grid points at the knots to their nearest data point.";
+of the distances from the grid points at the knots to their nearest data point.
+Height is the up axis (--up, default auto: the thin axis of a sheet, else z):
+a y-up scan is fitted as y = f(x, -z), never as a wall of spikes over x, y.";
 
 /// `--weight`: the weight factor of the directed projection.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -246,6 +249,8 @@ pub fn run(a: MbaArgs) -> Result<()> {
     let progress = Progress::spinner(a.quiet || a.json);
     progress.stage(format!("reading {}", a.input.input.display()));
     let cloud = a.outliers.apply(a.input.load(a.json)?, a.json)?;
+    let up = a.out.view.up(cloud.points());
+    let (residual_name, parameters) = height_names(up);
     note_lattice(&a, cloud.points());
     let input = &a.input.input;
     let options = [
@@ -255,7 +260,9 @@ pub fn run(a: MbaArgs) -> Result<()> {
         ("alpha", "--alpha"),
         ("start", "--start"),
     ];
-    let r = mba(&cloud, &a.config(), &progress)
+    let mut config = a.config();
+    config.up = up;
+    let r = mba(&cloud, &config, &progress)
         .map_err(|e| anyhow::anyhow!("{}: {e}{}", input.display(), option_note(&e, &options)))?;
     let q = &r.assessment.quality;
     a.out.guard(
@@ -273,7 +280,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
     let mut doc = SurfaceDoc::new(&r.surface);
     doc.provenance = Some(provenance(
         operation,
-        Some("xy (u = x, v = y, scaled to [0, 1])".into()),
+        Some(parameters.into()),
         input,
         pts.len(),
         a.settings(r.levels.len(), r.cells),
@@ -282,7 +289,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
     let deviation = Deviation {
         per_point: &r.vertical,
         stats: q.at_parameters,
-        name: "vertical distance |z - f(x, y)|",
+        name: residual_name,
     };
     let (files, exaggeration) = a.out.files_with(
         &r.surface,
@@ -379,6 +386,25 @@ pub(crate) fn levels_table(levels: &[LevelRow], adjust: bool) -> String {
     t.render()
 }
 
+/// The height field's residual and parameters as the outputs name them,
+/// for the height axis `up` (`--up`).
+pub(crate) fn height_names(up: Up) -> (&'static str, &'static str) {
+    match up {
+        Up::Z => (
+            "vertical distance |z - f(x, y)|",
+            "xy (u = x, v = y, scaled to [0, 1])",
+        ),
+        Up::Y => (
+            "vertical distance |y - f(x, -z)|",
+            "x, -z (y up: u = x, v = -z, scaled to [0, 1])",
+        ),
+        Up::X => (
+            "vertical distance |x - f(y, z)|",
+            "yz (x up: u = y, v = z, scaled to [0, 1])",
+        ),
+    }
+}
+
 fn print_report(a: &MbaArgs, r: &MbaReport) -> Result<()> {
     let (m, n) = r.cells;
     outln!(
@@ -397,7 +423,7 @@ fn print_report(a: &MbaArgs, r: &MbaReport) -> Result<()> {
         "{}",
         crate::surface::quality_table(
             "final surface",
-            "vertical distance |z - f(x, y)|",
+            height_names(r.up).0,
             &r.assessment.quality,
             "grid points to nearest point (eq. 17)"
         )

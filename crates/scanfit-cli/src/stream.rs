@@ -159,7 +159,8 @@ pub fn mba(a: &MbaArgs, chunk: usize) -> Result<()> {
         ("max_levels", "--levels"),
         ("tolerance", "--tolerance"),
     ];
-    let r = match mba_streamed(&mut s, &config.mba, &config.assess, &progress) {
+    let up = a.out.view.up_given();
+    let r = match mba_streamed(&mut s, &config.mba, &config.assess, up, &progress) {
         Ok(r) => {
             finish_source(Ok(()), &mut s, &options)?;
             r
@@ -170,7 +171,7 @@ pub fn mba(a: &MbaArgs, chunk: usize) -> Result<()> {
     let mut doc = SurfaceDoc::new(&r.surface);
     doc.provenance = Some(provenance(
         "mba (multilevel B-spline approximation)",
-        Some("xy (u = x, v = y, scaled to [0, 1])".into()),
+        Some(crate::mba::height_names(r.up).1.into()),
         &a.input.input,
         q.points,
         a.settings(r.levels.len(), r.cells),
@@ -179,7 +180,7 @@ pub fn mba(a: &MbaArgs, chunk: usize) -> Result<()> {
     let deviation = Deviation {
         per_point: &[],
         stats: q.at_parameters,
-        name: "vertical distance |z - f(x, y)|",
+        name: crate::mba::height_names(r.up).0,
     };
     let (files, exaggeration) = a.out.files(
         &r.surface,
@@ -222,7 +223,7 @@ pub fn mba(a: &MbaArgs, chunk: usize) -> Result<()> {
         &files,
         exaggeration,
         &a.out,
-        "vertical distance |z - f(x, y)|",
+        crate::mba::height_names(r.up).0,
         &levels,
     )
 }

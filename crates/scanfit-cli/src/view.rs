@@ -92,11 +92,16 @@ impl ViewArgs {
 
     /// The up axis for pictures of `points`.
     pub fn up(&self, points: &[Point3]) -> Up {
+        self.up_given().unwrap_or_else(|| Up::automatic(points))
+    }
+
+    /// The up axis when `--up` names one (`None` for auto).
+    pub fn up_given(&self) -> Option<Up> {
         match self.up {
-            UpArg::Auto => Up::automatic(points),
-            UpArg::X => Up::X,
-            UpArg::Y => Up::Y,
-            UpArg::Z => Up::Z,
+            UpArg::Auto => None,
+            UpArg::X => Some(Up::X),
+            UpArg::Y => Some(Up::Y),
+            UpArg::Z => Some(Up::Z),
         }
     }
 

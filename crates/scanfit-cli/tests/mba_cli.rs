@@ -249,3 +249,44 @@ fn export_writes_several_patches_into_one_cad_file() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("bad.json"));
     assert!(!stp2.exists());
 }
+
+/// A y-up scan (terrain stored with height in y, as mesh and scanner
+/// software do) is fitted with y as height by default (`--up auto`), in
+/// memory and streamed, and matches the z-up fit; `--up z` forces the wall
+/// of spikes a height field over x, y gives, with errors many times larger.
+#[test]
+fn a_y_up_terrain_is_fitted_with_y_as_height() {
+    let d = tmpdir("mba", "yup");
+    let input = examples().join("terrain_50k.xyz");
+    let table = scanfit_io::read_points(&input).unwrap();
+    let yup = d.join("terrain_yup.xyz");
+    let mut text = String::from("x y z\n");
+    for p in &table.points {
+        // UpAxis::Y.point_from_frame: (x, y, z) -> (x, z, -y)
+        text.push_str(&format!("{} {} {}\n", p.x, p.z, -p.y));
+    }
+    std::fs::write(&yup, text).unwrap();
+    let rmse = |file: &std::path::Path, extra: &[&str]| {
+        let mut args = vec![
+            "mba",
+            file.to_str().unwrap(),
+            "--levels",
+            "5",
+            "--json",
+            "--no-trim",
+        ];
+        args.extend_from_slice(extra);
+        let v: serde_json::Value = serde_json::from_str(&ok(&run(&args))).unwrap();
+        v["quality"]["rmse_distance"].as_f64().unwrap()
+    };
+    let flat = rmse(&input, &[]);
+    let auto = rmse(&yup, &[]);
+    assert!((auto - flat).abs() <= 1e-9 * flat, "{auto} vs {flat}");
+    let streamed = rmse(&yup, &["--chunk-points", "7000"]);
+    assert!(
+        (streamed - flat).abs() <= 1e-9 * flat,
+        "{streamed} vs {flat}"
+    );
+    let wall = rmse(&yup, &["--up", "z"]);
+    assert!(wall > 5.0 * flat, "--up z: {wall} vs {flat}");
+}

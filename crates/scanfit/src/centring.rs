@@ -176,9 +176,18 @@ translate_fields! {
     crate::pipeline::curve::CurveReport => [fit];
     crate::pipeline::coons::PdeOutcome => [fit];
     crate::pipeline::coons::CoonsReport => [base, coons_surface, pde, surface, assessment];
-    crate::pipeline::mba::MbaReport => [surface, frame, assessment];
     crate::pipeline::turntable::TurntableReport => [turntable, assessment];
     crate::pipeline::reconstruct::ReconstructReport => [network, faces, complex];
+}
+
+/// The surface and the assessment move by `by`; the MBA frame, which lies in
+/// the up axis's z-up frame, by `by` turned into that frame.
+impl Translate for crate::pipeline::mba::MbaReport {
+    fn translate(&mut self, by: &Vector3) {
+        self.surface.translate(by);
+        self.assessment.translate(by);
+        self.frame.translate(&self.up.to_frame(by));
+    }
 }
 
 /// The MBA frame's origin `(x0, y0, z0)` moves; its extents do not.

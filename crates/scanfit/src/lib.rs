@@ -65,6 +65,7 @@ pub mod surface;
 pub mod testdata;
 pub mod topology;
 pub mod trim;
+pub mod up_axis;
 pub mod wire;
 
 pub use cloud::PointCloud;

@@ -6,92 +6,13 @@
 //! vertical exaggeration stretches that axis, and the camera looks from an
 //! azimuth (around the up axis) and an elevation (above the plane across it).
 
-use scanfit::distribution::percentile;
 use scanfit::{Point3, Vector3};
 
 use super::RenderOptions;
 
-/// The world axis that points up in a picture.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Up {
-    /// x up: the picture's frame is (y, z, x).
-    X,
-    /// y up (most mesh and scanner software): the frame is (x, -z, y), so
-    /// the `front` view looks from +z with x to the right and y up.
-    Y,
-    /// z up (CAD, terrain): the frame is the world's.
-    #[default]
-    Z,
-}
-
-impl Up {
-    /// `v` in the picture's z-up frame (a rotation: exact, no mirroring).
-    pub fn to_frame(self, v: &Vector3) -> Vector3 {
-        match self {
-            Up::Z => *v,
-            Up::Y => Vector3::new(v.x, -v.z, v.y),
-            Up::X => Vector3::new(v.y, v.z, v.x),
-        }
-    }
-
-    /// The coordinate of `p` along this axis (its height in the picture).
-    pub fn height(self, p: &Point3) -> f64 {
-        match self {
-            Up::X => p.x,
-            Up::Y => p.y,
-            Up::Z => p.z,
-        }
-    }
-
-    /// The axis's name, `"x"`, `"y"` or `"z"`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Up::X => "x",
-            Up::Y => "y",
-            Up::Z => "z",
-        }
-    }
-
-    /// The up axis a picture of `points` should use when none is given: the
-    /// axis along which the data are thinnest when they are a sheet (that
-    /// extent under half the next smaller one; extents between the 1st and
-    /// 99th percentiles, so stray points do not count), else z. Terrain and
-    /// relief scans then show their relief whichever axis they were stored
-    /// with; bodies keep z.
-    ///
-    /// ```
-    /// use scanfit::Point3;
-    /// use scanfit_io::render::Up;
-    /// // a 10 x 10 sheet, 1 thick, lying across y
-    /// let sheet: Vec<Point3> = (0..400)
-    ///     .map(|i| Point3::new((i % 20) as f64 * 0.5, (i % 3) as f64 * 0.5, (i / 20) as f64 * 0.5))
-    ///     .collect();
-    /// assert_eq!(Up::automatic(&sheet), Up::Y);
-    /// ```
-    pub fn automatic(points: &[Point3]) -> Up {
-        if points.len() < 3 {
-            return Up::Z;
-        }
-        let extent = |f: fn(&Point3) -> f64| {
-            let v: Vec<f64> = points.iter().map(f).collect();
-            percentile(&v, 0.99).unwrap_or(0.0) - percentile(&v, 0.01).unwrap_or(0.0)
-        };
-        let mut e = [
-            (extent(|p| p.x), Up::X),
-            (extent(|p| p.y), Up::Y),
-            (extent(|p| p.z), Up::Z),
-        ];
-        if e.iter().any(|(x, _)| !x.is_finite()) {
-            return Up::Z;
-        }
-        e.sort_by(|a, b| a.0.total_cmp(&b.0));
-        if e[0].0 < 0.5 * e[1].0 {
-            e[0].1
-        } else {
-            Up::Z
-        }
-    }
-}
+/// The world axis that points up in a picture (the library's [`UpAxis`](scanfit::up_axis::UpAxis):
+/// pictures are composed in its z-up frame).
+pub use scanfit::up_axis::UpAxis as Up;
 
 /// Named camera directions, relative to the up axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -19,6 +19,7 @@ use crate::mba::{lattice_surface, mba, Frame, Lattice, MbaConfig};
 use crate::metrics::ErrorStats;
 use crate::pipeline::assess::{assess_cloud_eq17, AssessConfig, Assessment};
 use crate::progress::Progress;
+use crate::up_axis::UpAxis;
 use crate::{Error, PointCloud, Result};
 
 /// Settings of [`run`].
@@ -34,6 +35,12 @@ pub struct MbaRunConfig {
     pub adjust: Option<AdjustConfig>,
     /// The assessment of the final surface (default [`AssessConfig::default`]).
     pub assess: AssessConfig,
+    /// The axis that is height (default z): the surface is `h = f(a, b)` in
+    /// that axis's z-up frame ([`UpAxis::to_frame`]: y up fits `y = f(x, -z)`,
+    /// x up `x = f(y, z)`), turned back to world axes. A y-up scan fitted
+    /// with z as height is a wall of spikes; [`UpAxis::automatic`] finds the
+    /// thin axis of a sheet.
+    pub up: UpAxis,
 }
 
 /// The adjustment's effect at one level.
@@ -73,11 +80,15 @@ pub struct LevelRow {
 pub struct MbaReport {
     /// The final surface (clamped bicubic, x and y linear in u and v).
     pub surface: Surface,
-    /// The map between data and lattice coordinates.
+    /// The map between data and lattice coordinates, in the up axis's z-up
+    /// frame ([`MbaRunConfig::up`]; the world's when z is up).
     pub frame: Frame,
+    /// The axis that is height.
+    pub up: UpAxis,
     /// Cells `(m, n)` of the final lattice (control net `(m + 3) x (n + 3)`).
     pub cells: (usize, usize),
-    /// Parameters of the points (x, y scaled to the unit square).
+    /// Parameters of the points (x, y of the up frame scaled to the unit
+    /// square).
     pub uv: Vec<[f64; 2]>,
     /// `|z - f(x, y)|` per point.
     pub vertical: Vec<f64>,
@@ -124,7 +135,36 @@ pub fn run(
     // computed relative to the data's centre, moved back exactly (issue 14)
     let centring = Centring::of(cloud.points());
     let local = centring.cloud(cloud)?;
-    Ok(centring.restore(run_centred(&local, config, progress)?))
+    let up = config.up;
+    if up == UpAxis::Z {
+        return Ok(centring.restore(run_centred(&local, config, progress)?));
+    }
+    // the height field in the up axis's frame, turned back (a rotation:
+    // distances, parameters and statistics are unchanged)
+    let turned = PointCloud::new(
+        local
+            .points()
+            .iter()
+            .map(|p| up.point_to_frame(p))
+            .collect(),
+    )?;
+    let mut r = run_centred(&turned, config, progress)?;
+    let ctrl = r
+        .surface
+        .control_points()
+        .iter()
+        .map(|p| up.point_from_frame(p))
+        .collect();
+    r.surface = Surface::new(
+        r.surface.knots_u().clone(),
+        r.surface.knots_v().clone(),
+        ctrl,
+    )?;
+    for inv in &mut r.assessment.inversions {
+        inv.point = up.point_from_frame(&inv.point);
+    }
+    r.up = up;
+    Ok(centring.restore(r))
 }
 
 /// [`run`] on data whose centre is at the origin.
@@ -191,6 +231,7 @@ fn run_centred(
     Ok(MbaReport {
         surface,
         frame,
+        up: UpAxis::Z,
         cells: (result.lattice.m, result.lattice.n),
         uv,
         vertical,

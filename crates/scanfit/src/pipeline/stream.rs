@@ -40,6 +40,7 @@ use crate::pipeline::surface_fit::{FitConfig, ParameterSource};
 use crate::progress::Progress;
 use crate::project::SurfaceInverter;
 use crate::spatial::KdTree;
+use crate::up_axis::UpAxis;
 use crate::{Error, Point3, PointCloud, Result};
 
 /// A chunk of points: positions and, when the source was asked for them,
@@ -85,39 +86,73 @@ impl PointSource for SliceSource<'_> {
 }
 
 /// A pass for the bounding box: the data's [`Centring`] (the in-memory
-/// pipelines compute relative to it) and the point count.
-fn centring_pass(source: &mut dyn PointSource) -> Result<(Centring, usize)> {
+/// pipelines compute relative to it) and the point count; with `sample`,
+/// also an evenly spaced sample of at most [`UP_SAMPLE`] points (every
+/// `2^k`-th point, `k` the smallest that fits) for [`UpAxis::automatic`].
+fn centring_pass(
+    source: &mut dyn PointSource,
+    mut sample: Option<&mut Vec<Point3>>,
+) -> Result<(Centring, usize)> {
     let (mut lo, mut hi, mut n) = (None::<Point3>, None::<Point3>, 0usize);
+    let mut stride = 1usize;
     source.pass(&mut |c| {
         for p in c.points {
             lo = Some(lo.map_or(*p, |l| Point3::from(l.coords.inf(&p.coords))));
             hi = Some(hi.map_or(*p, |h| Point3::from(h.coords.sup(&p.coords))));
+            if let Some(s) = sample.as_deref_mut() {
+                if n % stride == 0 {
+                    if s.len() == UP_SAMPLE {
+                        // keep every other point: the sample stays every
+                        // `stride`-th point of the input
+                        let mut k = 0;
+                        s.retain(|_| {
+                            k += 1;
+                            k % 2 == 1
+                        });
+                        stride *= 2;
+                    }
+                    if n % stride == 0 {
+                        s.push(*p);
+                    }
+                }
+            }
+            n += 1;
         }
-        n += c.points.len();
         Ok(())
     })?;
     let corners: Vec<Point3> = lo.into_iter().chain(hi).collect();
     Ok((Centring::of(&corners), n))
 }
 
-/// `source` with every chunk moved by `-centre`.
+/// Most points of the sample the streamed MBA decides its automatic up axis
+/// from (the 1st and 99th percentiles of 2^16 evenly spaced points).
+pub const UP_SAMPLE: usize = 1 << 16;
+
+/// `source` with every chunk moved by `-centre` and turned into the z-up
+/// frame of `up`.
 struct Centred<'a> {
     source: &'a mut dyn PointSource,
     centring: Centring,
+    up: UpAxis,
 }
 
 impl PointSource for Centred<'_> {
     fn pass(&mut self, f: &mut dyn FnMut(Chunk<'_>) -> Result<()>) -> Result<()> {
-        let centring = self.centring;
+        let (centring, up) = (self.centring, self.up);
         self.source.pass(&mut |c| {
-            let moved;
-            let points = if centring.is_identity() {
-                c.points
-            } else {
-                moved = centring.points(c.points);
-                &moved
-            };
-            f(Chunk { points, uv: c.uv })
+            if centring.is_identity() && up == UpAxis::Z {
+                return f(c);
+            }
+            let centre = centring.centre();
+            let moved: Vec<Point3> = c
+                .points
+                .iter()
+                .map(|p| up.point_to_frame(&(p - centre)))
+                .collect();
+            f(Chunk {
+                points: &moved,
+                uv: c.uv,
+            })
         })
     }
 }
@@ -128,6 +163,9 @@ impl PointSource for Centred<'_> {
 pub struct StreamedMba {
     /// The final surface (as the in-memory pipeline's).
     pub surface: Surface,
+    /// The axis that was height (the given one, or the automatic one from
+    /// an evenly spaced sample of the first pass).
+    pub up: UpAxis,
     /// Cells `(m, n)` of the final lattice.
     pub cells: (usize, usize),
     /// One row per level: vertical residuals (streamed) and eq. 17 of the
@@ -144,7 +182,8 @@ pub struct StreamedMba {
 
 /// Multilevel B-spline approximation of the points of `source` by passes
 /// (see the module documentation); the surface equals
-/// [`crate::pipeline::mba::run`]'s. The projection adjustment needs the
+/// [`crate::pipeline::mba::run`]'s with the same up axis (`up`; `None`:
+/// [`UpAxis::automatic`] on an evenly spaced sample). The projection adjustment needs the
 /// whole cloud and is not offered here.
 ///
 /// ```
@@ -162,7 +201,7 @@ pub struct StreamedMba {
 ///     .collect();
 /// let config = MbaConfig { max_levels: 4, ..Default::default() };
 /// let mut source = SliceSource { points: &p, uv: None, chunk: 333 };
-/// let r = mba(&mut source, &config, &AssessConfig::default(), &NoProgress)?;
+/// let r = mba(&mut source, &config, &AssessConfig::default(), None, &NoProgress)?;
 /// let once = mba_in_memory(&p, &config)?;
 /// assert_eq!(r.surface, lattice_surface(&once.frame, &once.lattice)?);
 /// assert_eq!(r.passes, 7); // bounding box, frame, 4 levels, measures
@@ -172,12 +211,20 @@ pub fn mba(
     source: &mut dyn PointSource,
     config: &MbaConfig,
     assess: &AssessConfig,
+    up: Option<UpAxis>,
     progress: &dyn Progress,
 ) -> Result<StreamedMba> {
     let t0 = Instant::now();
     progress.stage("pass 1: the bounding box", None);
-    let (centring, _) = centring_pass(source)?;
-    let source = &mut Centred { source, centring };
+    let mut sample = Vec::new();
+    let (centring, _) = centring_pass(source, up.is_none().then_some(&mut sample))?;
+    let up = up.unwrap_or_else(|| UpAxis::automatic(&sample));
+    drop(sample);
+    let source = &mut Centred {
+        source,
+        centring,
+        up,
+    };
     let mut frame_sums = FrameSums::default();
     source.pass(&mut |c| frame_sums.add(c.points))?;
     let frame = frame_sums.finish()?;
@@ -261,8 +308,15 @@ pub fn mba(
             seconds: rep.seconds,
         })
         .collect();
+    let ctrl = surface
+        .control_points()
+        .iter()
+        .map(|p| up.point_from_frame(p))
+        .collect();
+    let surface = Surface::new(surface.knots_u().clone(), surface.knots_v().clone(), ctrl)?;
     Ok(StreamedMba {
         surface: centring.restore(surface),
+        up,
         cells: (result.lattice.m, result.lattice.n),
         levels,
         passes,
@@ -338,8 +392,12 @@ pub fn fit(
     progress: &dyn Progress,
 ) -> Result<StreamedFit> {
     check_fit(config)?;
-    let (centring, count) = centring_pass(source)?;
-    let source = &mut Centred { source, centring };
+    let (centring, count) = centring_pass(source, None)?;
+    let source = &mut Centred {
+        source,
+        centring,
+        up: UpAxis::Z,
+    };
     let fit_config = config.resolved_fit(count);
     let mut eq = fit_config.uniform_equations()?;
     let (cu, cv) = fit_config.ctrl;
@@ -587,7 +645,7 @@ mod tests {
                 uv: None,
                 chunk,
             };
-            let r = mba(&mut s, &cfg.mba, &cfg.assess, &NoProgress).unwrap();
+            let r = mba(&mut s, &cfg.mba, &cfg.assess, None, &NoProgress).unwrap();
             assert_eq!(r.surface, once.surface, "chunk {chunk}");
             assert_eq!(r.passes, 8);
             let (a, b) = (r.quality, once.assessment.quality);
@@ -606,6 +664,52 @@ mod tests {
                 assert_eq!(x.grid_rmse, y.grid_rmse);
             }
         }
+    }
+
+    #[test]
+    fn a_y_up_scan_is_the_z_up_fit_turned_in_memory_and_streamed() {
+        // the same terrain stored y-up (far from the origin): height is y
+        let zup = terrain(8_000);
+        let yup: Vec<Point3> = zup.iter().map(|p| UpAxis::Y.point_from_frame(p)).collect();
+        let mut cfg = mba_pipeline::MbaRunConfig::default();
+        cfg.mba.max_levels = 4;
+        let flat = mba_pipeline::run(&PointCloud::new(zup).unwrap(), &cfg, &NoProgress).unwrap();
+        assert_eq!(UpAxis::automatic(&yup), UpAxis::Y);
+        cfg.up = UpAxis::Y;
+        let cloud = PointCloud::new(yup.clone()).unwrap();
+        let turned = mba_pipeline::run(&cloud, &cfg, &NoProgress).unwrap();
+        // exactly the z-up surface turned (negation and permutation are exact)
+        let back: Vec<Point3> = flat
+            .surface
+            .control_points()
+            .iter()
+            .map(|p| UpAxis::Y.point_from_frame(p))
+            .collect();
+        assert_eq!(turned.surface.control_points(), &back[..]);
+        assert_eq!(turned.up, UpAxis::Y);
+        assert_eq!(
+            turned.assessment.quality.orthogonal.rmse,
+            flat.assessment.quality.orthogonal.rmse
+        );
+        // fitted with z as height, the same scan is a wall: far worse
+        cfg.up = UpAxis::Z;
+        let wall = mba_pipeline::run(&cloud, &cfg, &NoProgress).unwrap();
+        assert!(
+            wall.assessment.quality.orthogonal.rmse
+                > 10.0 * turned.assessment.quality.orthogonal.rmse,
+            "{} vs {}",
+            wall.assessment.quality.orthogonal.rmse,
+            turned.assessment.quality.orthogonal.rmse
+        );
+        // streamed, with the axis found from the first pass's sample
+        let mut s = SliceSource {
+            points: &yup,
+            uv: None,
+            chunk: 1500,
+        };
+        let r = mba(&mut s, &cfg.mba, &cfg.assess, None, &NoProgress).unwrap();
+        assert_eq!(r.up, UpAxis::Y);
+        assert_eq!(r.surface, turned.surface);
     }
 
     #[test]
