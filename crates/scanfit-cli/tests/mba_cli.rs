@@ -124,7 +124,11 @@ fn mba_bad_input_is_reported_without_output() {
     std::fs::write(&one, "1 2 3\n").unwrap();
     let input = examples().join("terrain_50k.xyz");
     let cases: Vec<(Vec<&str>, &str)> = vec![
-        (vec![line.to_str().unwrap()], "all points have the same x"),
+        // (with --up auto these points are a sheet across x, fitted as x = f(y, z))
+        (
+            vec![line.to_str().unwrap(), "--up", "z"],
+            "all points have the same x",
+        ),
         (vec![one.to_str().unwrap()], "1 points given"),
         (
             vec![input.to_str().unwrap(), "--base", "0x2"],
