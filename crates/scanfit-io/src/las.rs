@@ -22,7 +22,9 @@ use crate::table::{capacity, Format, Origin, PointTable, ReadOptions};
 use crate::{Error, Result};
 
 mod layered;
+mod pointwise;
 use layered::read_layered;
+use pointwise::read_pointwise;
 
 /// Points decoded per call into the crate (fewer for long records: see
 /// [`BATCH_BYTES`]).
@@ -42,6 +44,30 @@ fn u64_at(b: &[u8], at: usize) -> Option<u64> {
         .try_into()
         .ok()
         .map(u64::from_le_bytes)
+}
+
+/// The LASzip VLR's payload (empty when it is not all in `bytes`).
+fn vlr_bytes(bytes: &[u8], at: u64, len: u64) -> &[u8] {
+    usize::try_from(at)
+        .ok()
+        .and_then(|at| bytes.get(at..at.checked_add(usize::try_from(len).ok()?)?))
+        .unwrap_or(&[])
+}
+
+/// The header's (scale, offset) per axis.
+fn transforms(path: &Path, bytes: &[u8]) -> Result<[(f64, f64); 3]> {
+    let mut transform = [(0.0, 0.0); 3];
+    for (k, t) in transform.iter_mut().enumerate() {
+        let (Some(scale), Some(offset)) = (u64_at(bytes, 131 + 8 * k), u64_at(bytes, 155 + 8 * k))
+        else {
+            return Err(Error::Invalid {
+                path: path.to_path_buf(),
+                message: "the file ends inside the LAS header's scale factors and offsets; it is truncated".into(),
+            });
+        };
+        *t = (f64::from_bits(scale), f64::from_bits(offset));
+    }
+    Ok(transform)
 }
 
 /// What the raw header says, as far as the size checks need it.
@@ -191,10 +217,10 @@ fn precheck(path: &Path, bytes: &[u8]) -> Result<Raw> {
 /// Without them a few-kilobyte file can make the decoder allocate
 /// gigabytes (it sizes buffers from these fields before reading).
 ///
-/// Returns, for the layered compressor, what scanfit's own decoder needs
-/// ([`Layered`]); `None` for the pointwise compressor (formats 0-5, read
-/// through the `laz` crate).
-fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<Option<Layered>> {
+/// Returns which decoder reads the points: scanfit's own for the layered
+/// compressor ([`Layered`]) and for pointwise items of version 2
+/// ([`Pointwise`]), the `laz` crate for pointwise items of version 1.
+fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<Compressed> {
     let binary = |offset: u64, message: String| Error::Binary {
         path: path.to_path_buf(),
         offset,
@@ -254,7 +280,9 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<Option<Layered>> {
     let mut first_point = 0u64;
     let mut layers = 0u64;
     let mut layered_ok = true;
+    let mut version2 = false;
     for k in 0..usize::from(items) {
+        version2 |= u16_at(vlr, 38 + 6 * k) == Some(2);
         let (Some(ty), Some(size)) = (u16_at(vlr, 34 + 6 * k), u16_at(vlr, 36 + 6 * k)) else {
             return Err(binary(vlr_at, format!(
                 "the LASzip VLR declares {items} items, but its {vlr_len} bytes hold fewer; the file is damaged"
@@ -280,8 +308,10 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<Option<Layered>> {
     let start = raw.offset_to_points;
     // the chunk table: its offset is the first 8 bytes of the point data
     // (or, when that is not past them, the last 8 bytes of the file)
+    // (compressor 1 has no chunk table: its point data starts at once)
     let table = usize::try_from(start)
         .ok()
+        .filter(|_| compressor != 1)
         .and_then(|s| u64_at(bytes, s))
         .and_then(|o| {
             if (o as i64) > start as i64 {
@@ -335,7 +365,37 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<Option<Layered>> {
         });
     }
     if compressor != 3 {
-        return Ok(None);
+        if !version2 {
+            return Ok(Compressed::Crate);
+        }
+        // the chunk table's point and byte counts (its size was checked
+        // above; the crate's table reader runs on the checked bytes)
+        let table = if compressor == 2 {
+            let lazvlr = laz::LazVlr::from_buffer(vlr)
+                .map_err(|e| binary(vlr_at, format!("the LASzip VLR is damaged: {e}")))?;
+            quietly(|| {
+                let mut cursor = Cursor::new(bytes);
+                cursor.set_position(start);
+                laz::laszip::ChunkTable::read_from(&mut cursor, &lazvlr)
+                    .ok()
+                    .map(|t| {
+                        (0..t.len())
+                            .map(|k| (t[k].point_count, t[k].byte_count))
+                            .collect()
+                    })
+            })
+            .flatten()
+        } else {
+            None
+        };
+        return Ok(Compressed::Pointwise(Pointwise {
+            vlr_at,
+            vlr_len,
+            start,
+            count,
+            data_end,
+            table,
+        }));
     }
     if !layered_ok {
         return Err(binary(vlr_at, "the LASzip VLR uses the layered compressor with an item type it does not allow; the file is damaged".into()));
@@ -396,13 +456,37 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<Option<Layered>> {
         pos += head + sizes;
         chunk += 1;
     }
-    Ok(Some(Layered {
+    Ok(Compressed::Layered(Layered {
         vlr_at,
         vlr_len,
         count,
         data_end,
         table_counts,
     }))
+}
+
+/// Which decoder reads a compressed file's points ([`laz_check`]).
+enum Compressed {
+    /// pointwise items of version 1: the `laz` crate
+    Crate,
+    /// pointwise items of version 2: [`crate::laz14::PointwiseLaz`]
+    Pointwise(Pointwise),
+    /// the layered compressor: [`crate::laz14::LayeredLaz`]
+    Layered(Layered),
+}
+
+/// A pointwise LAZ file (point formats 0-5, items of version 2) as
+/// [`laz_check`] found it.
+struct Pointwise {
+    vlr_at: u64,
+    vlr_len: u64,
+    /// the point data's offset
+    start: u64,
+    count: u64,
+    /// where the chunks end: the chunk table, the first EVLR or the file's end
+    data_end: u64,
+    /// the chunk table as (points, bytes) per chunk (compressor 2)
+    table: Option<Vec<(u64, u64)>>,
 }
 
 /// A layered LAZ file (point formats 6-10) as [`laz_check`] found it.
@@ -553,19 +637,21 @@ fn read_with_crate(path: &Path, bytes: Vec<u8>, raw: &Raw) -> Result<Decoded> {
 /// Reads a LAS or LAZ file's bytes (`path` is for messages).
 pub(crate) fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<PointTable> {
     let raw = precheck(path, bytes)?;
-    let layered = if raw.compressed {
+    let compressed = if raw.compressed {
         laz_check(path, bytes, &raw)?
     } else {
-        None
+        Compressed::Crate
     };
-    let decoded = match layered {
-        // LAS 1.4 points: scanfit's own decoder (the laz crate's recursion
-        // on damaged GPS-time layers overflows the stack)
-        Some(layered) => read_layered(path, bytes, &raw, &layered)?,
+    let decoded = match compressed {
+        // LAZ with version-2 pointwise items or layered (LAS 1.4) points:
+        // scanfit's own decoders (the laz crate's GPS-time decoders recurse
+        // on damaged data until the stack overflows)
+        Compressed::Layered(layered) => read_layered(path, bytes, &raw, &layered)?,
+        Compressed::Pointwise(pw) => read_pointwise(path, bytes, &pw)?,
         // the crate is third-party code: a panic on a damaged file becomes
         // one error, without its message on stderr. Our own readers return
         // errors and never panic on file content.
-        None => quietly(|| read_with_crate(path, bytes.to_vec(), &raw)).ok_or_else(|| Error::Invalid {
+        Compressed::Crate => quietly(|| read_with_crate(path, bytes.to_vec(), &raw)).ok_or_else(|| Error::Invalid {
             path: path.to_path_buf(),
             message: "the LAS/LAZ decoder failed on this file (it is damaged, or uses a variant the las crate does not handle)".into(),
         })??,

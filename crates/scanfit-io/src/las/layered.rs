@@ -9,7 +9,7 @@ use std::path::Path;
 use rayon::prelude::*;
 use scanfit::Point3;
 
-use super::{column_names, u64_at, Decoded, Layered, Raw};
+use super::{column_names, transforms, vlr_bytes, Decoded, Layered, Raw};
 use crate::laz14::{LayeredLaz, Laz14Error, Point14};
 use crate::table::capacity;
 use crate::{Error, Result};
@@ -27,10 +27,7 @@ pub(super) fn read_layered(
         message: e.message,
     };
     let format = bytes.get(104).copied().unwrap_or(0) & 0x3f;
-    let vlr = usize::try_from(layered.vlr_at)
-        .ok()
-        .and_then(|at| bytes.get(at..at.checked_add(usize::try_from(layered.vlr_len).ok()?)?))
-        .unwrap_or(&[]);
+    let vlr = vlr_bytes(bytes, layered.vlr_at, layered.vlr_len);
     let file = LayeredLaz::new(
         bytes,
         vlr,
@@ -53,17 +50,7 @@ pub(super) fn read_layered(
             ),
         });
     }
-    let mut transform = [(0.0, 0.0); 3];
-    for (k, t) in transform.iter_mut().enumerate() {
-        let (Some(scale), Some(offset)) = (u64_at(bytes, 131 + 8 * k), u64_at(bytes, 155 + 8 * k))
-        else {
-            return Err(Error::Invalid {
-                path: path.to_path_buf(),
-                message: "the file ends inside the LAS header's scale factors and offsets; it is truncated".into(),
-            });
-        };
-        *t = (f64::from_bits(scale), f64::from_bits(offset));
-    }
+    let transform = transforms(path, bytes)?;
     let names = column_names(true, rgb, nir);
     let cap = capacity(layered.count, bytes.len()).min(1 << 24);
     let mut points = Vec::with_capacity(cap);
