@@ -145,34 +145,33 @@ fn reader_matches_the_las_crate(format: u8) {
 /// `laz` crate, whose version-1 GPS decoder does not recurse).
 #[test]
 fn version_1_items_are_read_through_the_laz_crate() {
-    use laz::{LasZipCompressor, LazItemRecordBuilder, LazVlrBuilder};
-    use std::io::{Seek, SeekFrom};
     let n = 1200;
     let raw = records(1, 0, n, 5);
-    let vlr = LazVlrBuilder::new(LazItemRecordBuilder::version_1_of::<laz::las::Point1>(0))
-        .with_fixed_chunk_size(500)
-        .build();
-    let mut payload = Vec::new();
-    vlr.write_to(&mut payload).unwrap();
-    let start = 227 + 54 + payload.len() as u64;
-    let mut h = laz10_gen::las12_header(0x81, 28, n as u64, start, 1);
-    let mut vh = vec![0u8; 54];
-    vh[2..16].copy_from_slice(b"laszip encoded");
-    vh[18..20].copy_from_slice(&22204u16.to_le_bytes());
-    vh[20..22].copy_from_slice(&(payload.len() as u16).to_le_bytes());
-    h.extend_from_slice(&vh);
-    h.extend_from_slice(&payload);
-    let mut cursor = Cursor::new(h);
-    cursor.seek(SeekFrom::End(0)).unwrap();
-    let mut c = LasZipCompressor::new(cursor, vlr).unwrap();
-    c.compress_many(&raw).unwrap();
-    c.done().unwrap();
-    let bytes = c.into_inner().into_inner();
+    let bytes = laz10_gen::compress_v1(n, 500);
     let table = parse_cloud(Path::new("f.laz"), &bytes, &ReadOptions::default()).unwrap();
     assert_eq!(table.points.len(), n);
     let gps = table.columns.iter().position(|c| c == "gps_time").unwrap() - 3;
     for (k, r) in raw.chunks_exact(28).enumerate() {
         let t = f64::from_le_bytes(r[20..28].try_into().unwrap());
         assert_eq!(table.extra[gps][k].to_bits(), t.to_bits(), "point {k}");
+    }
+}
+
+/// Writes small pointwise LAZ seeds for the laz fuzz target (formats 1 and
+/// 3 with GPS-time jumps and returns to earlier sequences, format 5 with
+/// wave packets and extra bytes) into `$SCANFIT_SEED_DIR`:
+/// `SCANFIT_SEED_DIR=fuzz/corpus/laz cargo test -p scanfit-io --test laz10 -- --ignored write_fuzz_seeds`
+#[test]
+#[ignore = "writes fuzz seeds; run by hand"]
+fn write_fuzz_seeds() {
+    let dir = std::path::PathBuf::from(std::env::var_os("SCANFIT_SEED_DIR").unwrap());
+    for (name, format, extra, n, chunk, seed) in [
+        ("pointwise1.laz", 1u8, 0usize, 40usize, 16u32, 3u64),
+        ("pointwise3.laz", 3, 0, 40, 16, 4),
+        ("pointwise5-extra.laz", 5, 2, 24, 12, 5),
+    ] {
+        let raw = records(format, extra, n, seed);
+        let f = compress(format, extra, Chunks::Fixed(chunk), &raw);
+        std::fs::write(dir.join(name), &f.bytes).unwrap();
     }
 }

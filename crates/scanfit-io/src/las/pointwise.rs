@@ -9,10 +9,16 @@ use std::path::Path;
 use rayon::prelude::*;
 use scanfit::Point3;
 
+use super::layered::binary;
 use super::{column_names, transforms, Decoded, Pointwise};
-use crate::laz14::{Laz14Error, PointwiseLaz, PointwiseRecord};
+use crate::laz14::{PointwiseLaz, PointwiseRecord};
 use crate::table::capacity;
 use crate::{Error, Result};
+
+/// The columns of a pointwise file's points (see [`column_names`]).
+pub(super) fn names(file: &PointwiseLaz) -> Vec<&'static str> {
+    column_names(file.has_gps_time(), file.has_rgb(), false)
+}
 
 /// The file's chunks, checked (see [`PointwiseLaz::new`]).
 pub(super) fn open(
@@ -30,14 +36,6 @@ pub(super) fn open(
         pw.table.as_deref(),
     )
     .map_err(|e| binary(path, e))
-}
-
-pub(super) fn binary(path: &Path, e: Laz14Error) -> Error {
-    Error::Binary {
-        path: path.to_path_buf(),
-        offset: e.offset,
-        message: e.message,
-    }
 }
 
 /// The extra columns of decoded points, appended to `columns` (in the
@@ -86,7 +84,7 @@ pub(super) fn read_pointwise(path: &Path, bytes: &[u8], pw: &Pointwise) -> Resul
         pw.vlr_at,
     )?;
     let transform = transforms(path, bytes)?;
-    let names = column_names(file.has_gps_time(), file.has_rgb(), false);
+    let names = names(&file);
     let cap = capacity(pw.count, bytes.len()).min(1 << 24);
     let mut points = Vec::with_capacity(cap);
     let mut columns = vec![Vec::with_capacity(cap); names.len()];

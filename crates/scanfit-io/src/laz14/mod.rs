@@ -42,7 +42,7 @@ mod point;
 mod point10;
 mod pointwise;
 
-pub use chunk::{ChunkSpan, LayeredLaz};
+pub use chunk::{ChunkSpan, LayeredLaz, ReadAt};
 pub use point10::Point10;
 pub use pointwise::{PointwiseLaz, PointwiseRecord};
 

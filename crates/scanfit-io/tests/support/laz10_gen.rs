@@ -297,3 +297,28 @@ pub fn ours(f: &Laz, n: u64) -> (Vec<PointwiseRecord>, usize) {
     }
     (out, file.chunks().len())
 }
+
+/// A LAS 1.2 LAZ file of `n` format-1 points with items of version 1
+/// (LASzip 1.x), in chunks of `chunk` points.
+pub fn compress_v1(n: usize, chunk: u32) -> Vec<u8> {
+    let raw = records(1, 0, n, 5);
+    let vlr = LazVlrBuilder::new(LazItemRecordBuilder::version_1_of::<Point1>(0))
+        .with_fixed_chunk_size(chunk)
+        .build();
+    let mut payload = Vec::new();
+    vlr.write_to(&mut payload).unwrap();
+    let start = 227 + 54 + payload.len() as u64;
+    let mut h = las12_header(0x81, 28, n as u64, start, 1);
+    let mut vh = vec![0u8; 54];
+    vh[2..16].copy_from_slice(b"laszip encoded");
+    vh[18..20].copy_from_slice(&22204u16.to_le_bytes());
+    vh[20..22].copy_from_slice(&(payload.len() as u16).to_le_bytes());
+    h.extend_from_slice(&vh);
+    h.extend_from_slice(&payload);
+    let mut cursor = Cursor::new(h);
+    cursor.seek(SeekFrom::End(0)).unwrap();
+    let mut c = LasZipCompressor::new(cursor, vlr).unwrap();
+    c.compress_many(&raw).unwrap();
+    c.done().unwrap();
+    c.into_inner().into_inner()
+}
