@@ -175,3 +175,47 @@ fn write_fuzz_seeds() {
         std::fs::write(dir.join(name), &f.bytes).unwrap();
     }
 }
+
+/// Writes the GPS-switch recursion input (see `laz10_gen::gps_switches`) to
+/// `$SCANFIT_SEED_DIR/gps-time-switches-pointwise.laz`.
+#[test]
+#[ignore = "writes a regression input; run by hand"]
+fn write_gps_switch_input() {
+    let dir = std::path::PathBuf::from(std::env::var_os("SCANFIT_SEED_DIR").unwrap());
+    std::fs::write(
+        dir.join("gps-time-switches-pointwise.laz"),
+        laz10_gen::gps_switches(1_000_000),
+    )
+    .unwrap();
+}
+
+/// Finding 5 of `docs/robustness.md`: a 429-byte format-1 file whose second
+/// point's GPS time is a million "switch sequence" symbols (written by
+/// `write_gps_switch_input`). The laz crate's version-2 GPS decoder
+/// recursed once per switch and overflowed the stack (SIGSEGV: exit 139,
+/// no message); the reader now refuses it with one error naming the chunk
+/// and the point, and the points before it decode as written.
+#[test]
+fn the_pointwise_gps_time_recursion_input_is_a_clear_error() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fuzz/regressions/laz/gps-time-switches-pointwise.laz");
+    let bytes = std::fs::read(path).unwrap();
+    assert_eq!(bytes, laz10_gen::gps_switches(1_000_000));
+    let e = parse_cloud(Path::new("f.laz"), &bytes, &ReadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("LAZ chunk 0 (points 0 to 1): point 1 cannot be decoded: its GPS time switches sequences more often than there are sequences"),
+        "{e}"
+    );
+    // four switches (one per sequence) are followed; the time is the
+    // first sequence's again, unchanged
+    let ok = parse_cloud(
+        Path::new("f.laz"),
+        &laz10_gen::gps_switches(4),
+        &ReadOptions::default(),
+    )
+    .unwrap();
+    let gps = ok.columns.iter().position(|c| c == "gps_time").unwrap() - 3;
+    assert_eq!(ok.extra[gps], [1.0e8, 1.0e8]);
+}

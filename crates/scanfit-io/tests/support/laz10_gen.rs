@@ -322,3 +322,62 @@ pub fn compress_v1(n: usize, chunk: u32) -> Vec<u8> {
     c.done().unwrap();
     c.into_inner().into_inner()
 }
+
+/// A two-point LAZ file of format 1 (compressor 1: one chunk, no chunk
+/// table) whose second point's GPS time is `switches` "switch to another
+/// sequence" symbols followed by "unchanged": the stream LASzip's version-2
+/// GPS decoder follows by recursion, one call per switch. Encoded with the
+/// `laz` crate's own arithmetic encoder and models, so the point-10 fields
+/// before it decode as written (nothing changed, X, Y and Z differences 0).
+pub fn gps_switches(switches: usize) -> Vec<u8> {
+    use laz::compressors::IntegerCompressor;
+    use laz::encoders::ArithmeticEncoder;
+    use laz::models::ArithmeticModelBuilder;
+    let mut enc = ArithmeticEncoder::new(Cursor::new(Vec::new()));
+    let model = |n: u32| ArithmeticModelBuilder::new(n).with_compression(true).build();
+    let ic = |bits, contexts| {
+        let mut c = IntegerCompressor::new(bits, contexts, 8, 0);
+        c.init();
+        c
+    };
+    let (mut dx, mut dy, mut dz) = (ic(32, 2), ic(32, 22), ic(32, 20));
+    // point 2: no field changed, then X, Y, Z (one return of one: n == 1)
+    enc.encode_symbol(&mut model(64), 0).unwrap();
+    dx.compress(&mut enc, 0, 0, 1).unwrap();
+    let k = dx.k();
+    dy.compress(&mut enc, 0, 0, 1 + if k < 20 { k & !1 } else { 20 })
+        .unwrap();
+    let k = (dx.k() + dy.k()) / 2;
+    dz.compress(&mut enc, 0, 0, 1 + if k < 18 { k & !1 } else { 18 })
+        .unwrap();
+    // GPS time: every sequence starts without a difference, so each switch
+    // lands on the six-symbol model again
+    let mut no_diff = model(6);
+    for _ in 0..switches {
+        enc.encode_symbol(&mut no_diff, 3).unwrap();
+    }
+    enc.encode_symbol(&mut no_diff, 0).unwrap();
+    enc.done().unwrap();
+    let stream = enc.into_inner().into_inner();
+    let vlr = LazVlrBuilder::new(LazItemRecordBuilder::version_2_of::<Point1>(0))
+        .with_fixed_chunk_size(u32::MAX - 1)
+        .build();
+    let mut payload = Vec::new();
+    vlr.write_to(&mut payload).unwrap();
+    payload[0] = 1; // compressor 1: pointwise, one chunk
+    let start = 227 + 54 + payload.len() as u64;
+    let mut f = las12_header(0x81, 28, 2, start, 1);
+    let mut vh = vec![0u8; 54];
+    vh[2..16].copy_from_slice(b"laszip encoded");
+    vh[18..20].copy_from_slice(&22204u16.to_le_bytes());
+    vh[20..22].copy_from_slice(&(payload.len() as u16).to_le_bytes());
+    f.extend_from_slice(&vh);
+    f.extend_from_slice(&payload);
+    // the first point raw: X = Y = Z = 0, return 1 of 1, GPS time 1e8
+    let mut first = [0u8; 28];
+    first[14] = 1 | (1 << 3);
+    first[20..28].copy_from_slice(&1.0e8f64.to_le_bytes());
+    f.extend_from_slice(&first);
+    f.extend_from_slice(&stream);
+    f
+}
