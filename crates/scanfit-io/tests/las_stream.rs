@@ -144,3 +144,42 @@ fn laz_of_item_version_1_streams_through_the_laz_crate() {
     std::fs::write(&path, laz10_gen::compress_v1(1200, 500)).unwrap();
     assert_eq!(same_streamed(&path, 700), [700, 500]);
 }
+
+/// `mba --chunk-points` on LAS and LAZ: the streamed surface (FileSource,
+/// chunks of 700 points, which split LAZ chunks of 1000) is the in-memory
+/// pipeline's, control point for control point (the PLY and text streaming
+/// tests' criterion).
+#[test]
+fn streamed_mba_on_las_and_laz_gives_the_in_memory_surface() {
+    use scanfit::pipeline::assess::AssessConfig;
+    use scanfit::pipeline::mba::{run, MbaRunConfig};
+    use scanfit::pipeline::stream::mba;
+    use scanfit::progress::NoProgress;
+    use scanfit_io::source::FileSource;
+    let n = 3000;
+    let raw = laz10_gen::records(0, 0, n, 21);
+    let mut las = laz10_gen::las12_header(0, 20, n as u64, 227, 0);
+    las.extend_from_slice(&raw);
+    let las_path = dir().join("mba.las");
+    std::fs::write(&las_path, &las).unwrap();
+    let laz_path = laz_file("mba.laz", 1, 0, laz10_gen::Chunks::Fixed(1000), n);
+    let mut config = MbaRunConfig::default();
+    config.mba.max_levels = 5;
+    for path in [las_path, laz_path] {
+        let cloud = read_cloud(&path, &ReadOptions::default())
+            .unwrap()
+            .into_cloud()
+            .unwrap();
+        let whole = run(&cloud, &config, &NoProgress).unwrap();
+        let mut source = FileSource::new(&path, ReadOptions::default(), 700, false);
+        let streamed = mba(
+            &mut source,
+            &config.mba,
+            &AssessConfig::default(),
+            &NoProgress,
+        )
+        .unwrap();
+        assert_eq!(streamed.surface, whole.surface, "{}", path.display());
+        assert_eq!(streamed.passes, 8);
+    }
+}

@@ -334,7 +334,11 @@ pub fn gps_switches(switches: usize) -> Vec<u8> {
     use laz::encoders::ArithmeticEncoder;
     use laz::models::ArithmeticModelBuilder;
     let mut enc = ArithmeticEncoder::new(Cursor::new(Vec::new()));
-    let model = |n: u32| ArithmeticModelBuilder::new(n).with_compression(true).build();
+    let model = |n: u32| {
+        ArithmeticModelBuilder::new(n)
+            .with_compression(true)
+            .build()
+    };
     let ic = |bits, contexts| {
         let mut c = IntegerCompressor::new(bits, contexts, 8, 0);
         c.init();
