@@ -309,6 +309,39 @@ impl TextSource {
     }
 }
 
+/// The next chunk of a reader of fixed records (PLY, LAS/LAZ) with the
+/// non-finite policy applied: a chunk whose points were all dropped is
+/// skipped; a file with no point left is an error.
+fn finished_chunks(
+    mut next: impl FnMut() -> Result<Option<PointTable>>,
+    policy: NonFinite,
+    path: &Path,
+    served: usize,
+    warnings: &mut Vec<String>,
+) -> Result<Option<PointTable>> {
+    loop {
+        let Some(t) = next()? else {
+            if served == 0 {
+                return Err(Error::Invalid {
+                    path: path.to_path_buf(),
+                    message: "no points left: every point has a non-finite coordinate".into(),
+                });
+            }
+            return Ok(None);
+        };
+        let all_bad = t
+            .points
+            .iter()
+            .all(|q| !q.coords.iter().all(|v| v.is_finite()));
+        if all_bad && policy == NonFinite::Drop {
+            continue;
+        }
+        let mut t = t.finish(policy)?;
+        warnings.append(&mut t.warnings);
+        return Ok(Some(t));
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -526,38 +559,5 @@ mod tests {
         assert_eq!(n, 2);
         std::fs::remove_dir_all(&dir)?;
         Ok(())
-    }
-}
-
-/// The next chunk of a reader of fixed records (PLY, LAS/LAZ) with the
-/// non-finite policy applied: a chunk whose points were all dropped is
-/// skipped; a file with no point left is an error.
-fn finished_chunks(
-    mut next: impl FnMut() -> Result<Option<PointTable>>,
-    policy: NonFinite,
-    path: &Path,
-    served: usize,
-    warnings: &mut Vec<String>,
-) -> Result<Option<PointTable>> {
-    loop {
-        let Some(t) = next()? else {
-            if served == 0 {
-                return Err(Error::Invalid {
-                    path: path.to_path_buf(),
-                    message: "no points left: every point has a non-finite coordinate".into(),
-                });
-            }
-            return Ok(None);
-        };
-        let all_bad = t
-            .points
-            .iter()
-            .all(|q| !q.coords.iter().all(|v| v.is_finite()));
-        if all_bad && policy == NonFinite::Drop {
-            continue;
-        }
-        let mut t = t.finish(policy)?;
-        warnings.append(&mut t.warnings);
-        return Ok(Some(t));
     }
 }

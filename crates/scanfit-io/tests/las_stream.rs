@@ -93,8 +93,7 @@ fn pointwise_laz_streams_one_laz_chunk_at_a_time() {
 
 #[test]
 fn layered_laz_streams_one_laz_chunk_at_a_time() {
-    #[path = "support/laz_gen.rs"]
-    mod laz_gen;
+    use laz10_gen::laz_gen;
     let raw = laz_gen::records(7, 3000, 12);
     let f = laz_gen::compress(7, false, laz_gen::Chunks::Fixed(1100), &raw);
     let path = dir().join("l7.laz");

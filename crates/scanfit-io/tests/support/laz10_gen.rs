@@ -12,7 +12,7 @@ use laz::{LasZipCompressor, LasZipDecompressor, LazItemRecordBuilder, LazVlr, La
 use scanfit_io::laz14::{Point10, PointwiseLaz, PointwiseRecord};
 
 #[path = "laz_gen.rs"]
-mod laz_gen;
+pub mod laz_gen;
 pub use laz_gen::{Chunks, Rng};
 
 /// Bytes of a record of `format` (0-5) with `extra` extra bytes.
