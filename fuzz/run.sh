@@ -13,6 +13,9 @@
 # input to fuzz/regressions/TARGET, where `cargo test -p scanfit-io --test
 # fuzz_corpus` replays it on stable. A summary line per target (executions,
 # coverage) is printed at the end and written to fuzz/work/summary.txt.
+# The laz target writes every input to $SCANFIT_FUZZ_LAST when it is set, so
+# an input that kills the process before libFuzzer can save it (a stack
+# overflow) is still on disk: SCANFIT_FUZZ_LAST=/tmp/last.laz fuzz/run.sh 300 laz
 set -euo pipefail
 cd "$(dirname "$0")"
 secs=${1:-300}

@@ -9,6 +9,12 @@ N points, seed 18 (numpy's PCG64); x, y uniform in [0, 1], z = Franke(x, y);
 with --uv two more properties u = x and v = y (for `scanfit fit --params
 uv-columns`). All properties are float64. The files are big (40 bytes per
 point with --uv): write them under /tmp, never commit them.
+
+    python3 benches/scale/make_franke.py N OUT.las
+
+writes the same points as a LAS 1.2 file of point format 0 (20-byte
+records, coordinates stored as integers at a scale of 1e-7, one return of
+one, class 2), for the LAS rows of "Peak memory of fit and mba".
 """
 import sys
 
@@ -30,6 +36,9 @@ def main():
     rng = np.random.default_rng(18)
     x = rng.random(n)
     y = rng.random(n)
+    if out.endswith(".las"):
+        write_las(out, x, y, franke(x, y))
+        return
     cols = [x, y, franke(x, y)] + ([x, y] if uv else [])
     names = ["x", "y", "z"] + (["u", "v"] if uv else [])
     header = "ply\nformat binary_little_endian 1.0\n"
@@ -42,6 +51,32 @@ def main():
         for s in range(0, n, step):
             block = np.stack([c[s:s + step] for c in cols], axis=1)
             f.write(block.astype("<f8").tobytes())
+
+
+def write_las(out, x, y, z):
+    """LAS 1.2, point format 0, scale 1e-7, offset 0."""
+    import struct
+    n, scale = len(x), 1e-7
+    h = bytearray(227)
+    h[0:4] = b"LASF"
+    h[24], h[25] = 1, 2
+    h[26:58] = b"scanfit make_franke.py".ljust(32, b"\0")
+    struct.pack_into("<HIIBHI", h, 94, 227, 227, 0, 0, 20, n)
+    struct.pack_into("<3d3d", h, 131, scale, scale, scale, 0.0, 0.0, 0.0)
+    struct.pack_into("<6d", h, 179, x.max(), x.min(), y.max(), y.min(), z.max(), z.min())
+    rec = np.dtype([("x", "<i4"), ("y", "<i4"), ("z", "<i4"), ("intensity", "<u2"),
+                    ("returns", "u1"), ("class", "u1"), ("angle", "i1"), ("user", "u1"),
+                    ("source", "<u2")])
+    with open(out, "wb") as f:
+        f.write(bytes(h))
+        step = 1_000_000
+        for s in range(0, n, step):
+            r = np.zeros(min(step, n - s), dtype=rec)
+            for name, c in (("x", x), ("y", y), ("z", z)):
+                r[name] = np.round(c[s:s + step] / scale).astype("<i4")
+            r["returns"] = 1 | (1 << 3)
+            r["class"] = 2
+            f.write(r.tobytes())
 
 
 if __name__ == "__main__":

@@ -6,14 +6,17 @@ make_franke.py.
 
     python3 benches/scale/make_franke.py 1000000 /tmp/franke_1000000.ply
     python3 benches/scale/make_franke.py 1000000 /tmp/franke_uv_1000000.ply --uv
-    python3 benches/scale/run.py target/release/scanfit 1000000 [--repeat 3] [--only fit|mba] [-- EXTRA...]
+    python3 benches/scale/make_franke.py 10000000 /tmp/franke_10000000.las
+    python3 benches/scale/run.py target/release/scanfit 1000000 [--repeat 3] [--only fit|mba|mba_las|mba_las_streamed] [-- EXTRA...]
 
 Each command runs `--repeat` times (default 3) under `/usr/bin/time -v`
 with SCANFIT_TIMINGS=1 (the CLI then prints each stage's wall time); the
 script prints, per command, the median wall time and CPU time, the stage
 split of the median run, the largest peak RSS and the bytes per point, and the load
 average before and after (the machine is shared). Arguments after `--` are
-added to every command (e.g. `--measure full`).
+added to every command (e.g. `--measure full`). When /tmp/franke_N.las
+exists, `mba` also runs on it in memory (`mba_las`) and streamed in chunks
+of 10^6 points (`mba_las_streamed`, `--chunk-points 1000000`).
 """
 import os
 import re
@@ -55,6 +58,12 @@ def main():
         "mba": [binary, "mba", f"/tmp/franke_{n}.ply", "--levels", "8", "--base", "1x1",
                 "-o", "/tmp/scale_mba.json", "--json", "-q"],
     }
+    las = f"/tmp/franke_{n}.las"
+    if os.path.exists(las):
+        mba_las = [binary, "mba", las, "--levels", "8", "--base", "1x1",
+                   "-o", "/tmp/scale_mba_las.json", "--json", "-q"]
+        commands["mba_las"] = mba_las
+        commands["mba_las_streamed"] = mba_las + ["--chunk-points", "1000000"]
     for name, cmd in commands.items():
         if only and name != only:
             continue

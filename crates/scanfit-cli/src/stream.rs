@@ -1,7 +1,8 @@
 //! `scanfit fit --chunk-points N` and `scanfit mba --chunk-points N`: the
 //! input read in chunks, in passes ([`scanfit_io::source::FileSource`]
 //! over [`scanfit::pipeline::stream`]). Memory depends on the model, not on
-//! the point count, for the formats [`reads_in_chunks`] names (text, PLY);
+//! the point count, for the formats [`reads_in_chunks`] names (text, PLY,
+//! LAS/LAZ);
 //! other formats are read whole, and a note says so. The reports are those
 //! of the in-memory commands (the same title, tables and JSON keys), plus
 //! what streaming measured.
@@ -45,7 +46,7 @@ fn source(input: &InputArgs, chunk: usize, uv: bool, quiet: bool) -> Result<File
     let options = input.options();
     if !quiet && !reads_in_chunks(&input.input, &options)? {
         crate::print_stderr(format_args!(
-            "note: {} is read whole (chunked reading covers text files .xyz .csv .txt .pts .asc PLY: ascii, and binary without list properties in the vertices); memory grows with its point count",
+            "note: {} is read whole (chunked reading covers text files .xyz .csv .txt .pts .asc, LAS/LAZ, and PLY: ascii, and binary without list properties in the vertices); memory grows with its point count",
             input.input.display()
         ));
     }

@@ -11,7 +11,8 @@
 //! fields, non-finite policy; errors name the file's line). PLY files
 //! (binary with fixed-size vertex records, or ascii) are read a chunk of
 //! vertex records at a time by the PLY reader's own decoding
-//! (`ply_chunks.rs`). Other formats (and other PLY layouts) are read whole
+//! (`ply_chunks.rs`), LAS and LAZ files a chunk of records or one LAZ chunk at
+//! a time (`las/stream.rs`). Other formats (and other PLY layouts) are read whole
 //! and served in chunks ([`PointChunks::bounded`] says which): their memory
 //! grows with the point count.
 
@@ -57,6 +58,7 @@ pub struct PointChunks {
 enum Source {
     Text(TextSource),
     Ply(crate::ply_read::chunks::PlyChunks, NonFinite),
+    Las(Box<crate::las::LasChunks>, NonFinite),
     Whole(Option<PointTable>),
 }
 
@@ -100,6 +102,11 @@ impl PointChunks {
                 Some(p) => Source::Ply(p, options.non_finite),
                 None => Source::Whole(Some(crate::read_cloud(path, options)?)),
             }
+        } else if format == Some(Format::Las) {
+            Source::Las(
+                Box::new(crate::las::LasChunks::open(path)?),
+                options.non_finite,
+            )
         } else {
             Source::Whole(Some(crate::read_cloud(path, options)?))
         };
@@ -116,7 +123,10 @@ impl PointChunks {
     /// in the layouts of [`crate::ply_read::chunks`]), rather than the whole
     /// file being read at once.
     pub fn bounded(&self) -> bool {
-        matches!(self.source, Source::Text(_) | Source::Ply(..))
+        matches!(
+            self.source,
+            Source::Text(_) | Source::Ply(..) | Source::Las(..)
+        )
     }
 
     /// Warnings of the reader, complete once the pass has ended.
@@ -128,29 +138,31 @@ impl PointChunks {
     pub fn next_chunk(&mut self) -> Result<Option<PointTable>> {
         let got = match &mut self.source {
             Source::Whole(table) => whole_chunk(table, self.chunk, &mut self.warnings),
-            Source::Ply(p, policy) => loop {
-                let Some(t) = p.next(self.chunk)? else {
-                    if self.points == 0 {
-                        return Err(Error::Invalid {
-                            path: self.path.clone(),
-                            message: "no points left: every point has a non-finite coordinate"
-                                .into(),
-                        });
-                    }
-                    break None;
-                };
-                // a chunk whose points were all dropped is skipped
-                let all_bad = t
-                    .points
-                    .iter()
-                    .all(|q| !q.coords.iter().all(|v| v.is_finite()));
-                if all_bad && *policy == NonFinite::Drop {
-                    continue;
+            Source::Ply(p, policy) => {
+                let policy = *policy;
+                finished_chunks(
+                    || p.next(self.chunk),
+                    policy,
+                    &self.path,
+                    self.points,
+                    &mut self.warnings,
+                )?
+            }
+            Source::Las(l, policy) => {
+                let policy = *policy;
+                let chunk = self.chunk;
+                let got = finished_chunks(
+                    || l.next(chunk),
+                    policy,
+                    &self.path,
+                    self.points,
+                    &mut self.warnings,
+                )?;
+                if got.is_none() {
+                    self.warnings.extend_from_slice(l.warnings());
                 }
-                let mut t = t.finish(*policy)?;
-                self.warnings.append(&mut t.warnings);
-                break Some(t);
-            },
+                got
+            }
             Source::Text(t) => {
                 let got = t.next(&self.path, self.chunk)?;
                 if got.is_none() {
@@ -294,6 +306,39 @@ impl TextSource {
         self.parser.block(text, self.lines, &mut self.ready)?;
         self.lines += split_lines(text).count();
         Ok(())
+    }
+}
+
+/// The next chunk of a reader of fixed records (PLY, LAS/LAZ) with the
+/// non-finite policy applied: a chunk whose points were all dropped is
+/// skipped; a file with no point left is an error.
+fn finished_chunks(
+    mut next: impl FnMut() -> Result<Option<PointTable>>,
+    policy: NonFinite,
+    path: &Path,
+    served: usize,
+    warnings: &mut Vec<String>,
+) -> Result<Option<PointTable>> {
+    loop {
+        let Some(t) = next()? else {
+            if served == 0 {
+                return Err(Error::Invalid {
+                    path: path.to_path_buf(),
+                    message: "no points left: every point has a non-finite coordinate".into(),
+                });
+            }
+            return Ok(None);
+        };
+        let all_bad = t
+            .points
+            .iter()
+            .all(|q| !q.coords.iter().all(|v| v.is_finite()));
+        if all_bad && policy == NonFinite::Drop {
+            continue;
+        }
+        let mut t = t.finish(policy)?;
+        warnings.append(&mut t.warnings);
+        return Ok(Some(t));
     }
 }
 

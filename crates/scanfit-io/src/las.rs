@@ -22,7 +22,13 @@ use crate::table::{capacity, Format, Origin, PointTable, ReadOptions};
 use crate::{Error, Result};
 
 mod layered;
+mod pointwise;
+mod stream;
+mod view;
 use layered::read_layered;
+use pointwise::read_pointwise;
+pub(crate) use stream::LasChunks;
+use view::{u16_at, u32_at, u64_at, u8_at, View, ViewReader};
 
 /// Points decoded per call into the crate (fewer for long records: see
 /// [`BATCH_BYTES`]).
@@ -31,17 +37,28 @@ const BATCH: u64 = 1 << 18;
 /// Most bytes of decoded records per call into the crate.
 const BATCH_BYTES: u64 = 16 << 20;
 
-fn u16_at(b: &[u8], at: usize) -> Option<u16> {
-    b.get(at..at + 2)?.try_into().ok().map(u16::from_le_bytes)
-}
-fn u32_at(b: &[u8], at: usize) -> Option<u32> {
-    b.get(at..at + 4)?.try_into().ok().map(u32::from_le_bytes)
-}
-fn u64_at(b: &[u8], at: usize) -> Option<u64> {
-    b.get(at..at.checked_add(8)?)?
-        .try_into()
+/// The LASzip VLR's payload (empty when it is not all in `bytes`).
+fn vlr_bytes(bytes: &[u8], at: u64, len: u64) -> &[u8] {
+    usize::try_from(at)
         .ok()
-        .map(u64::from_le_bytes)
+        .and_then(|at| bytes.get(at..at.checked_add(usize::try_from(len).ok()?)?))
+        .unwrap_or(&[])
+}
+
+/// The header's (scale, offset) per axis.
+fn transforms(path: &Path, bytes: &(impl View + ?Sized)) -> Result<[(f64, f64); 3]> {
+    let mut transform = [(0.0, 0.0); 3];
+    for (k, t) in transform.iter_mut().enumerate() {
+        let (Some(scale), Some(offset)) = (u64_at(bytes, 131 + 8 * k), u64_at(bytes, 155 + 8 * k))
+        else {
+            return Err(Error::Invalid {
+                path: path.to_path_buf(),
+                message: "the file ends inside the LAS header's scale factors and offsets; it is truncated".into(),
+            });
+        };
+        *t = (f64::from_bits(scale), f64::from_bits(offset));
+    }
+    Ok(transform)
 }
 
 /// What the raw header says, as far as the size checks need it.
@@ -73,7 +90,7 @@ fn layered_item(item_type: u16, size: u16) -> Option<(u64, u64)> {
 /// it, mirroring what the crate reads: the EVLR fields whenever the version
 /// is 1.4 (whatever the header size says), the first EVLR's 64-bit length,
 /// the point count against the bytes, and the scale factors.
-fn precheck(path: &Path, bytes: &[u8]) -> Result<Raw> {
+fn precheck(path: &Path, bytes: &(impl View + ?Sized)) -> Result<Raw> {
     let invalid = |message: String| Error::Invalid {
         path: path.to_path_buf(),
         message,
@@ -83,12 +100,12 @@ fn precheck(path: &Path, bytes: &[u8]) -> Result<Raw> {
         offset,
         message,
     };
-    if !bytes.starts_with(b"LASF") {
+    if bytes.read(0, 4).as_deref() != Some(b"LASF") {
         return Err(invalid(
             "not a LAS/LAZ file: it does not start with 'LASF' (bad magic)".into(),
         ));
     }
-    let len = bytes.len() as u64;
+    let len = bytes.size();
     let (
         Some(major),
         Some(minor),
@@ -98,11 +115,11 @@ fn precheck(path: &Path, bytes: &[u8]) -> Result<Raw> {
         Some(record_len),
         Some(legacy_count),
     ) = (
-        bytes.get(24).copied(),
-        bytes.get(25).copied(),
+        u8_at(bytes, 24),
+        u8_at(bytes, 25),
         u16_at(bytes, 94),
         u32_at(bytes, 96),
-        bytes.get(104).copied(),
+        u8_at(bytes, 104),
         u16_at(bytes, 105),
         u32_at(bytes, 107),
     )
@@ -191,21 +208,21 @@ fn precheck(path: &Path, bytes: &[u8]) -> Result<Raw> {
 /// Without them a few-kilobyte file can make the decoder allocate
 /// gigabytes (it sizes buffers from these fields before reading).
 ///
-/// Returns, for the layered compressor, what scanfit's own decoder needs
-/// ([`Layered`]); `None` for the pointwise compressor (formats 0-5, read
-/// through the `laz` crate).
-fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<Option<Layered>> {
+/// Returns which decoder reads the points: scanfit's own for the layered
+/// compressor ([`Layered`]) and for pointwise items of version 2
+/// ([`Pointwise`]), the `laz` crate for pointwise items of version 1.
+fn laz_check(path: &Path, bytes: &(impl View + ?Sized), raw: &Raw) -> Result<Compressed> {
     let binary = |offset: u64, message: String| Error::Binary {
         path: path.to_path_buf(),
         offset,
         message,
     };
-    let len = bytes.len() as u64;
+    let len = bytes.size();
     let header_size = u64::from(u16_at(bytes, 94).unwrap_or(0));
     let vlrs = u32_at(bytes, 100).unwrap_or(0);
     let count = {
         let legacy = u64::from(u32_at(bytes, 107).unwrap_or(0));
-        match (bytes.get(24..26), u64_at(bytes, 247)) {
+        match (bytes.read(24, 2).as_deref(), u64_at(bytes, 247)) {
             (Some([1, 4]), Some(large)) if legacy == 0 => large,
             _ => legacy,
         }
@@ -218,7 +235,7 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<Option<Layered>> {
             break;
         };
         let (Some(user), Some(record), Some(length)) = (
-            bytes.get(start + 2..start + 18),
+            bytes.read(start as u64 + 2, 16),
             u16_at(bytes, start + 18),
             u16_at(bytes, start + 20),
         ) else {
@@ -239,14 +256,12 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<Option<Layered>> {
             "the point format is compressed (LAZ), but none of the {vlrs} VLRs that follow the {header_size}-byte header is the LASzip VLR; the file is damaged"
         )));
     };
-    let Some(vlr) = usize::try_from(vlr_at)
-        .ok()
-        .and_then(|v| bytes.get(v..v.checked_add(vlr_len as usize)?))
-    else {
+    let Some(vlr_payload) = bytes.read(vlr_at, vlr_len as usize) else {
         return Err(binary(vlr_at, format!(
             "the LASzip VLR declares {vlr_len} bytes, but the file ends before them; it is truncated"
         )));
     };
+    let vlr: &[u8] = &vlr_payload;
     let compressor = u16_at(vlr, 0).unwrap_or(0);
     let chunk_size = u32_at(vlr, 12).unwrap_or(0);
     let items = u16_at(vlr, 32).unwrap_or(0);
@@ -254,7 +269,9 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<Option<Layered>> {
     let mut first_point = 0u64;
     let mut layers = 0u64;
     let mut layered_ok = true;
+    let mut version2 = false;
     for k in 0..usize::from(items) {
+        version2 |= u16_at(vlr, 38 + 6 * k) == Some(2);
         let (Some(ty), Some(size)) = (u16_at(vlr, 34 + 6 * k), u16_at(vlr, 36 + 6 * k)) else {
             return Err(binary(vlr_at, format!(
                 "the LASzip VLR declares {items} items, but its {vlr_len} bytes hold fewer; the file is damaged"
@@ -280,15 +297,16 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<Option<Layered>> {
     let start = raw.offset_to_points;
     // the chunk table: its offset is the first 8 bytes of the point data
     // (or, when that is not past them, the last 8 bytes of the file)
+    // (compressor 1 has no chunk table: its point data starts at once)
     let table = usize::try_from(start)
         .ok()
+        .filter(|_| compressor != 1)
         .and_then(|s| u64_at(bytes, s))
         .and_then(|o| {
             if (o as i64) > start as i64 {
                 Some(o)
             } else {
-                bytes
-                    .len()
+                (bytes.size() as usize)
                     .checked_sub(8)
                     .and_then(|k| u64_at(bytes, k))
                     .filter(|&o| (o as i64) > start as i64)
@@ -335,7 +353,39 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<Option<Layered>> {
         });
     }
     if compressor != 3 {
-        return Ok(None);
+        if !version2 {
+            return Ok(Compressed::Crate);
+        }
+        // the chunk table's point and byte counts (its size was checked
+        // above; the crate's table reader runs on the checked bytes)
+        let table = if compressor == 2 {
+            let lazvlr = laz::LazVlr::from_buffer(vlr)
+                .map_err(|e| binary(vlr_at, format!("the LASzip VLR is damaged: {e}")))?;
+            quietly(|| {
+                let mut cursor = std::io::BufReader::new(ViewReader {
+                    view: bytes,
+                    pos: start,
+                });
+                laz::laszip::ChunkTable::read_from(&mut cursor, &lazvlr)
+                    .ok()
+                    .map(|t| {
+                        (0..t.len())
+                            .map(|k| (t[k].point_count, t[k].byte_count))
+                            .collect()
+                    })
+            })
+            .flatten()
+        } else {
+            None
+        };
+        return Ok(Compressed::Pointwise(Pointwise {
+            vlr_at,
+            vlr_len,
+            start,
+            count,
+            data_end,
+            table,
+        }));
     }
     if !layered_ok {
         return Err(binary(vlr_at, "the LASzip VLR uses the layered compressor with an item type it does not allow; the file is damaged".into()));
@@ -344,8 +394,10 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<Option<Layered>> {
     let table_counts: Option<Vec<u64>> = if chunk_size == u32::MAX {
         let lazvlr = laz::LazVlr::from_buffer(vlr)
             .map_err(|e| binary(vlr_at, format!("the LASzip VLR is damaged: {e}")))?;
-        let mut cursor = Cursor::new(bytes);
-        cursor.set_position(start);
+        let mut cursor = std::io::BufReader::new(ViewReader {
+            view: bytes,
+            pos: start,
+        });
         laz::laszip::ChunkTable::read_from(&mut cursor, &lazvlr)
             .ok()
             .map(|t| (0..t.len()).map(|k| t[k].point_count).collect())
@@ -396,13 +448,37 @@ fn laz_check(path: &Path, bytes: &[u8], raw: &Raw) -> Result<Option<Layered>> {
         pos += head + sizes;
         chunk += 1;
     }
-    Ok(Some(Layered {
+    Ok(Compressed::Layered(Layered {
         vlr_at,
         vlr_len,
         count,
         data_end,
         table_counts,
     }))
+}
+
+/// Which decoder reads a compressed file's points ([`laz_check`]).
+enum Compressed {
+    /// pointwise items of version 1: the `laz` crate
+    Crate,
+    /// pointwise items of version 2: [`crate::laz14::PointwiseLaz`]
+    Pointwise(Pointwise),
+    /// the layered compressor: [`crate::laz14::LayeredLaz`]
+    Layered(Layered),
+}
+
+/// A pointwise LAZ file (point formats 0-5, items of version 2) as
+/// [`laz_check`] found it.
+struct Pointwise {
+    vlr_at: u64,
+    vlr_len: u64,
+    /// the point data's offset
+    start: u64,
+    count: u64,
+    /// where the chunks end: the chunk table, the first EVLR or the file's end
+    data_end: u64,
+    /// the chunk table as (points, bytes) per chunk (compressor 2)
+    table: Option<Vec<(u64, u64)>>,
 }
 
 /// A layered LAZ file (point formats 6-10) as [`laz_check`] found it.
@@ -474,44 +550,69 @@ struct Decoded {
     declared: u64,
 }
 
-/// Everything that calls into the `las` crate. It runs inside
-/// `catch_unwind` (see `parse`): the crate is third-party code, and a panic
-/// on a damaged file must become an error, not a crash.
-fn read_with_crate(path: &Path, bytes: Vec<u8>, raw: &Raw) -> Result<Decoded> {
-    let total = bytes.len() as u64;
-    let lerr = |e: las::Error| Error::Invalid {
+/// A `las` crate reader past its header, with the declared count checked
+/// against the bytes present (uncompressed records), the columns it gives
+/// and a point buffer for it.
+struct CrateReader {
+    reader: las::Reader,
+    pd: las::PointData,
+    names: Vec<&'static str>,
+    declared: u64,
+    record: u64,
+}
+
+fn crate_error(path: &Path) -> impl Fn(las::Error) -> Error + '_ {
+    move |e| Error::Invalid {
         path: path.to_path_buf(),
         message: format!("cannot read the LAS/LAZ data: {e}"),
-    };
-    let mut reader = las::Reader::new(Cursor::new(bytes)).map_err(lerr)?;
-    let header = reader.header().clone();
-    let n = header.number_of_points();
-    let fmt = *header.point_format();
-    let record = u64::from(fmt.len()).max(1);
-    let avail = total.saturating_sub(raw.offset_to_points);
-    if !raw.compressed && (n as u128) * (record as u128) > avail as u128 {
-        return Err(Error::Binary {
-            path: path.to_path_buf(),
-            offset: raw.offset_to_points,
-            message: format!(
-                "the header declares {n} point records of {record} bytes, but only {avail} bytes follow: {} complete records; the file is truncated or its point count is wrong",
-                avail / record
-            ),
-        });
     }
-    let names = column_names(fmt.has_gps_time, fmt.has_color, fmt.has_nir);
-    let cap = capacity(n, (avail / record) as usize).min(1 << 24);
-    let mut points = Vec::with_capacity(cap);
-    let mut columns = vec![Vec::with_capacity(cap); names.len()];
-    let batch = (BATCH_BYTES / record).clamp(1, BATCH);
-    let mut pd = las::PointDataBuilder::new().for_header(&header).build();
-    let mut read = 0u64;
-    while read < n {
-        let got = reader.fill_points(batch, &mut pd).map_err(lerr)?;
-        if got == 0 {
-            break;
+}
+
+impl CrateReader {
+    /// Reads the header of `source` (a file of `total` bytes).
+    fn new<R>(path: &Path, source: R, total: u64, raw: &Raw) -> Result<Self>
+    where
+        R: std::io::Read + std::io::Seek + Send + Sync + std::fmt::Debug + 'static,
+    {
+        let reader = las::Reader::new(source).map_err(crate_error(path))?;
+        let header = reader.header().clone();
+        let n = header.number_of_points();
+        let fmt = *header.point_format();
+        let record = u64::from(fmt.len()).max(1);
+        let avail = total.saturating_sub(raw.offset_to_points);
+        if !raw.compressed && (n as u128) * (record as u128) > avail as u128 {
+            return Err(Error::Binary {
+                path: path.to_path_buf(),
+                offset: raw.offset_to_points,
+                message: format!(
+                    "the header declares {n} point records of {record} bytes, but only {avail} bytes follow: {} complete records; the file is truncated or its point count is wrong",
+                    avail / record
+                ),
+            });
         }
-        read += got;
+        Ok(Self {
+            pd: las::PointDataBuilder::new().for_header(&header).build(),
+            reader,
+            names: column_names(fmt.has_gps_time, fmt.has_color, fmt.has_nir),
+            declared: n,
+            record,
+        })
+    }
+
+    /// Reads at most `batch` points and appends their coordinates and
+    /// columns (in the order of `names`); returns how many were read.
+    fn fill(
+        &mut self,
+        path: &Path,
+        batch: u64,
+        points: &mut Vec<Point3>,
+        columns: &mut [Vec<f64>],
+    ) -> Result<u64> {
+        let got = self
+            .reader
+            .fill_points(batch, &mut self.pd)
+            .map_err(crate_error(path))?;
+        let pd = &self.pd;
         points.extend(
             pd.x()
                 .zip(pd.y())
@@ -541,34 +642,90 @@ fn read_with_crate(path: &Path, bytes: Vec<u8>, raw: &Raw) -> Result<Decoded> {
         if let Some(nir) = pd.nir() {
             push(&mut nir.map(f64::from));
         }
+        Ok(got)
+    }
+}
+
+/// Everything that calls into the `las` crate. It runs inside
+/// `catch_unwind` (see `parse`): the crate is third-party code, and a panic
+/// on a damaged file must become an error, not a crash.
+fn read_with_crate(path: &Path, bytes: Vec<u8>, raw: &Raw) -> Result<Decoded> {
+    let total = bytes.len() as u64;
+    let mut r = CrateReader::new(path, Cursor::new(bytes), total, raw)?;
+    let (n, record) = (r.declared, r.record);
+    let avail = total.saturating_sub(raw.offset_to_points);
+    let cap = capacity(n, (avail / record) as usize).min(1 << 24);
+    let mut points = Vec::with_capacity(cap);
+    let mut columns = vec![Vec::with_capacity(cap); r.names.len()];
+    let batch = (BATCH_BYTES / record).clamp(1, BATCH);
+    let mut read = 0u64;
+    while read < n {
+        let got = r.fill(path, batch, &mut points, &mut columns)?;
+        if got == 0 {
+            break;
+        }
+        read += got;
     }
     Ok(Decoded {
         points,
-        names,
+        names: r.names,
         columns,
         declared: n,
     })
 }
 
+/// The error of a panic caught in the `las` crate.
+fn crate_failed(path: &Path) -> Error {
+    Error::Invalid {
+        path: path.to_path_buf(),
+        message: "the LAS/LAZ decoder failed on this file (it is damaged, or uses a variant the las crate does not handle)".into(),
+    }
+}
+
+/// The header's warnings: a LAS 1.4 count that disagrees with the legacy
+/// count, and (uncompressed) whole records after the `n` read.
+fn header_warnings(path: &Path, raw: &Raw, n: u64) -> Vec<String> {
+    let mut warnings = Vec::new();
+    if let Some((legacy, large)) = raw.count_mismatch {
+        warnings.push(format!(
+            "{}: the LAS 1.4 header's point count is {large}, but its legacy count is {legacy}; the {legacy} points of the legacy count were read, as the LAS 1.4 specification asks (repair the header)",
+            path.display()
+        ));
+    }
+    if !raw.compressed {
+        let used = raw.offset_to_points + raw.record_len * n;
+        let spare = raw.data_end.saturating_sub(used);
+        if raw.record_len > 0 && spare >= raw.record_len {
+            warnings.push(format!(
+                "{}: the header declares {n} point records, but {spare} more bytes ({} records of {} bytes) follow them; they were not read (the header's point count may be wrong)",
+                path.display(),
+                spare / raw.record_len,
+                raw.record_len
+            ));
+        }
+    }
+    warnings
+}
+
 /// Reads a LAS or LAZ file's bytes (`path` is for messages).
 pub(crate) fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<PointTable> {
     let raw = precheck(path, bytes)?;
-    let layered = if raw.compressed {
+    let compressed = if raw.compressed {
         laz_check(path, bytes, &raw)?
     } else {
-        None
+        Compressed::Crate
     };
-    let decoded = match layered {
-        // LAS 1.4 points: scanfit's own decoder (the laz crate's recursion
-        // on damaged GPS-time layers overflows the stack)
-        Some(layered) => read_layered(path, bytes, &raw, &layered)?,
+    let decoded = match compressed {
+        // LAZ with version-2 pointwise items or layered (LAS 1.4) points:
+        // scanfit's own decoders (the laz crate's GPS-time decoders recurse
+        // on damaged data until the stack overflows)
+        Compressed::Layered(layered) => read_layered(path, bytes, &raw, &layered)?,
+        Compressed::Pointwise(pw) => read_pointwise(path, bytes, &pw)?,
         // the crate is third-party code: a panic on a damaged file becomes
         // one error, without its message on stderr. Our own readers return
         // errors and never panic on file content.
-        None => quietly(|| read_with_crate(path, bytes.to_vec(), &raw)).ok_or_else(|| Error::Invalid {
-            path: path.to_path_buf(),
-            message: "the LAS/LAZ decoder failed on this file (it is damaged, or uses a variant the las crate does not handle)".into(),
-        })??,
+        Compressed::Crate => quietly(|| read_with_crate(path, bytes.to_vec(), &raw))
+            .ok_or_else(|| crate_failed(path))??,
     };
     let n = decoded.points.len();
     if (n as u64) < decoded.declared {
@@ -588,25 +745,7 @@ pub(crate) fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<
     }
     let mut columns: Vec<String> = ["x", "y", "z"].iter().map(|s| s.to_string()).collect();
     columns.extend(decoded.names.iter().map(|s| s.to_string()));
-    let mut warnings = Vec::new();
-    if let Some((legacy, large)) = raw.count_mismatch {
-        warnings.push(format!(
-            "{}: the LAS 1.4 header's point count is {large}, but its legacy count is {legacy}; the {legacy} points of the legacy count were read, as the LAS 1.4 specification asks (repair the header)",
-            path.display()
-        ));
-    }
-    if !raw.compressed {
-        let used = raw.offset_to_points + raw.record_len * n as u64;
-        let spare = raw.data_end.saturating_sub(used);
-        if raw.record_len > 0 && spare >= raw.record_len {
-            warnings.push(format!(
-                "{}: the header declares {n} point records, but {spare} more bytes ({} records of {} bytes) follow them; they were not read (the header's point count may be wrong)",
-                path.display(),
-                spare / raw.record_len,
-                raw.record_len
-            ));
-        }
-    }
+    let warnings = header_warnings(path, &raw, n as u64);
     PointTable {
         path: path.to_path_buf(),
         format: Format::Las,

@@ -18,8 +18,8 @@ use crate::chunks::PointChunks;
 use crate::{Error, ReadOptions, Result};
 
 /// Whether [`PointChunks`] reads `path` a chunk at a time (text files; PLY
-/// files, ascii or with fixed-size binary vertex records), rather than
-/// whole. Reads at most the PLY header.
+/// files, ascii or with fixed-size binary vertex records; LAS and LAZ
+/// files), rather than whole. Reads at most the PLY header.
 ///
 /// ```
 /// use scanfit_io::source::reads_in_chunks;
@@ -40,6 +40,7 @@ pub fn reads_in_chunks(path: &Path, options: &ReadOptions) -> Result<bool> {
     Ok(match format {
         Some(crate::Format::Text) => true,
         Some(crate::Format::Ply) => crate::ply_read::chunks::PlyChunks::open(path)?.is_some(),
+        Some(crate::Format::Las) => true,
         _ => false,
     })
 }

@@ -9,30 +9,31 @@ use std::path::Path;
 use rayon::prelude::*;
 use scanfit::Point3;
 
-use super::{column_names, u64_at, Decoded, Layered, Raw};
-use crate::laz14::{LayeredLaz, Laz14Error, Point14};
+use super::{column_names, transforms, vlr_bytes, Decoded, Layered, Raw};
+use crate::laz14::{LayeredLaz, Laz14Error, Point14, ReadAt};
 use crate::table::capacity;
 use crate::{Error, Result};
 
-/// Decodes every chunk of a layered LAZ file.
-pub(super) fn read_layered(
-    path: &Path,
-    bytes: &[u8],
-    raw: &Raw,
-    layered: &Layered,
-) -> Result<Decoded> {
-    let binary = |e: Laz14Error| Error::Binary {
+pub(super) fn binary(path: &Path, e: Laz14Error) -> Error {
+    Error::Binary {
         path: path.to_path_buf(),
         offset: e.offset,
         message: e.message,
-    };
-    let format = bytes.get(104).copied().unwrap_or(0) & 0x3f;
-    let vlr = usize::try_from(layered.vlr_at)
-        .ok()
-        .and_then(|at| bytes.get(at..at.checked_add(usize::try_from(layered.vlr_len).ok()?)?))
-        .unwrap_or(&[]);
+    }
+}
+
+/// The file's chunks walked and checked, and its point format (`format`,
+/// from the header) checked against the LASzip items.
+pub(super) fn open(
+    path: &Path,
+    read: ReadAt<'_>,
+    vlr: &[u8],
+    format: u8,
+    raw: &Raw,
+    layered: &Layered,
+) -> Result<LayeredLaz> {
     let file = LayeredLaz::new(
-        bytes,
+        read,
         vlr,
         layered.vlr_at,
         raw.offset_to_points,
@@ -40,7 +41,7 @@ pub(super) fn read_layered(
         layered.count,
         layered.table_counts.as_deref(),
     )
-    .map_err(binary)?;
+    .map_err(|e| binary(path, e))?;
     let (rgb, nir) = (matches!(format, 7 | 8 | 10), matches!(format, 8 | 10));
     if !(6..=10).contains(&format) || file.has_rgb() != rgb || file.has_nir() != nir {
         return Err(Error::Binary {
@@ -53,22 +54,29 @@ pub(super) fn read_layered(
             ),
         });
     }
-    let mut transform = [(0.0, 0.0); 3];
-    for (k, t) in transform.iter_mut().enumerate() {
-        let (Some(scale), Some(offset)) = (u64_at(bytes, 131 + 8 * k), u64_at(bytes, 155 + 8 * k))
-        else {
-            return Err(Error::Invalid {
-                path: path.to_path_buf(),
-                message: "the file ends inside the LAS header's scale factors and offsets; it is truncated".into(),
-            });
-        };
-        *t = (f64::from_bits(scale), f64::from_bits(offset));
-    }
-    let names = column_names(true, rgb, nir);
-    let cap = capacity(layered.count, bytes.len()).min(1 << 24);
-    let mut points = Vec::with_capacity(cap);
-    let mut columns = vec![Vec::with_capacity(cap); names.len()];
+    Ok(file)
+}
+
+/// The columns of a layered file's points (see [`column_names`]).
+pub(super) fn names(file: &LayeredLaz) -> Vec<&'static str> {
+    column_names(true, file.has_rgb(), file.has_nir())
+}
+
+/// Appends decoded points: coordinates to `points`, the columns of
+/// [`names`] to `columns`.
+pub(super) fn append(
+    file: &LayeredLaz,
+    transform: &[(f64, f64); 3],
+    chunk: &[Point14],
+    points: &mut Vec<Point3>,
+    columns: &mut [Vec<f64>],
+) {
     let at = |v: i32, k: usize| transform[k].0 * f64::from(v) + transform[k].1;
+    points.extend(
+        chunk
+            .iter()
+            .map(|p| Point3::new(at(p.x, 0), at(p.y, 1), at(p.z, 2))),
+    );
     let fields: [&(dyn Fn(&Point14) -> f64 + Sync); 10] = [
         &|p| f64::from(p.intensity),
         &|p| f64::from(p.return_number),
@@ -81,7 +89,35 @@ pub(super) fn read_layered(
         &|p| f64::from(p.rgb[2]),
         &|p| f64::from(p.nir),
     ];
+    let (rgb, nir) = (file.has_rgb(), file.has_nir());
     let used = [true, true, true, true, true, true, rgb, rgb, rgb, nir];
+    let mut column = columns.iter_mut();
+    for (f, _) in fields.iter().zip(used).filter(|(_, u)| *u) {
+        if let Some(col) = column.next() {
+            col.extend(chunk.iter().map(f));
+        }
+    }
+}
+
+/// Decodes every chunk of a layered LAZ file held in `bytes`.
+pub(super) fn read_layered(
+    path: &Path,
+    bytes: &[u8],
+    raw: &Raw,
+    layered: &Layered,
+) -> Result<Decoded> {
+    let format = bytes.get(104).copied().unwrap_or(0) & 0x3f;
+    let vlr = vlr_bytes(bytes, layered.vlr_at, layered.vlr_len);
+    let read = |at: u64, n: usize| -> Option<Vec<u8>> {
+        let at = usize::try_from(at).ok()?;
+        bytes.get(at..at.checked_add(n)?).map(<[u8]>::to_vec)
+    };
+    let file = open(path, &read, vlr, format, raw, layered)?;
+    let transform = transforms(path, bytes)?;
+    let names = names(&file);
+    let cap = capacity(layered.count, bytes.len()).min(1 << 24);
+    let mut points = Vec::with_capacity(cap);
+    let mut columns = vec![Vec::with_capacity(cap); names.len()];
     // chunks are independent: decode a few per thread at a time, append in
     // file order (the first damaged chunk in file order is the error)
     let group = 2 * rayon::current_num_threads().max(1);
@@ -90,23 +126,17 @@ pub(super) fn read_layered(
         let decoded: Vec<_> = (first..(first + group).min(count))
             .into_par_iter()
             .map(|c| {
+                let at = file.chunks()[c].offset as usize;
+                let data = bytes
+                    .get(at..at.saturating_add(file.chunk_bytes(c) as usize))
+                    .unwrap_or(&[]);
                 let mut chunk = Vec::new();
-                file.decode_chunk(c, &mut chunk).map(|()| chunk)
+                file.decode_chunk(c, data, &mut chunk).map(|()| chunk)
             })
             .collect();
         for chunk in decoded {
-            let chunk = chunk.map_err(binary)?;
-            points.extend(
-                chunk
-                    .iter()
-                    .map(|p| Point3::new(at(p.x, 0), at(p.y, 1), at(p.z, 2))),
-            );
-            let mut column = columns.iter_mut();
-            for (f, _) in fields.iter().zip(used).filter(|(_, u)| *u) {
-                if let Some(col) = column.next() {
-                    col.extend(chunk.iter().map(f));
-                }
-            }
+            let chunk = chunk.map_err(|e| binary(path, e))?;
+            append(&file, &transform, &chunk, &mut points, &mut columns);
         }
     }
     Ok(Decoded {

@@ -148,15 +148,22 @@ pub struct ChunkSpan {
     pub first_point: u64,
 }
 
+/// Reads `n` bytes of a file at an offset (`None` when they are not all
+/// in the file).
+pub type ReadAt<'r> = &'r dyn Fn(u64, usize) -> Option<Vec<u8>>;
+
 /// A layered LAZ file whose chunk headers have been walked and checked.
-pub struct LayeredLaz<'a> {
-    bytes: &'a [u8],
+/// Holds no file bytes: [`LayeredLaz::decode_chunk`] is given each chunk's
+/// bytes, so a caller can read one chunk at a time.
+pub struct LayeredLaz {
     items: Items,
     chunks: Vec<ChunkSpan>,
+    sizes: Vec<u64>,
 }
 
-impl<'a> LayeredLaz<'a> {
-    /// Walks the chunks of `bytes` (the whole file): `vlr` is the LASzip
+impl LayeredLaz {
+    /// Walks the chunks of a file (its chunk headers read through `read`,
+    /// at their offsets): `vlr` is the LASzip
     /// VLR's payload (found at byte `vlr_at`, for messages), the point data
     /// runs from `start` (the 8-byte chunk-table offset) to `end` (the
     /// chunk table, the first EVLR or the file's end), `count` points are
@@ -171,11 +178,12 @@ impl<'a> LayeredLaz<'a> {
     /// // a LASzip VLR with the pointwise compressor is not a layered file
     /// let mut vlr = vec![0u8; 40];
     /// vlr[0] = 2;
-    /// let e = LayeredLaz::new(&[], &vlr, 0, 0, 0, 0, None).err().unwrap();
+    /// let e = LayeredLaz::new(&|_, _| None, &vlr, 0, 0, 0, 0, None).err().unwrap();
     /// assert!(e.message.contains("compressor 2"));
     /// ```
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
-        bytes: &'a [u8],
+        read: ReadAt<'_>,
         vlr: &[u8],
         vlr_at: u64,
         start: u64,
@@ -184,9 +192,9 @@ impl<'a> LayeredLaz<'a> {
         table_counts: Option<&[u64]>,
     ) -> Result<Self, Laz14Error> {
         let (items, chunk_size) = Items::from_vlr(vlr, vlr_at)?;
-        let end = end.min(bytes.len() as u64);
         let head = (items.record() + 4 + 4 * items.layers()) as u64;
         let mut chunks = Vec::new();
+        let mut lens = Vec::new();
         let mut pos = start.saturating_add(8);
         let mut done = 0u64;
         while done < count {
@@ -200,10 +208,10 @@ impl<'a> LayeredLaz<'a> {
                     "the header declares {count} points, but the compressed data ends after {done} of them (before the header of chunk {c}); the file is truncated"
                 )));
             }
-            let p = pos as usize;
-            let declared = u64::from(u32_at(bytes, p + items.record()).unwrap_or(0));
+            let header = read(pos, head as usize).unwrap_or_default();
+            let declared = u64::from(u32_at(&header, items.record()).unwrap_or(0));
             let sizes: u64 = (0..items.layers())
-                .map(|l| u64::from(u32_at(bytes, p + items.record() + 4 + 4 * l).unwrap_or(0)))
+                .map(|l| u64::from(u32_at(&header, items.record() + 4 + 4 * l).unwrap_or(0)))
                 .sum();
             let room = end - pos - head;
             if sizes > room {
@@ -232,14 +240,20 @@ impl<'a> LayeredLaz<'a> {
                 points,
                 first_point: done,
             });
+            lens.push(head + sizes);
             done += points;
             pos += head + sizes;
         }
         Ok(Self {
-            bytes,
             items,
             chunks,
+            sizes: lens,
         })
+    }
+
+    /// The size in bytes of chunk `index` (0 for no such chunk).
+    pub fn chunk_bytes(&self, index: usize) -> u64 {
+        self.sizes.get(index).copied().unwrap_or(0)
     }
 
     /// The chunks, in file order.
@@ -257,9 +271,15 @@ impl<'a> LayeredLaz<'a> {
         self.items.nir
     }
 
-    /// Decodes chunk `index` (of [`LayeredLaz::chunks`]), appending its
-    /// points to `out`.
-    pub fn decode_chunk(&self, index: usize, out: &mut Vec<Point14>) -> Result<(), Laz14Error> {
+    /// Decodes chunk `index` (of [`LayeredLaz::chunks`]) from `bytes` (its
+    /// [`LayeredLaz::chunk_bytes`] bytes, starting at its offset),
+    /// appending its points to `out`.
+    pub fn decode_chunk(
+        &self,
+        index: usize,
+        bytes: &[u8],
+        out: &mut Vec<Point14>,
+    ) -> Result<(), Laz14Error> {
         let span = *self.chunks.get(index).ok_or_else(|| Laz14Error {
             offset: 0,
             message: format!(
@@ -277,9 +297,8 @@ impl<'a> LayeredLaz<'a> {
         };
         let items = self.items;
         // the walk in `new` checked that the header and layers fit
-        let p = span.offset as usize;
-        let record = self
-            .bytes
+        let p = 0usize;
+        let record = bytes
             .get(p..p + items.record())
             .ok_or_else(|| err("the chunk is truncated".into()))?;
         let raw: &[u8; POINT_BYTES] = record[..POINT_BYTES]
@@ -297,9 +316,8 @@ impl<'a> LayeredLaz<'a> {
         let mut layer_at = sizes_at + 4 * items.layers();
         let mut layers: Vec<&[u8]> = Vec::with_capacity(items.layers());
         for l in 0..items.layers() {
-            let size = u32_at(self.bytes, sizes_at + 4 * l).unwrap_or(0) as usize;
-            let layer = self
-                .bytes
+            let size = u32_at(bytes, sizes_at + 4 * l).unwrap_or(0) as usize;
+            let layer = bytes
                 .get(layer_at..layer_at + size)
                 .ok_or_else(|| err("the chunk's layers run past the data".into()))?;
             layers.push(layer);

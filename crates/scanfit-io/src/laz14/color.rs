@@ -62,13 +62,13 @@ impl<T: Copy> Contexts<T> {
     }
 }
 
-struct RgbModels {
+pub(super) struct RgbModels {
     used: SymbolModel,
     bytes: [SymbolModel; 6],
 }
 
 impl RgbModels {
-    fn new() -> Box<Self> {
+    pub(super) fn new() -> Box<Self> {
         Box::new(Self {
             used: SymbolModel::new(128),
             bytes: std::array::from_fn(|_| SymbolModel::new(256)),
@@ -107,7 +107,11 @@ impl RgbDecoder {
 /// One colour: which bytes changed, then red's bytes as differences, and
 /// green's and blue's as differences from red's change (when not grey),
 /// byte plane by byte plane (low byte: plane 0, high byte: plane 1).
-fn decode_rgb(dec: &mut Decoder<'_>, m: &mut RgbModels, last: [u16; 3]) -> Step<[u16; 3]> {
+pub(super) fn decode_rgb(
+    dec: &mut Decoder<'_>,
+    m: &mut RgbModels,
+    last: [u16; 3],
+) -> Step<[u16; 3]> {
     let used = dec.symbol(&mut m.used)?;
     let byte = |v: u16, plane: usize| (v >> (8 * plane)) as u8;
     // model k (0-5) = red low, red high, green low, green high, blue low,

@@ -280,8 +280,12 @@ pub fn ours(f: &Laz, n: u64, variable: bool) -> (Vec<Point14>, usize) {
     } else {
         None
     };
+    let read = |at: u64, n: usize| {
+        let at = at as usize;
+        f.bytes.get(at..at + n).map(<[u8]>::to_vec)
+    };
     let file = LayeredLaz::new(
-        &f.bytes,
+        &read,
         &f.vlr_payload,
         375 + 54,
         f.start,
@@ -292,7 +296,9 @@ pub fn ours(f: &Laz, n: u64, variable: bool) -> (Vec<Point14>, usize) {
     .unwrap();
     let mut out = Vec::new();
     for c in 0..file.chunks().len() {
-        file.decode_chunk(c, &mut out).unwrap();
+        let at = file.chunks()[c].offset as usize;
+        let bytes = &f.bytes[at..at + file.chunk_bytes(c) as usize];
+        file.decode_chunk(c, bytes, &mut out).unwrap();
     }
     (out, file.chunks().len())
 }

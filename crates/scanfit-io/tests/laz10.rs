@@ -1,0 +1,221 @@
+//! scanfit's pointwise-LAZ decoder (`scanfit_io::laz14::PointwiseLaz`,
+//! point formats 0-5, items of version 2) against the `laz` crate's, bit
+//! for bit: files of every format (and with extra bytes) are compressed
+//! here with `laz::LasZipCompressor` (fixed chunks with a partial last
+//! chunk, variable chunks of 1, 2, 700 and 1234 points) from generated
+//! points that exercise every coding path (multiple returns, GPS time
+//! repeats, steps, jumps to new sequences and returns to earlier ones,
+//! changing classification, scan direction and edge flags, intensity,
+//! scan angle, user data, point source, RGB including grey, wave packets
+//! whose offsets repeat, follow, jump and are raw, extra bytes), then
+//! decoded by both.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::io::Cursor;
+use std::path::Path;
+
+use scanfit_io::laz14::PointwiseRecord;
+use scanfit_io::{parse_cloud, ReadOptions};
+
+#[path = "support/laz10_gen.rs"]
+mod laz10_gen;
+use laz10_gen::{compress, fields, laz_decode, ours, record_len, records, Chunks};
+
+fn same(a: &[PointwiseRecord], b: &[PointwiseRecord], what: &str) {
+    assert_eq!(a.len(), b.len(), "{what}: point counts");
+    for (k, (p, q)) in a.iter().zip(b).enumerate() {
+        assert!(
+            p == q && p.gps_time.to_bits() == q.gps_time.to_bits(),
+            "{what}: point {k}:\n ours {p:?}\n laz  {q:?}"
+        );
+    }
+}
+
+fn check(format: u8, extra: usize, chunks: Chunks, n: usize, seed: u64) -> usize {
+    let raw = records(format, extra, n, seed);
+    let f = compress(format, extra, chunks, &raw);
+    let len = record_len(format, extra);
+    let theirs = laz_decode(&f, n, len);
+    assert_eq!(theirs, raw, "the laz crate round trip (format {format})");
+    let (mine, chunks) = ours(&f, n as u64);
+    same(
+        &mine,
+        &fields(&theirs, format, extra),
+        &format!("format {format}, {extra} extra bytes"),
+    );
+    chunks
+}
+
+#[test]
+fn formats_0_to_5_match_laz_with_fixed_chunks_and_a_partial_last_chunk() {
+    for format in 0..=5u8 {
+        assert_eq!(
+            check(format, 0, Chunks::Fixed(1000), 4321, 11 + u64::from(format)),
+            5
+        );
+    }
+}
+
+#[test]
+fn extra_bytes_match_laz() {
+    check(1, 3, Chunks::Fixed(1500), 4000, 33);
+    check(5, 2, Chunks::Fixed(1500), 3000, 34);
+}
+
+#[test]
+fn variable_chunks_match_laz() {
+    // chunks of 1 point (nothing decoded after the raw record), 2, 700, 1234
+    assert_eq!(
+        check(3, 0, Chunks::Variable(&[1, 2, 700, 1234]), 3000, 44),
+        8
+    );
+}
+
+#[test]
+fn many_seeds_of_format_3_match_laz() {
+    for seed in 100..110 {
+        check(3, 0, Chunks::Fixed(600), 1500, seed);
+    }
+}
+
+/// The reader (`parse_cloud`) on LAZ files of formats 0-5 gives the
+/// columns and coordinates the las crate gives, value for value.
+#[test]
+fn the_reader_uses_the_decoder_and_matches_the_las_crate() {
+    for format in 0..=5u8 {
+        reader_matches_the_las_crate(format);
+    }
+}
+
+fn reader_matches_the_las_crate(format: u8) {
+    let n = 2500;
+    let raw = records(format, 0, n, 88 + u64::from(format));
+    let f = compress(format, 0, Chunks::Fixed(1000), &raw);
+    let table = parse_cloud(Path::new("f.laz"), &f.bytes, &ReadOptions::default()).unwrap();
+    let mut reader = las::Reader::new(Cursor::new(f.bytes.clone())).unwrap();
+    let pd = reader.read_points(n as u64).unwrap();
+    let points: Vec<las::Point> = pd.points().map(|p| p.unwrap()).collect();
+    assert_eq!(table.points.len(), n);
+    let mut names: Vec<&str> = vec![
+        "intensity",
+        "return_number",
+        "number_of_returns",
+        "classification",
+        "point_source_id",
+    ];
+    if matches!(format, 1 | 3 | 4 | 5) {
+        names.push("gps_time");
+    }
+    if matches!(format, 2 | 3 | 5) {
+        names.extend(["red", "green", "blue"]);
+    }
+    assert_eq!(table.columns[3..], names[..], "format {format}");
+    for (k, p) in points.iter().enumerate() {
+        let q = table.points[k];
+        assert_eq!(
+            (q.x.to_bits(), q.y.to_bits(), q.z.to_bits()),
+            (p.x.to_bits(), p.y.to_bits(), p.z.to_bits()),
+            "format {format}, point {k}"
+        );
+        let mut expect = vec![
+            f64::from(p.intensity),
+            f64::from(p.return_number),
+            f64::from(p.number_of_returns),
+            f64::from(u8::from(p.classification)),
+            f64::from(p.point_source_id),
+        ];
+        if let Some(t) = p.gps_time {
+            expect.push(t);
+        }
+        if let Some(c) = p.color {
+            expect.extend([f64::from(c.red), f64::from(c.green), f64::from(c.blue)]);
+        }
+        for (c, v) in expect.iter().enumerate() {
+            assert_eq!(
+                table.extra[c][k].to_bits(),
+                v.to_bits(),
+                "format {format}, point {k}, {}",
+                names[c]
+            );
+        }
+    }
+}
+
+/// A LAZ file of version-1 items (LASzip 1.x) is still read (through the
+/// `laz` crate, whose version-1 GPS decoder does not recurse).
+#[test]
+fn version_1_items_are_read_through_the_laz_crate() {
+    let n = 1200;
+    let raw = records(1, 0, n, 5);
+    let bytes = laz10_gen::compress_v1(n, 500);
+    let table = parse_cloud(Path::new("f.laz"), &bytes, &ReadOptions::default()).unwrap();
+    assert_eq!(table.points.len(), n);
+    let gps = table.columns.iter().position(|c| c == "gps_time").unwrap() - 3;
+    for (k, r) in raw.chunks_exact(28).enumerate() {
+        let t = f64::from_le_bytes(r[20..28].try_into().unwrap());
+        assert_eq!(table.extra[gps][k].to_bits(), t.to_bits(), "point {k}");
+    }
+}
+
+/// Writes small pointwise LAZ seeds for the laz fuzz target (formats 1 and
+/// 3 with GPS-time jumps and returns to earlier sequences, format 5 with
+/// wave packets and extra bytes) into `$SCANFIT_SEED_DIR`:
+/// `SCANFIT_SEED_DIR=fuzz/corpus/laz cargo test -p scanfit-io --test laz10 -- --ignored write_fuzz_seeds`
+#[test]
+#[ignore = "writes fuzz seeds; run by hand"]
+fn write_fuzz_seeds() {
+    let dir = std::path::PathBuf::from(std::env::var_os("SCANFIT_SEED_DIR").unwrap());
+    for (name, format, extra, n, chunk, seed) in [
+        ("pointwise1.laz", 1u8, 0usize, 40usize, 16u32, 3u64),
+        ("pointwise3.laz", 3, 0, 40, 16, 4),
+        ("pointwise5-extra.laz", 5, 2, 24, 12, 5),
+    ] {
+        let raw = records(format, extra, n, seed);
+        let f = compress(format, extra, Chunks::Fixed(chunk), &raw);
+        std::fs::write(dir.join(name), &f.bytes).unwrap();
+    }
+}
+
+/// Writes the GPS-switch recursion input (see `laz10_gen::gps_switches`) to
+/// `$SCANFIT_SEED_DIR/gps-time-switches-pointwise.laz`.
+#[test]
+#[ignore = "writes a regression input; run by hand"]
+fn write_gps_switch_input() {
+    let dir = std::path::PathBuf::from(std::env::var_os("SCANFIT_SEED_DIR").unwrap());
+    std::fs::write(
+        dir.join("gps-time-switches-pointwise.laz"),
+        laz10_gen::gps_switches(1_000_000),
+    )
+    .unwrap();
+}
+
+/// Finding 5 of `docs/robustness.md`: a 429-byte format-1 file whose second
+/// point's GPS time is a million "switch sequence" symbols (written by
+/// `write_gps_switch_input`). The laz crate's version-2 GPS decoder
+/// recursed once per switch and overflowed the stack (SIGSEGV: exit 139,
+/// no message); the reader now refuses it with one error naming the chunk
+/// and the point, and the points before it decode as written.
+#[test]
+fn the_pointwise_gps_time_recursion_input_is_a_clear_error() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fuzz/regressions/laz/gps-time-switches-pointwise.laz");
+    let bytes = std::fs::read(path).unwrap();
+    assert_eq!(bytes, laz10_gen::gps_switches(1_000_000));
+    let e = parse_cloud(Path::new("f.laz"), &bytes, &ReadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("LAZ chunk 0 (points 0 to 1): point 1 cannot be decoded: its GPS time switches sequences more often than there are sequences"),
+        "{e}"
+    );
+    // four switches (one per sequence) are followed; the time is the
+    // first sequence's again, unchanged
+    let ok = parse_cloud(
+        Path::new("f.laz"),
+        &laz10_gen::gps_switches(4),
+        &ReadOptions::default(),
+    )
+    .unwrap();
+    let gps = ok.columns.iter().position(|c| c == "gps_time").unwrap() - 3;
+    assert_eq!(ok.extra[gps], [1.0e8, 1.0e8]);
+}
