@@ -14,7 +14,7 @@ use scanfit::project::{DirectedConfig, WeightFactor};
 use scanfit_io::json::SurfaceDoc;
 use scanfit_io::write_all_atomic;
 
-use crate::args::{choice, option_note, InputArgs, NXM};
+use crate::args::{choice, cli_message, InputArgs, NXM};
 use crate::outputs::{
     print_written, provenance, quality_doc, samples_json, Deviation, Picture, SurfaceOutputArgs,
 };
@@ -255,16 +255,18 @@ pub fn run(a: MbaArgs) -> Result<()> {
         ("alpha", "--alpha"),
         ("start", "--start"),
     ];
-    let r = mba(&cloud, &a.config(), &progress)
-        .map_err(|e| anyhow::anyhow!("{}: {e}{}", input.display(), option_note(&e, &options)))?;
-    let q = &r.assessment.quality;
+    let mut r = mba(&cloud, &a.config(), &progress)
+        .map_err(|e| anyhow::anyhow!("{}: {}", input.display(), cli_message(&e, &options)))?;
+    let pts = cloud.points();
+    let trimmed = a.trim.apply(true, &r.surface, pts, &r.uv, None)?;
+    let q = &mut r.assessment.quality;
+    crate::cad::measure_trimmed(q, trimmed.as_ref(), &cloud, &a.config().assess)?;
     a.out.guard(
         q,
         "remove stray points or use fewer levels (--levels) or a tolerance (--tolerance)",
     )?;
+    let q = &r.assessment.quality;
     progress.stage("writing");
-    let pts = cloud.points();
-    let trimmed = a.trim.apply(true, &r.surface, pts, &r.uv, None)?;
     let operation = if a.adjust {
         "mba (multilevel B-spline approximation + projection adjustment)"
     } else {

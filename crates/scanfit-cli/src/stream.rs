@@ -12,7 +12,7 @@ use scanfit_io::json::SurfaceDoc;
 use scanfit_io::source::{reads_in_chunks, FileSource};
 use scanfit_io::write_all_atomic;
 
-use crate::args::{option_note, InputArgs};
+use crate::args::{cli_message, InputArgs};
 use crate::mba::MbaArgs;
 use crate::outputs::{
     print_written, provenance, quality_doc, samples_json, Deviation, Files, Picture,
@@ -61,7 +61,7 @@ fn finish_source(
     if let Err(e) = r {
         return Err(match s.take_failure() {
             Some(f) => f.into(),
-            None => anyhow::anyhow!("{}: {e}{}", s.path().display(), option_note(&e, options)),
+            None => anyhow::anyhow!("{}: {}", s.path().display(), cli_message(&e, options)),
         });
     }
     crate::print_warnings(s.warnings());
