@@ -863,7 +863,10 @@ fn boundary(a: BoundaryArgs) -> Result<()> {
     let t0 = Instant::now();
     let r = find_boundary(&cloud, &cfg, &progress)
         .map_err(|e| {
-            anyhow::anyhow!("{}", cli_message(&e, &[("corner_positions", "--corner-at")]))
+            anyhow::anyhow!(
+                "{}",
+                cli_message(&e, &[("corner_positions", "--corner-at")])
+            )
         })
         .with_context(|| format!("boundary of {}", a.input.input.display()))?;
     let secs = t0.elapsed().as_secs_f64();

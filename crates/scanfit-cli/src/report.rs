@@ -295,7 +295,10 @@ pub fn run(a: ReportArgs) -> Result<()> {
     progress.stage("rendering");
     let pic = pictures(&a, &surface, trimmed.as_ref(), pts, &r)?;
     progress.finish();
-    write_atomic(&out, page(&a, &doc, &surface, &r, &pic, trimmed.is_some()).as_bytes())?;
+    write_atomic(
+        &out,
+        page(&a, &doc, &surface, &r, &pic, trimmed.is_some()).as_bytes(),
+    )?;
     let q = &r.assessment.quality;
     let s = &q.orthogonal;
     if a.json {

@@ -61,7 +61,15 @@ fn fit_and_report_measure_the_trimmed_face_only() {
     let (max, far, out, n) = samples(&f);
     assert!(max < 1.5 && far == 0.0 && out < 0.5, "{f}");
     // untrimmed, the rectangle's corners are 20 spacings from the data
-    let u = json(&["fit", &inp, "--no-trim", "-o", &p("rect.json"), "--json", "-q"]);
+    let u = json(&[
+        "fit",
+        &inp,
+        "--no-trim",
+        "-o",
+        &p("rect.json"),
+        "--json",
+        "-q",
+    ]);
     let (umax, ufar, uout, un) = samples(&u);
     assert!(umax > 15.0 && ufar > 0.1 && uout > 10.0, "{u}");
     // the face's samples are the rectangle's inside the outline (about

@@ -314,7 +314,9 @@ fn setting_errors_name_the_option_first() {
         assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
         // the option opens the message: only the context (the file, the
         // step) comes before it
-        let at = err.find(start).unwrap_or_else(|| panic!("{args:?}: '{start}' not in {err}"));
+        let at = err
+            .find(start)
+            .unwrap_or_else(|| panic!("{args:?}: '{start}' not in {err}"));
         let before = &err[..at];
         assert!(
             before.starts_with("error: ") && !before.contains(" = "),
