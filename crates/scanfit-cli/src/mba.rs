@@ -239,7 +239,10 @@ pub fn run(a: MbaArgs) -> Result<()> {
     }
     if let Some(n) = a.chunk_points {
         if a.trim.trim {
-            anyhow::bail!("--trim finds the outline from all points at once; leave it out with --chunk-points (the surface is then the untrimmed rectangle)");
+            anyhow::bail!(
+                "--trim cannot be used with --chunk-points: {}",
+                crate::stream::TRIM_STREAMED
+            );
         }
         return crate::stream::mba(&a, n);
     }
