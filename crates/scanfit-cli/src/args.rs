@@ -283,16 +283,35 @@ fn vectors(s: &str, what: &str) -> std::result::Result<Vectors, String> {
         .map(Vectors)
 }
 
-/// " (option --alpha)" when `e` is about a library setting that `options`
-/// maps to a command-line option (`(setting, option)` pairs), else "".
-pub fn option_note(e: &scanfit::Error, options: &[(&str, &str)]) -> String {
+/// The library's error `e` as the command line says it. An invalid setting
+/// that `options` maps to a command-line option (`(setting, option)` pairs;
+/// the option may go on with advice, as in `"--corners I,J,K,L with loop
+/// positions ..."`) names the option first, where the library names its
+/// config field: `--alpha = -1: the adjustment's alpha must be ...`, the
+/// advice last (`(try --corners I,J,K,L with ...)`). An error of one patch
+/// keeps its `patch N: ` prefix; every other error is the library's message.
+pub fn cli_message(e: &scanfit::Error, options: &[(&str, &str)]) -> String {
     match e {
-        scanfit::Error::InvalidSetting { setting, .. } => options
-            .iter()
-            .find(|(s, _)| s == setting)
-            .map(|(_, o)| format!(" (option {o})"))
-            .unwrap_or_default(),
-        _ => String::new(),
+        scanfit::Error::InvalidSetting {
+            setting,
+            value,
+            hint,
+        } => match options.iter().find(|(s, _)| s == setting) {
+            Some((_, o)) => {
+                let (name, advice) = o.split_once(' ').unwrap_or((o, ""));
+                let advice = if advice.is_empty() {
+                    String::new()
+                } else {
+                    format!(" (try {o})")
+                };
+                format!("{name} = {value}: {hint}{advice}")
+            }
+            None => e.to_string(),
+        },
+        scanfit::Error::InPatch { patch, source } => {
+            format!("patch {patch}: {}", cli_message(source, options))
+        }
+        _ => e.to_string(),
     }
 }
 

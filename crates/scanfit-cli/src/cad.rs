@@ -8,8 +8,10 @@ use anyhow::Result;
 use clap::{Args, ValueEnum};
 use scanfit::bspline::Surface;
 use scanfit::cloud::boundary::Boundary;
+use scanfit::pipeline::assess::{AssessConfig, SurfaceQuality};
+use scanfit::pipeline::assess_trimmed::assess_trimmed;
 use scanfit::trim::{trim_surface, trim_to_points, TrimConfig, TrimmedSurface};
-use scanfit::Point3;
+use scanfit::{Point3, PointCloud};
 use scanfit_io::iges::iges_file_with;
 use scanfit_io::step::{step_file_with, CadItem};
 use scanfit_io::units::{CadOptions, LengthUnit};
@@ -122,6 +124,22 @@ impl TrimArgs {
     }
 }
 
+/// The surface-to-points measures and the extent check of `quality` (the
+/// pipeline's assessment with `config`) taken again over the trimmed face,
+/// when there is one: the parts of the rectangle outside the trim loops are
+/// in no output and do not count.
+pub fn measure_trimmed(
+    quality: &mut SurfaceQuality,
+    trimmed: Option<&TrimmedSurface>,
+    cloud: &PointCloud,
+    config: &AssessConfig,
+) -> Result<()> {
+    if let Some(t) = trimmed {
+        assess_trimmed(quality, t, cloud, config)?;
+    }
+    Ok(())
+}
+
 /// One line describing a trimmed face, for the command's report.
 pub fn trim_line(t: &TrimmedSurface) -> String {
     let outer = match &t.outer {
@@ -139,7 +157,7 @@ pub fn trim_line(t: &TrimmedSurface) -> String {
         String::new()
     };
     format!(
-        "trimmed face: bounded by {outer} and {} holes; 3D trim curves within {dev:.3e} data units of the surface{skipped}",
+        "trimmed face: bounded by {outer} and {} holes; 3D trim curves within {dev:.3e} data units of the surface{skipped}; surface samples and extent measured on the face (eq. 17 on the whole knot grid)",
         t.holes.len()
     )
 }

@@ -23,7 +23,7 @@ use scanfit_io::render::{
 use scanfit_io::{cloud_bytes, write_all_atomic, WriteFormat};
 
 pub use crate::args::InputArgs;
-use crate::args::{choice, option_note, value_name, Indices, Parsed, INDICES, VECTOR3};
+use crate::args::{choice, cli_message, value_name, Indices, Parsed, INDICES, VECTOR3};
 use crate::outputs::{check_outputs, extension, Files};
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -863,8 +863,10 @@ fn boundary(a: BoundaryArgs) -> Result<()> {
     let t0 = Instant::now();
     let r = find_boundary(&cloud, &cfg, &progress)
         .map_err(|e| {
-            let note = option_note(&e, &[("corner_positions", "--corner-at")]);
-            anyhow::anyhow!("{e}{note}")
+            anyhow::anyhow!(
+                "{}",
+                cli_message(&e, &[("corner_positions", "--corner-at")])
+            )
         })
         .with_context(|| format!("boundary of {}", a.input.input.display()))?;
     let secs = t0.elapsed().as_secs_f64();

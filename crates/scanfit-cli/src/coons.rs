@@ -22,7 +22,7 @@ use scanfit_io::json::SurfaceDoc;
 use scanfit_io::render::{Marker, Polyline};
 use scanfit_io::write_all_atomic;
 
-use crate::args::{choice, option_note, value_name as name, InputArgs, Parsed, INDICES, NXM};
+use crate::args::{choice, cli_message, value_name as name, InputArgs, Parsed, INDICES, NXM};
 use crate::cloud::CriterionArg;
 use crate::outputs::{
     points_file, print_written, provenance, quality_doc, samples_json, Deviation, Files, Picture,
@@ -308,9 +308,9 @@ pub fn run(a: CoonsArgs) -> Result<()> {
     let input = a.input.input.display().to_string();
     progress.stage(format!("reading {input}"));
     let cloud = a.outliers.apply(a.input.load(a.json)?, a.json)?;
-    let r = coons(&cloud, &cfg, &progress)
+    let mut r = coons(&cloud, &cfg, &progress)
         .map_err(|e| {
-            let note = option_note(
+            let message = cli_message(
                 &e,
                 &[
                     ("export_tolerance", "--export-tolerance"),
@@ -324,20 +324,22 @@ pub fn run(a: CoonsArgs) -> Result<()> {
                     ),
                 ],
             );
-            anyhow::anyhow!("{e}{note}")
+            anyhow::anyhow!("{message}")
         })
         .with_context(|| format!("Coons patch of {input} ({} sides)", a.sides.count()))?;
     let secs = t0.elapsed().as_secs_f64();
-    a.out.guard(
-        &r.assessment.quality,
-        "check the corners (--corners), use fewer control points (--ctrl) or fewer PDE terms (--pde)",
-    )?;
-    progress.stage("writing");
     let pts = cloud.points();
     let boundary = Some(&r.base.boundary);
     let trimmed = a
         .trim
         .apply(true, &r.surface, pts, &r.parameters.uv, boundary)?;
+    let q = &mut r.assessment.quality;
+    crate::cad::measure_trimmed(q, trimmed.as_ref(), &cloud, &cfg.assess)?;
+    a.out.guard(
+        q,
+        "check the corners (--corners), use fewer control points (--ctrl) or fewer PDE terms (--pde)",
+    )?;
+    progress.stage("writing");
     let (files, exaggeration) = outputs(&a, pts, &r, trimmed.as_ref())?;
     write_all_atomic(&files)?;
     progress.finish();

@@ -16,7 +16,7 @@ use scanfit_io::svg::{curve_panels, curve_panels_png, Panel, PanelSize};
 use scanfit_io::{write_all_atomic, PointTable};
 use serde::Serialize;
 
-use crate::args::{option_note, InputArgs, Parsed, Vectors, VECTORS};
+use crate::args::{cli_message, InputArgs, Parsed, Vectors, VECTORS};
 use crate::outputs::{check_outputs, provenance};
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -162,7 +162,7 @@ fn locate(e: &scanfit::Error, table: &PointTable) -> anyhow::Error {
                 ("smoothing", "--smooth"),
                 ("end_derivatives", "--end-tangents"),
             ];
-            anyhow::anyhow!("{e}{}", option_note(e, &options))
+            anyhow::anyhow!("{}", cli_message(e, &options))
         }
     }
 }

@@ -15,7 +15,7 @@ use scanfit_io::json::SurfaceDoc;
 use scanfit_io::render::Up;
 use scanfit_io::write_all_atomic;
 
-use crate::args::{choice, option_note, InputArgs, NXM};
+use crate::args::{choice, cli_message, InputArgs, NXM};
 use crate::outputs::{
     print_written, provenance, quality_doc, samples_json, Deviation, Picture, SurfaceOutputArgs,
 };
@@ -242,7 +242,10 @@ pub fn run(a: MbaArgs) -> Result<()> {
     }
     if let Some(n) = a.chunk_points {
         if a.trim.trim {
-            anyhow::bail!("--trim finds the outline from all points at once; leave it out with --chunk-points (the surface is then the untrimmed rectangle)");
+            anyhow::bail!(
+                "--trim cannot be used with --chunk-points: {}",
+                crate::stream::TRIM_STREAMED
+            );
         }
         return crate::stream::mba(&a, n);
     }
@@ -262,16 +265,18 @@ pub fn run(a: MbaArgs) -> Result<()> {
     ];
     let mut config = a.config();
     config.up = up;
-    let r = mba(&cloud, &config, &progress)
-        .map_err(|e| anyhow::anyhow!("{}: {e}{}", input.display(), option_note(&e, &options)))?;
-    let q = &r.assessment.quality;
+    let mut r = mba(&cloud, &config, &progress)
+        .map_err(|e| anyhow::anyhow!("{}: {}", input.display(), cli_message(&e, &options)))?;
+    let pts = cloud.points();
+    let trimmed = a.trim.apply(true, &r.surface, pts, &r.uv, None)?;
+    let q = &mut r.assessment.quality;
+    crate::cad::measure_trimmed(q, trimmed.as_ref(), &cloud, &config.assess)?;
     a.out.guard(
         q,
         "remove stray points or use fewer levels (--levels) or a tolerance (--tolerance)",
     )?;
+    let q = &r.assessment.quality;
     progress.stage("writing");
-    let pts = cloud.points();
-    let trimmed = a.trim.apply(true, &r.surface, pts, &r.uv, None)?;
     let operation = if a.adjust {
         "mba (multilevel B-spline approximation + projection adjustment)"
     } else {

@@ -198,7 +198,9 @@ pub fn run(a: ReconstructArgs) -> Result<()> {
     let t0 = Instant::now();
     let (cloud, dropped) = a.input.load_counted()?;
     let progress = Progress::spinner(a.quiet);
+    let settings = crate::segment::SegmentOptions::SETTINGS;
     let r = reconstruct::run(&cloud, &cfg, &progress)
+        .map_err(|e| anyhow::anyhow!("{}", crate::args::cli_message(&e, &settings)))
         .with_context(|| format!("reconstructing {}", a.input.input.display()))?;
     progress.finish();
     let seconds = t0.elapsed().as_secs_f64();

@@ -12,7 +12,7 @@ use scanfit::distribution::Histogram;
 use scanfit::metrics::nearest_points;
 use scanfit::pipeline::measure::{run as measure, MeasureConfig, MeasureReport};
 use scanfit::trim::TrimmedSurface;
-use scanfit::Point3;
+use scanfit::{Point3, PointCloud};
 use scanfit_io::json::{read_surface, SurfaceDoc};
 use scanfit_io::render::{
     format_value, render_png, render_points_png, ColourScale, Colouring, RenderOptions,
@@ -161,11 +161,12 @@ fn figures(r: &MeasureReport) -> [(&'static str, f64); 5] {
 }
 
 /// One line on the surface samples' distance to the points.
-fn samples_line(r: &MeasureReport) -> String {
+fn samples_line(r: &MeasureReport, trimmed: bool) -> String {
     let s = &r.assessment.quality.samples_to_points;
     format!(
-        "surface samples to nearest point ({} samples): mean {}, max {}, RMSE {}; {:.1}% farther than {} point spacings ({})",
+        "surface samples to nearest point ({} samples{}): mean {}, max {}, RMSE {}; {:.1}% farther than {} point spacings ({})",
         s.stats.count,
+        if trimmed { " on the trimmed face" } else { "" },
         num(s.stats.mean),
         num(s.stats.max),
         num(s.stats.rmse),
@@ -182,6 +183,7 @@ fn page(
     surface: &Surface,
     r: &MeasureReport,
     pic: &Pictures,
+    trimmed: bool,
 ) -> String {
     let q = &r.assessment.quality;
     let mut html = String::new();
@@ -208,7 +210,7 @@ fn page(
     let _ = write!(
         html,
         "</table><p>{}.</p><h3>Histogram</h3>{}",
-        escape(&samples_line(r)),
+        escape(&samples_line(r, trimmed)),
         histogram_svg(&r.histogram)
     );
     let _ = write!(html, "<h2>Surface</h2><table><tr><td>degrees</td><td class=n>{p} x {qd}</td></tr><tr><td>control points</td><td class=n>{cu} x {cv}</td></tr><tr><td>periodic</td><td class=n>{:?}</td></tr>", surface.periodic());
@@ -282,13 +284,21 @@ pub fn run(a: ReportArgs) -> Result<()> {
     let trimmed = doc
         .trimmed(&surface)
         .map_err(|e| anyhow::anyhow!("{}: {e}", a.surface.display()))?;
-    let table = a.input.table(false)?;
-    let pts = &table.points;
-    let r = measure(&surface, pts, &MeasureConfig::default(), &progress)?;
+    let cloud = PointCloud::new(a.input.table(false)?.points)?;
+    let pts = cloud.points();
+    let config = MeasureConfig::default();
+    let mut r = measure(&surface, pts, &config, &progress)?;
+    // a trimmed face is measured as trimmed: the surface samples cover the
+    // face, not its parameter rectangle
+    let q = &mut r.assessment.quality;
+    crate::cad::measure_trimmed(q, trimmed.as_ref(), &cloud, &config.assess)?;
     progress.stage("rendering");
     let pic = pictures(&a, &surface, trimmed.as_ref(), pts, &r)?;
     progress.finish();
-    write_atomic(&out, page(&a, &doc, &surface, &r, &pic).as_bytes())?;
+    write_atomic(
+        &out,
+        page(&a, &doc, &surface, &r, &pic, trimmed.is_some()).as_bytes(),
+    )?;
     let q = &r.assessment.quality;
     let s = &q.orthogonal;
     if a.json {
@@ -322,7 +332,7 @@ pub fn run(a: ReportArgs) -> Result<()> {
         t.row(vec![k.into(), num(v), "data units".into()]);
     }
     out!("{}", t.render());
-    outln!("{}", samples_line(&r));
+    outln!("{}", samples_line(&r, trimmed.is_some()));
     crate::cad::print_trim(trimmed.as_ref())?;
     if q.unconverged > 0 {
         outln!("note: {} point inversions did not converge", q.unconverged);

@@ -13,7 +13,7 @@ use scanfit::PointCloud;
 use scanfit_io::render::{render_scene_png, PointScene};
 use scanfit_io::write_all_atomic;
 
-use crate::args::InputArgs;
+use crate::args::{cli_message, InputArgs};
 use crate::outputs::{check_outputs, print_written, Files};
 use crate::progress::Progress;
 use crate::table::{num, Table};
@@ -52,6 +52,11 @@ pub struct SegmentOptions {
 }
 
 impl SegmentOptions {
+    /// The library settings these options set, with their option names
+    /// (for [`crate::args::cli_message`]).
+    pub const SETTINGS: [(&'static str, &'static str); 2] =
+        [("max_angle_deg", "--angle"), ("min_cell", "--min-cell")];
+
     /// The library settings.
     pub fn config(&self) -> SegmentConfig {
         let mut c = SegmentConfig::default();
@@ -99,6 +104,7 @@ pub fn run(a: SegmentArgs) -> Result<()> {
     let progress = Progress::spinner(a.quiet || a.json);
     let t0 = Instant::now();
     let r = segment_cloud(&cloud, &a.segment.config(), &progress)
+        .map_err(|e| anyhow::anyhow!("{}", cli_message(&e, &SegmentOptions::SETTINGS)))
         .with_context(|| format!("segmenting {}", a.input.input.display()))?;
     let seconds = t0.elapsed().as_secs_f64();
     progress.finish();

@@ -13,7 +13,7 @@ use scanfit_io::json::SurfaceDoc;
 use scanfit_io::source::{reads_in_chunks, FileSource};
 use scanfit_io::write_all_atomic;
 
-use crate::args::{option_note, InputArgs};
+use crate::args::{cli_message, InputArgs};
 use crate::mba::MbaArgs;
 use crate::outputs::{
     print_written, provenance, quality_doc, samples_json, Deviation, Files, Picture,
@@ -62,7 +62,7 @@ fn finish_source(
     if let Err(e) = r {
         return Err(match s.take_failure() {
             Some(f) => f.into(),
-            None => anyhow::anyhow!("{}: {e}{}", s.path().display(), option_note(&e, options)),
+            None => anyhow::anyhow!("{}: {}", s.path().display(), cli_message(&e, options)),
         });
     }
     crate::print_warnings(s.warnings());
@@ -142,6 +142,10 @@ pub fn fit(a: &FitArgs, chunk: usize) -> Result<()> {
     )
 }
 
+/// Why a streamed `mba` gives the untrimmed rectangle, and how to get a
+/// trimmed face instead (the note of the default, the refusal of `--trim`).
+pub const TRIM_STREAMED: &str = "--chunk-points fits the whole xy rectangle, since the outline (alpha shape) needs all points at once; for a face trimmed to the outline and holes run without --chunk-points, or on a thinned copy that fits in memory (scanfit cloud clean IN --voxel-spacings 2 -o thin.ply, then scanfit mba thin.ply)";
+
 /// Runs `scanfit mba --chunk-points N`.
 pub fn mba(a: &MbaArgs, chunk: usize) -> Result<()> {
     check_outputs(&a.out)?;
@@ -150,7 +154,9 @@ pub fn mba(a: &MbaArgs, chunk: usize) -> Result<()> {
     }
     let quiet = a.quiet || a.json;
     if !quiet && !a.trim.no_trim {
-        crate::print_stderr(format_args!("note: the surface is the untrimmed rectangle: trimming to the points' outline (the in-memory default) needs all points at once (--no-trim silences this note)"));
+        crate::print_stderr(format_args!(
+            "note: the surface is NOT trimmed: {TRIM_STREAMED}; --no-trim silences this note"
+        ));
     }
     let progress = Progress::spinner(quiet);
     let mut s = source(&a.input, chunk, false, quiet)?;

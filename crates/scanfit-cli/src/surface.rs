@@ -14,7 +14,7 @@ use scanfit::PointCloud;
 use scanfit_io::json::SurfaceDoc;
 use scanfit_io::{write_all_atomic, PointTable};
 
-use crate::args::{choice, option_note, InputArgs, NXM};
+use crate::args::{choice, cli_message, InputArgs, NXM};
 use crate::outputs::{
     points_file, print_written, provenance, quality_doc, quality_rows, samples_json, Deviation,
     Picture, PngStyle,
@@ -189,10 +189,16 @@ fn cloud_of(a: &FitArgs, table: &mut PointTable) -> Result<PointCloud> {
 /// The library's error with the file and line of the point it names.
 fn locate(e: scanfit::Error, table: &PointTable) -> anyhow::Error {
     let file = table.path.display();
-    let options = [("smoothing", "--smooth"), ("periodic_u", "--periodic-u")];
+    let options = [
+        ("smoothing", "--smooth"),
+        ("periodic_u", "--periodic-u"),
+        ("ctrl", "--ctrl"),
+        ("params", "--params"),
+        ("knots", "--knots"),
+    ];
     match e.point_indices().first() {
         Some(&i) => anyhow::anyhow!("{file}: {e} ({})", table.locate(i)),
-        None => anyhow::anyhow!("{file}: {e}{}", option_note(&e, &options)),
+        None => anyhow::anyhow!("{file}: {}", cli_message(&e, &options)),
     }
 }
 
@@ -226,15 +232,17 @@ pub fn run(a: FitArgs) -> Result<()> {
         return crate::stream::fit(&a, n);
     }
     let progress = Progress::spinner(a.quiet);
-    let (cloud, r) = read_and_fit(&a, &progress)?;
-    a.out.guard(
-        &r.assessment.quality,
-        "raise the smoothing (--smooth; by default it is scaled to the data) or use fewer control points (--ctrl)",
-    )?;
-    progress.stage("writing");
+    let (cloud, mut r) = read_and_fit(&a, &progress)?;
     let pts = cloud.points();
     let plane = matches!(a.params, ParamsArg::Plane) && !a.periodic_u;
     let trimmed = a.trim.apply(plane, &r.surface, pts, &r.uv, None)?;
+    let q = &mut r.assessment.quality;
+    crate::cad::measure_trimmed(q, trimmed.as_ref(), &cloud, &a.config().assess)?;
+    a.out.guard(
+        q,
+        "raise the smoothing (--smooth; by default it is scaled to the data) or use fewer control points (--ctrl)",
+    )?;
+    progress.stage("writing");
     let q = &r.assessment.quality;
     let quality = quality_doc(q, r.rounds.iter().map(|r| r.errors.rmse).collect());
     let mut doc = SurfaceDoc::new(&r.surface);

@@ -18,7 +18,7 @@ use scanfit::{PointCloud, Vector3};
 use scanfit_io::json::SurfaceDoc;
 use scanfit_io::write_all_atomic;
 
-use crate::args::{choice, option_note, InputArgs, Parsed, NXM};
+use crate::args::{choice, cli_message, InputArgs, Parsed, NXM};
 use crate::outputs::{
     print_written, provenance, quality_doc, samples_json, Deviation, Files, Picture, PngStyle,
     SurfaceOutputArgs,
@@ -199,8 +199,8 @@ pub fn run(a: TurntableArgs) -> Result<()> {
     let t0 = Instant::now();
     let r = turntable(&cloud, &cfg, &progress)
         .map_err(|e| {
-            let note = option_note(&e, &[("compare_weights.rounds", "--compare-rounds")]);
-            anyhow::anyhow!("{e}{note}")
+            let options = [("compare_weights.rounds", "--compare-rounds")];
+            anyhow::anyhow!("{}", cli_message(&e, &options))
         })
         .with_context(|| a.input.input.display().to_string())?;
     let seconds = t0.elapsed().as_secs_f64();

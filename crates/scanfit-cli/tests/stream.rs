@@ -119,3 +119,77 @@ fn streamed_fit_writes_the_in_memory_surface_and_refuses_whole_cloud_options() {
     }
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+#[test]
+fn streamed_mba_says_in_one_line_that_it_is_untrimmed_and_how_to_trim() {
+    let d = tmp("mba-trim");
+    let sample = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/data/terrain_50k.xyz"
+    );
+    let out = d.join("s.json");
+    let o = out.to_str().unwrap();
+    // the default (trim on in memory): one note line, with the way to a
+    // trimmed face
+    let run = scanfit(&[
+        "mba",
+        sample,
+        "--levels",
+        "4",
+        "--chunk-points",
+        "20000",
+        "-o",
+        o,
+    ]);
+    ok(&run);
+    let err = String::from_utf8_lossy(&run.stderr);
+    let notes: Vec<&str> = err.lines().filter(|l| l.contains("trim")).collect();
+    assert_eq!(notes.len(), 1, "{err}");
+    assert!(
+        notes[0].starts_with("note: the surface is NOT trimmed: ")
+            && notes[0].contains("run without --chunk-points")
+            && notes[0].contains("--no-trim silences"),
+        "{err}"
+    );
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    assert!(doc.get("trim").is_none());
+    // --no-trim: no note
+    let run = scanfit(&[
+        "mba",
+        sample,
+        "--levels",
+        "4",
+        "--chunk-points",
+        "20000",
+        "--no-trim",
+        "-o",
+        o,
+    ]);
+    ok(&run);
+    assert!(!String::from_utf8_lossy(&run.stderr).contains("trim"));
+    // --trim asked: refused before any work, with the same way out
+    std::fs::remove_file(&out).unwrap();
+    let run = scanfit(&["mba", sample, "--chunk-points", "20000", "--trim", "-o", o]);
+    assert_eq!(run.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        err.contains("--trim cannot be used with --chunk-points")
+            && err.contains("run without --chunk-points"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    // the thinning command the note suggests works as printed
+    let thin = d.join("thin.ply");
+    ok(&scanfit(&[
+        "cloud",
+        "clean",
+        sample,
+        "--voxel-spacings",
+        "2",
+        "-o",
+        thin.to_str().unwrap(),
+    ]));
+    assert!(thin.exists());
+    std::fs::remove_dir_all(&d).unwrap();
+}

@@ -102,13 +102,13 @@ fn library_errors_carry_their_point_and_option() {
         (vec!["fit", huge.to_str().unwrap(), "--ctrl", "6"], "huge.xyz:1)"),
         (
             vec!["fit", f, "--ctrl", "6", "--smooth", "-1"],
-            "(option --smooth)",
+            "s.xyz: --smooth = -1: ",
         ),
         (
             vec!["mba", f, "--adjust", "--alpha", "-1"],
-            "alpha = -1: the adjustment's alpha must be a positive number (the paper uses 1.49) (option --alpha)",
+            "s.xyz: --alpha = -1: the adjustment's alpha must be a positive number (the paper uses 1.49)\n",
         ),
-        (vec!["mba", f, "--base", "0x2"], "(option --base)"),
+        (vec!["mba", f, "--base", "0x2"], "s.xyz: --base = 0 x 2: "),
     ];
     for (args, needle) in cases {
         let o = run(&args);
@@ -136,16 +136,25 @@ fn fit_reports_the_surface_samples_far_from_the_data() {
     }
     std::fs::write(&input, s).unwrap();
     // (smoothing holds the control points over the empty quarter)
-    let out = ok(&run(&[
-        "fit",
-        input.to_str().unwrap(),
-        "--ctrl",
-        "6",
-        "--smooth",
-        "1e-6",
-        "--json",
-    ]));
-    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let fit = |trim: &str| -> serde_json::Value {
+        let out = ok(&run(&[
+            "fit",
+            input.to_str().unwrap(),
+            "--ctrl",
+            "6",
+            "--smooth",
+            "1e-6",
+            trim,
+            "--json",
+        ]));
+        serde_json::from_str(&out).unwrap()
+    };
+    // trimmed (the default) to the L, the face has no sample far from it
+    let t = fit("--trim");
+    assert!(t["trim"]["outer"].as_u64().unwrap() > 100, "{t}");
+    assert_eq!(t["samples_to_points"]["far_share"].as_f64().unwrap(), 0.0);
+    // the untrimmed rectangle spans the empty quarter
+    let v = fit("--no-trim");
     let far = v["samples_to_points"]["far_share"].as_f64().unwrap();
     // samples farther than 3 spacings (3/39) from the L: x, y > 20/39 + 3/39
     // roughly, (1 - 23/39)^2 = 0.17 of the square
@@ -254,4 +263,66 @@ fn reconstruct_options_are_typed() {
     let o = run(&["reconstruct", v, "-q", "--ignore", "-5,13", "--json"]);
     let out = ok(&o);
     assert!(out.contains("\"patches\""), "{out}");
+}
+
+/// A library setting refused with the command-line option named first (the
+/// library's own field name nowhere), the value and the library's hint
+/// after it, advice last.
+#[test]
+fn setting_errors_name_the_option_first() {
+    let d = tmpdir("typed", "option-first");
+    let input = d.join("s.xyz");
+    sheet(&input);
+    let f = input.to_str().unwrap();
+    // (arguments, what the message starts with after `error: <context>: `,
+    // the library's field name that must not show)
+    let cases: Vec<(Vec<&str>, &str, &str)> = vec![
+        (
+            vec!["fit", f, "--ctrl", "6", "--smooth", "-1"],
+            "--smooth = -1: smoothing weight -1 must be finite and non-negative",
+            "smoothing =",
+        ),
+        (
+            vec!["mba", f, "--tolerance", "-1"],
+            "--tolerance = -1: the MBA tolerance must be",
+            ": tolerance",
+        ),
+        (
+            vec!["mba", f, "--levels", "40"],
+            "--levels = 40: 40 levels on a ",
+            "max_levels",
+        ),
+        (
+            vec!["cloud", "segment", f, "--angle", "95"],
+            "--angle = 95: an angle in (0, 90) degrees",
+            "max_angle_deg",
+        ),
+        (
+            vec!["cloud", "segment", f, "--min-cell", "0"],
+            "--min-cell = 0: a positive number of point spacings",
+            "min_cell",
+        ),
+        (
+            vec!["coons", f, "--pde", "4x4", "--export-tolerance=-1"],
+            "--export-tolerance = -1: the B-spline form",
+            "export_tolerance",
+        ),
+    ];
+    for (args, start, field) in cases {
+        let o = run(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        // the option opens the message: only the context (the file, the
+        // step) comes before it
+        let at = err
+            .find(start)
+            .unwrap_or_else(|| panic!("{args:?}: '{start}' not in {err}"));
+        let before = &err[..at];
+        assert!(
+            before.starts_with("error: ") && !before.contains(" = "),
+            "{args:?}: {err}"
+        );
+        assert!(!err.contains(field), "{args:?}: '{field}' in {err}");
+        assert!(!err.contains("(option "), "{args:?}: {err}");
+    }
 }

@@ -16,7 +16,9 @@ use scanfit::{Point3, Vector3};
 pub struct Panel<'a> {
     /// Title (the method name).
     pub title: String,
-    /// One line under the title (figures, or the error).
+    /// The text under the title (figures, or the error), wrapped onto as
+    /// many lines as it needs: the header of every panel grows to the
+    /// longest subtitle's lines, and no text is cut.
     pub subtitle: String,
     /// The data points.
     pub points: &'a [Point3],
@@ -72,8 +74,45 @@ impl Projection {
     }
 }
 
+/// Height of a panel's header (title and a two-line subtitle); longer
+/// subtitles grow it by a line height per line ([`Header`]).
 const HEADER: f64 = 52.0;
 const MARGIN: f64 = 14.0;
+
+/// The header shared by the panels of a figure: every subtitle wrapped at
+/// `per_line` characters, and the header's height, grown from [`HEADER`]
+/// (two subtitle lines) by `line` pixels per line of the longest subtitle
+/// beyond two. The panels grow by the same amount, so the plot area keeps
+/// its size.
+struct Header {
+    lines: Vec<Vec<String>>,
+    height: f64,
+}
+
+impl Header {
+    fn of(panels: &[Panel], per_line: usize, line: f64) -> Self {
+        let lines: Vec<Vec<String>> = panels.iter().map(|p| wrap(&p.subtitle, per_line)).collect();
+        let most = lines.iter().map(Vec::len).max().unwrap_or(0);
+        Self {
+            lines,
+            height: HEADER + line * most.saturating_sub(2) as f64,
+        }
+    }
+
+    /// A panel's size with the header's growth added.
+    fn panel(&self, size: PanelSize) -> PanelSize {
+        PanelSize {
+            width: size.width,
+            height: size.height + self.height - HEADER,
+        }
+    }
+}
+
+/// Characters per subtitle line in the SVG (about 6 px per character at
+/// 10.5 px) and in the PNG (the 8 px bitmap font).
+fn per_line(size: PanelSize, char_width: f64) -> usize {
+    (((size.width - 20.0) / char_width) as usize).max(8)
+}
 
 /// Size of one panel in pixels.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -99,6 +138,8 @@ impl PanelSize {
 
 /// An SVG document with the panels in a grid of `columns` columns.
 pub fn curve_panels(panels: &[Panel], columns: usize, title: &str, size: PanelSize) -> String {
+    let header = Header::of(panels, per_line(size, 6.0), 13.0);
+    let size = header.panel(size);
     let (panel_w, panel_h) = (size.width, size.height);
     let columns = columns.max(1);
     let rows = panels.len().div_ceil(columns);
@@ -121,7 +162,7 @@ pub fn curve_panels(panels: &[Panel], columns: usize, title: &str, size: PanelSi
     for (k, panel) in panels.iter().enumerate() {
         let (col, row) = (k % columns, k / columns);
         let (x0, y0) = (col as f64 * panel_w, top + row as f64 * panel_h);
-        draw_panel(&mut s, panel, x0, y0, k, size);
+        draw_panel(&mut s, panel, (x0, y0), k, size, &header);
     }
     s.push_str("</svg>\n");
     s
@@ -137,7 +178,12 @@ pub(crate) struct PanelLayout {
     pub(crate) ctrl: Vec<(f64, f64)>,
 }
 
-pub(crate) fn panel_layout(panel: &Panel, x0: f64, y0: f64, size: PanelSize) -> PanelLayout {
+pub(crate) fn panel_layout(
+    panel: &Panel,
+    (x0, y0): (f64, f64),
+    size: PanelSize,
+    header: f64,
+) -> PanelLayout {
     let (panel_w, panel_h) = (size.width, size.height);
     let proj = Projection::fit(panel.points);
     let data: Vec<(f64, f64)> = panel.points.iter().map(|p| proj.apply(p)).collect();
@@ -183,11 +229,11 @@ pub(crate) fn panel_layout(panel: &Panel, x0: f64, y0: f64, size: PanelSize) -> 
         )
     };
     let (vw, vh) = ((view.2 - view.0).max(1e-12), (view.3 - view.1).max(1e-12));
-    let (aw, ah) = (panel_w - 2.0 * MARGIN, panel_h - HEADER - 2.0 * MARGIN);
+    let (aw, ah) = (panel_w - 2.0 * MARGIN, panel_h - header - 2.0 * MARGIN);
     let scale = (aw / vw).min(ah / vh);
     let (ox, oy) = (
         x0 + MARGIN + (aw - vw * scale) / 2.0,
-        y0 + HEADER + MARGIN + (ah - vh * scale) / 2.0,
+        y0 + header + MARGIN + (ah - vh * scale) / 2.0,
     );
     let map = |p: &(f64, f64)| (ox + (p.0 - view.0) * scale, oy + (view.3 - p.1) * scale);
     PanelLayout {
@@ -197,13 +243,20 @@ pub(crate) fn panel_layout(panel: &Panel, x0: f64, y0: f64, size: PanelSize) -> 
     }
 }
 
-fn draw_panel(s: &mut String, panel: &Panel, x0: f64, y0: f64, id: usize, size: PanelSize) {
+fn draw_panel(
+    s: &mut String,
+    panel: &Panel,
+    (x0, y0): (f64, f64),
+    id: usize,
+    size: PanelSize,
+    header: &Header,
+) {
     let (panel_w, panel_h) = (size.width, size.height);
     let PanelLayout {
         data,
         samples,
         ctrl,
-    } = panel_layout(panel, x0, y0, size);
+    } = panel_layout(panel, (x0, y0), size, header.height);
     let map = |p: &(f64, f64)| *p;
 
     let _ = writeln!(
@@ -226,9 +279,7 @@ fn draw_panel(s: &mut String, panel: &Panel, x0: f64, y0: f64, id: usize, size: 
     } else {
         "#b00"
     };
-    // about 6 px per character at 10.5 px
-    let per_line = ((panel_w - 20.0) / 6.0) as usize;
-    for (k, line) in wrap(&panel.subtitle, per_line, 2).iter().enumerate() {
+    for (k, line) in header.lines[id].iter().enumerate() {
         let _ = writeln!(
             s,
             r#"<text x="{:.1}" y="{:.1}" font-size="10.5" fill="{colour}">{}</text>"#,
@@ -241,9 +292,9 @@ fn draw_panel(s: &mut String, panel: &Panel, x0: f64, y0: f64, id: usize, size: 
         s,
         r#"<clipPath id="clip{id}"><rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}"/></clipPath><g clip-path="url(#clip{id})">"#,
         x0 + 3.0,
-        y0 + HEADER,
+        y0 + header.height,
         panel_w - 6.0,
-        panel_h - HEADER - 3.0
+        panel_h - header.height - 3.0
     );
     if !ctrl.is_empty() {
         let _ = writeln!(
@@ -289,28 +340,27 @@ fn path(pts: &[(f64, f64)], map: &impl Fn(&(f64, f64)) -> (f64, f64)) -> String 
     out
 }
 
-/// Splits `s` at spaces into at most `max_lines` lines of about `width`
-/// characters; the last line ends in an ellipsis when text is left over.
-fn wrap(s: &str, width: usize, max_lines: usize) -> Vec<String> {
+/// Splits `s` at spaces into lines of at most `width` characters (a word
+/// longer than that is broken into pieces of `width`); every word is kept.
+fn wrap(s: &str, width: usize) -> Vec<String> {
+    let width = width.max(1);
     let mut lines: Vec<String> = Vec::new();
     let mut cur = String::new();
     for word in s.split_whitespace() {
-        if !cur.is_empty() && cur.chars().count() + 1 + word.chars().count() > width {
-            lines.push(std::mem::take(&mut cur));
+        let chars: Vec<char> = word.chars().collect();
+        for piece in chars.chunks(width) {
+            let n = cur.chars().count();
+            if n > 0 && n + 1 + piece.len() > width {
+                lines.push(std::mem::take(&mut cur));
+            }
+            if !cur.is_empty() {
+                cur.push(' ');
+            }
+            cur.extend(piece);
         }
-        if !cur.is_empty() {
-            cur.push(' ');
-        }
-        cur.push_str(word);
     }
     if !cur.is_empty() {
         lines.push(cur);
-    }
-    if lines.len() > max_lines {
-        lines.truncate(max_lines);
-        let last = &mut lines[max_lines - 1];
-        let keep: String = last.chars().take(width.saturating_sub(1)).collect();
-        *last = keep + "…";
     }
     lines
 }
@@ -331,6 +381,9 @@ pub fn curve_panels_png(
     size: PanelSize,
 ) -> crate::Result<Vec<u8>> {
     use crate::render::{draw_text, encode_png, Canvas};
+    // 11 px per line of the bitmap font; its two lines fit in HEADER
+    let header = Header::of(panels, per_line(size, 8.0), 11.0);
+    let size = header.panel(size);
     let columns = columns.max(1);
     let rows = panels.len().div_ceil(columns).max(1);
     let top = if title.is_empty() { 0.0 } else { 30.0 };
@@ -370,11 +423,11 @@ pub fn curve_panels_png(
             top + (k / columns) as f64 * size.height,
         );
         // clip to the panel: draw into a panel-sized view of the layout
-        let l = panel_layout(panel, x0, y0, size);
+        let l = panel_layout(panel, (x0, y0), size, header.height);
         let inside = |p: &(f64, f64)| {
             p.0 >= x0 + 3.0
                 && p.0 <= x0 + size.width - 3.0
-                && p.1 >= y0 + HEADER
+                && p.1 >= y0 + header.height
                 && p.1 <= y0 + size.height - 3.0
         };
         let grey = [140, 140, 140];
@@ -439,10 +492,7 @@ pub fn curve_panels_png(
         } else {
             [180, 0, 0]
         };
-        for (i, s) in wrap(&panel.subtitle, ((size.width - 20.0) / 8.0) as usize, 2)
-            .iter()
-            .enumerate()
-        {
+        for (i, s) in header.lines[k].iter().enumerate() {
             draw_text(&mut canvas, tx, ty + 14 + 11 * i, s, 1, colour);
         }
     }
@@ -501,8 +551,65 @@ mod tests {
     }
 
     #[test]
-    fn wrapping() {
-        assert_eq!(wrap("aa bb cc", 5, 2), vec!["aa bb", "cc"]);
-        assert_eq!(wrap("aa bb cc dd ee", 5, 2), vec!["aa bb", "cc d…"]);
+    fn wrapping_keeps_every_word() {
+        assert_eq!(wrap("aa bb cc", 5), vec!["aa bb", "cc"]);
+        assert_eq!(wrap("aa bb cc dd ee", 5), vec!["aa bb", "cc dd", "ee"]);
+        // a word longer than a line is broken, not cut
+        assert_eq!(wrap("x abcdefgh y", 4), vec!["x", "abcd", "efgh", "y"]);
+        assert!(wrap("", 5).is_empty());
+    }
+
+    /// The text of every subtitle `<text>` element of an SVG, in order.
+    fn subtitle_text(svg: &str) -> String {
+        svg.lines()
+            .filter(|l| l.contains(r#"font-size="10.5""#))
+            .map(|l| l.split('>').nth(1).unwrap().split('<').next().unwrap())
+            .collect::<Vec<_>>()
+            .join(" ")
+    }
+
+    #[test]
+    fn long_subtitles_are_wrapped_whole_and_the_header_grows() {
+        let pts = vec![Point3::new(0., 0., 0.), Point3::new(1., 1., 0.)];
+        let long = "error: exponential parameterization gives coincident parameters at points 3 and 4 (u = 0.49999999999999994 then 0.5); the interpolation matrix would be singular, choose another method (e.g. centripetal)";
+        let panels = vec![
+            Panel {
+                title: "exponential".into(),
+                subtitle: long.into(),
+                points: &pts,
+                curve: None,
+            },
+            Panel {
+                title: "uniform".into(),
+                subtitle: "loops 0".into(),
+                points: &pts,
+                curve: None,
+            },
+        ];
+        let svg = curve_panels(&panels, 2, "", PanelSize::GRID);
+        // every character of both subtitles is in the picture, nothing cut
+        assert_eq!(subtitle_text(&svg), format!("{long} loops 0"));
+        assert!(!svg.contains('…'));
+        // 56 characters a line: the long one needs 4 lines, so the panels
+        // grow by two 13 px lines and the plot area keeps its height
+        let lines = wrap(long, per_line(PanelSize::GRID, 6.0));
+        assert_eq!(lines.len(), 4);
+        assert!(lines.iter().all(|l| l.chars().count() <= 56));
+        assert!(svg.contains(r#"height="336""#), "{}", &svg[..200]);
+        // the last subtitle line sits above the clipped plot area
+        let last_y = 32.0 + 13.0 * 3.0;
+        assert!(svg.contains(&format!(r#"y="{last_y:.1}" font-size="10.5""#)));
+        assert!(svg.contains(r#"<rect x="3.0" y="78.0""#));
+        // a short one keeps the two-line header of 52 px
+        let svg = curve_panels(&panels[1..], 1, "", PanelSize::GRID);
+        assert!(svg.contains(r#"height="310""#));
+        // the PNG grows the same way (8 px characters, 11 px lines: 42 a
+        // line, 5 lines, 3 more than two) and draws all of it
+        let png = curve_panels_png(&panels, 2, "", PanelSize::GRID).unwrap();
+        let r = png::Decoder::new(std::io::Cursor::new(png))
+            .read_info()
+            .unwrap();
+        assert_eq!(wrap(long, per_line(PanelSize::GRID, 8.0)).len(), 5);
+        assert_eq!((r.info().width, r.info().height), (720, 310 + 33));
     }
 }

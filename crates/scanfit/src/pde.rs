@@ -637,6 +637,31 @@ mod tests {
             assert!(b.surface.point(t, 0.0).z.abs() < 1e-15);
             assert!(b.surface.point(1.0, t).z.abs() < 1e-15);
         }
+        // a tolerance out of reach under a cap: the refinement stops at the
+        // last net within the cap and says so, with the deviation it reached
+        let first = fit
+            .surface
+            .to_bspline(&BsplineConversionConfig::new(1.0))
+            .unwrap();
+        let (cu, cv) = first.surface.counts();
+        assert!(!first.capped);
+        let capped = fit
+            .surface
+            .to_bspline(&BsplineConversionConfig {
+                max_control_points: Some(cu * cv + 1),
+                ..BsplineConversionConfig::new(1e-14)
+            })
+            .unwrap();
+        assert!(capped.capped);
+        assert_eq!(capped.surface.counts(), (cu, cv));
+        assert_eq!(capped.max_deviation, first.max_deviation);
+        assert!(capped.max_deviation > 1e-14);
+        // and a cap below the coarsest net is an error naming it
+        let e = fit.surface.to_bspline(&BsplineConversionConfig {
+            max_control_points: Some(cu * cv - 1),
+            ..BsplineConversionConfig::new(1e-14)
+        });
+        assert!(format!("{}", e.unwrap_err()).contains("more than the cap"));
     }
 
     #[test]

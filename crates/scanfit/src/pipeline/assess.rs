@@ -859,7 +859,7 @@ fn rms(d: &[f64]) -> f64 {
 }
 
 /// The axis-aligned bounding box of `points` (`None` when empty).
-fn bounding_box(points: &[Point3]) -> Option<(Point3, Point3)> {
+pub(crate) fn bounding_box(points: &[Point3]) -> Option<(Point3, Point3)> {
     let first = *points.first()?;
     Some(
         points
@@ -951,16 +951,29 @@ pub(crate) fn knot_line_points(surface: &Surface) -> Vec<Point3> {
         .collect()
 }
 
+/// The intervals `(nu, nv)` of the sample grid of `config` for `surface`
+/// (see [`AssessConfig::samples`]).
+pub(crate) fn grid_size(surface: &Surface, config: &AssessConfig) -> (usize, usize) {
+    let (cu, cv) = surface.counts();
+    config
+        .samples
+        .unwrap_or(((cu * 4).clamp(32, 200), (cv * 4).clamp(32, 200)))
+}
+
+/// The distance from each of `queries` to the nearest point of `cloud` (its
+/// KD-tree when built, else KD-trees of chunks, as the assessment queries).
+pub(crate) fn nearest_distances(cloud: &PointCloud, queries: &[Point3]) -> Result<Vec<f64>> {
+    let all = AllPoints::Cloud(cloud);
+    Ok(Index::of(&all, false)?.query(queries, &[])?.0)
+}
+
 /// The sample grid of `config` (intervals `(nu, nv)`) and its surface points.
 pub(crate) fn sample_grid(
     surface: &Surface,
     config: &AssessConfig,
 ) -> Result<((usize, usize), Vec<Point3>)> {
     check(config)?;
-    let (cu, cv) = surface.counts();
-    let (nu, nv) = config
-        .samples
-        .unwrap_or(((cu * 4).clamp(32, 200), (cv * 4).clamp(32, 200)));
+    let (nu, nv) = grid_size(surface, config);
     let ((u0, u1), (v0, v1)) = surface.domain();
     let samples: Vec<Point3> = (0..=nu)
         .flat_map(|i| (0..=nv).map(move |j| (i, j)))

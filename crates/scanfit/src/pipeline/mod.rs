@@ -26,6 +26,8 @@
 //! Modules:
 //!
 //! * [`assess`]: the surface assessment every surface pipeline ends with.
+//! * [`assess_trimmed`]: its surface-to-points half again over a trimmed
+//!   face.
 //! * [`cloud`]: the point-cloud tools (info, normals, hidden point removal,
 //!   boundary and corners).
 //! * [`coons`]: one patch to a surface by the Coons paper (B-spline) or the
@@ -49,6 +51,7 @@
 //! * [`turntable`]: cylinder-like clouds by the virtual turntable.
 
 pub mod assess;
+pub mod assess_trimmed;
 pub mod cloud;
 pub mod coons;
 pub mod curve;
