@@ -101,7 +101,8 @@ pub fn smallest_eigen(a: &[f64; 6]) -> Option<SmallestEigen> {
     let l1 = q + 2.0 * p * phi.cos();
     let l3 = q + 2.0 * p * (phi + third).cos();
     let l2 = 3.0 * q - l1 - l3;
-    if !(l2 - l3 > GAP * (l1 - l3)) {
+    // (finite here: the scaled entries are at most 1 in magnitude)
+    if l2 - l3 <= GAP * (l1 - l3) {
         return None;
     }
     let v = null_vector(&m, l3)?;
