@@ -95,36 +95,69 @@ impl Pca {
     /// Surface variation `l3 / (l1 + l2 + l3)` (Pauly et al. 2002): 0 on a
     /// plane, 1/3 for isotropic noise; a cheap curvature/noise indicator.
     pub fn variation(&self) -> f64 {
-        let s = self.values[0] + self.values[1] + self.values[2];
-        if s > 0.0 {
-            self.values[2].max(0.0) / s
-        } else {
-            0.0
-        }
+        surface_variation(&self.values)
     }
+}
+
+/// [`Pca::variation`] of eigenvalues `l1 >= l2 >= l3`.
+pub(crate) fn surface_variation(values: &[f64; 3]) -> f64 {
+    let s = values[0] + values[1] + values[2];
+    if s > 0.0 {
+        values[2].max(0.0) / s
+    } else {
+        0.0
+    }
+}
+
+/// Centroid and covariance of `points` (`None` for no points), the
+/// covariance as `[c00, c11, c22, c01, c02, c12]`. It is accumulated about
+/// the first point and then re-centred, which keeps it accurate for
+/// coordinates far from the origin (georeferenced scans).
+pub(crate) fn covariance(points: impl IntoIterator<Item = Vector3>) -> Option<(Point3, [f64; 6])> {
+    let mut it = points.into_iter();
+    let first = it.next()?;
+    let (mut n, mut sum, mut c) = (1.0, Vector3::zeros(), [0.0; 6]);
+    for p in it {
+        let d = p - first;
+        sum += d;
+        c[0] += d.x * d.x;
+        c[1] += d.y * d.y;
+        c[2] += d.z * d.z;
+        c[3] += d.x * d.y;
+        c[4] += d.x * d.z;
+        c[5] += d.y * d.z;
+        n += 1.0;
+    }
+    let m = sum / n;
+    let cov = [
+        c[0] / n - m.x * m.x,
+        c[1] / n - m.y * m.y,
+        c[2] / n - m.z * m.z,
+        c[3] / n - m.x * m.y,
+        c[4] / n - m.x * m.z,
+        c[5] / n - m.y * m.z,
+    ];
+    Some((Point3::from(first + m), cov))
 }
 
 /// PCA of `points` (`None` for no points). The covariance is accumulated
 /// about the first point and then re-centred, which keeps it accurate for
 /// coordinates far from the origin (georeferenced scans).
 pub fn pca<'a>(points: impl IntoIterator<Item = &'a Point3>) -> Option<Pca> {
-    let mut it = points.into_iter();
-    let first = it.next()?.coords;
-    let (mut n, mut sum, mut cov) = (1.0, Vector3::zeros(), nalgebra::Matrix3::zeros());
-    for p in it {
-        let d = p.coords - first;
-        sum += d;
-        cov += d * d.transpose();
-        n += 1.0;
-    }
-    let mean = sum / n;
-    let cov = cov / n - mean * mean.transpose();
+    let (centroid, cov) = covariance(points.into_iter().map(|p| p.coords))?;
+    Some(pca_of(centroid, &cov))
+}
+
+/// The PCA of a covariance from [`covariance`] (nalgebra's iterative
+/// symmetric eigen solver).
+pub(crate) fn pca_of(centroid: Point3, c: &[f64; 6]) -> Pca {
+    let cov = nalgebra::Matrix3::new(c[0], c[3], c[4], c[3], c[1], c[5], c[4], c[5], c[2]);
     let eig = nalgebra::SymmetricEigen::new(cov);
     let mut idx = [0usize, 1, 2];
     idx.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]));
-    Some(Pca {
-        centroid: Point3::from(first + mean),
+    Pca {
+        centroid,
         values: idx.map(|i| eig.eigenvalues[i]),
         axes: idx.map(|i| eig.eigenvectors.column(i).into()),
-    })
+    }
 }

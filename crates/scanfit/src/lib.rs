@@ -39,6 +39,7 @@
 //! * [`surface`]: capability traits, [`surface::ParametricSurface`] (B-spline,
 //!   Coons, PDE) and [`surface::ParametricCurve`].
 //! * [`spatial`]: the one KD-tree every neighbour query uses.
+//! * [`eigen3`]: the closed-form symmetric 3 x 3 eigen solver of the normals.
 //! * [`par`]: the thread-count knob and the deterministic parallel sums.
 
 pub mod base;
@@ -46,6 +47,7 @@ pub mod bspline;
 pub mod centring;
 pub mod cloud;
 pub mod distribution;
+pub mod eigen3;
 mod error;
 pub mod fit;
 mod geom;

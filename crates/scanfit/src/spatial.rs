@@ -246,6 +246,14 @@ impl KdTree {
         &self.ids
     }
 
+    /// The indexed points' coordinates in the tree's order: those of the
+    /// point `spatial_order()[t]` at `t` (copies of the input, bit for bit).
+    /// Batch work that follows the tree order reads a point's neighbours
+    /// here, close in memory, instead of scattered over the input.
+    pub(crate) fn points_in_order(&self) -> &[[f64; 3]] {
+        &self.pts
+    }
+
     /// The `k` nearest *other* indexed points of every indexed point, as
     /// rows in input order (`k` indices and `k` distances each, nearest
     /// first): among the `k + 1` nearest of a point, the point itself (or,

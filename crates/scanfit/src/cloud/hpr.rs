@@ -34,7 +34,7 @@
 
 use std::collections::HashSet;
 
-use super::hull::convex_hull;
+use super::hull::hull_of_coordinates;
 use crate::{validate_points, Error, Point3, Result};
 
 /// Parameters of [`hidden_point_removal`].
@@ -93,8 +93,7 @@ pub fn hidden_point_removal(
             "hidden point removal: gamma = {gamma} is outside (0, 12]; the flipping radius R = max|p - C| * 10^gamma must exceed every distance (the default is 2)"
         )));
     }
-    let rel: Vec<_> = points.iter().map(|p| p - viewpoint).collect();
-    let norms: Vec<f64> = rel.iter().map(|v| v.norm()).collect();
+    let norms: Vec<f64> = points.iter().map(|p| (p - viewpoint).norm()).collect();
     let max_norm = norms.iter().copied().fold(0.0, f64::max);
     if let Some(i) = norms
         .iter()
@@ -107,13 +106,16 @@ pub fn hidden_point_removal(
     }
     let radius = max_norm * 10f64.powf(gamma);
     // Katz et al. eq. 1: p' = p + 2 (R - |p|) p / |p| = p (2R / |p| - 1)
-    let mut flipped: Vec<Point3> = rel
-        .iter()
-        .zip(&norms)
-        .map(|(v, &d)| Point3::from(v * (2.0 * radius / d - 1.0)))
-        .collect();
-    flipped.push(Point3::origin());
-    let hull = convex_hull(&flipped)
+    let mut flipped: Vec<[f64; 3]> = Vec::with_capacity(points.len() + 1);
+    flipped.extend(points.iter().zip(&norms).map(|(p, &d)| {
+        let v = (p - viewpoint) * (2.0 * radius / d - 1.0);
+        [v.x, v.y, v.z]
+    }));
+    flipped.push([0.0; 3]);
+    drop(norms);
+    // the points and the viewpoint are finite (checked above), so are the
+    // flipped points (|p'| < 2R)
+    let hull = hull_of_coordinates(flipped)
         .map_err(|e| Error::InvalidInput(format!("hidden point removal: {e}")))?;
     let n = points.len();
     let mut visible: Vec<usize> = hull.vertices.into_iter().filter(|&i| i < n).collect();

@@ -255,26 +255,29 @@ pub fn convex_hull(points: &[Point3]) -> Result<ConvexHull> {
             what: "a 3D convex hull".into(),
         });
     }
-    if points.len() >= NIL as usize {
+    let p: Vec<[f64; 3]> = points.iter().map(|q| [q.x, q.y, q.z]).collect();
+    hull_of_coordinates(p)
+}
+
+/// [`convex_hull`] of points given as coordinate triples, already checked
+/// to be at least 4 and finite; they are scaled in place.
+pub(crate) fn hull_of_coordinates(mut p: Vec<[f64; 3]>) -> Result<ConvexHull> {
+    if p.len() >= NIL as usize {
         return Err(Error::InvalidInput(format!(
             "{} points exceed the convex hull's limit of 2^32 - 1; thin the cloud",
-            points.len()
+            p.len()
         )));
     }
     // scale by a power of two (exact) so that orient3d's products cannot overflow
-    let max_abs = points
-        .iter()
-        .flat_map(|p| p.coords.iter().map(|c| c.abs()))
-        .fold(0.0f64, f64::max);
+    let max_abs = p.iter().flatten().fold(0.0f64, |m, c| m.max(c.abs()));
     let scale = if max_abs > 0.0 {
         2f64.powi(-(max_abs.log2().ceil() as i32))
     } else {
         1.0
     };
-    let p: Vec<[f64; 3]> = points
-        .iter()
-        .map(|q| [q.x * scale, q.y * scale, q.z * scale])
-        .collect();
+    for q in &mut p {
+        *q = q.map(|c| c * scale);
+    }
     let simplex = initial_simplex(&p)?;
     let faces = quickhull(&p, simplex)?;
     let mut is_vertex = vec![false; p.len()];

@@ -21,7 +21,16 @@
 //!   it; with Hoppe's cost such an edge is free and flips everything after
 //!   it (a bust's body points inward while its head points outward).
 //!   [`Normals::disagreement`] measures what is left.
-//! * [`Orientation::None`]: the eigen solver's signs.
+//! * [`Orientation::None`]: the eigen solver's signs (arbitrary: the
+//!   closed form of [`crate::eigen3`] turns the largest component positive,
+//!   nalgebra's iterative solver, used where the smallest eigenvalue is not
+//!   separated, leaves its own).
+//!
+//! The normal is the smallest eigenvector by the closed form of
+//! [`crate::eigen3`] (within 1e-11 rad of nalgebra's iterative
+//! `SymmetricEigen`; on the 10^6-point panel of BENCHMARKS.md the normals
+//! differ from the iterative solver's by at most 9e-14 rad), or by the
+//! iterative solver where the closed form declines.
 
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -31,8 +40,9 @@ use rayon::prelude::*;
 use super::forest::Forest;
 use super::neighbours::Neighbourhoods;
 use super::PointCloud;
-use crate::spatial::map_in_order;
-use crate::{pca, Error, Point3, Result, Vector3};
+use crate::eigen3::{least_aligned_axis, smallest_eigen};
+use crate::geom::{covariance, pca_of, surface_variation};
+use crate::{Error, Point3, Result, Vector3};
 
 /// How to choose the sign of each normal.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -143,31 +153,56 @@ pub fn estimate_normals_on(
         });
     }
     let points = cloud.points();
+    let n = points.len();
     let scale = cloud.diagonal();
-    // visited in the tree order: a point's neighbours are in the cache
-    // from its predecessor's
-    let order = cloud.tree()?.spatial_order();
-    let per_point: Vec<(Vector3, f64, bool)> = map_in_order(order, |i| {
-        let nb = graph.indices_of(i);
-        let hood = std::iter::once(&points[i]).chain(nb.iter().map(|&j| &points[j as usize]));
-        match pca(hood) {
-            Some(p) => {
-                let flat = p.values[1] <= 1e-24 * scale * scale;
-                let n = if flat {
-                    // collinear neighbourhood: any perpendicular of the line
-                    p.axes[0].cross(&least_aligned_axis(&p.axes[0])).normalize()
-                } else {
-                    p.axes[2]
-                };
-                (n, p.variation(), flat)
+    // the work runs in the tree's order on the tree's copy of the points: a
+    // point's neighbours lie close to it there (in the input they may lie
+    // anywhere), and `at` (4 bytes a point) maps an input index to its place
+    let tree = cloud.tree()?;
+    let order = tree.spatial_order();
+    let pts = tree.points_in_order();
+    let mut at = vec![0u32; n];
+    for (t, &i) in order.iter().enumerate() {
+        at[i as usize] = t as u32;
+    }
+    let coords = |t: usize| Vector3::from(pts[t]);
+    let flat_below = 1e-24 * scale * scale;
+    let per_point: Vec<(Vector3, f64, bool)> = (0..n)
+        .into_par_iter()
+        .with_min_len(1024)
+        .map(|t| {
+            let nb = graph.indices_of(order[t] as usize);
+            let hood = std::iter::once(coords(t))
+                .chain(nb.iter().map(|&j| coords(at[j as usize] as usize)));
+            let Some((centroid, cov)) = covariance(hood) else {
+                return (Vector3::z(), 0.0, true);
+            };
+            // the closed form where the smallest eigenvalue stands apart
+            // (nearly every neighbourhood of a surface), else the iterative solver
+            if let Some(e) = smallest_eigen(&cov).filter(|e| e.values[1] > flat_below) {
+                return (e.vector, surface_variation(&e.values), false);
             }
-            None => (Vector3::z(), 0.0, true),
-        }
-    });
-    let mut normals: Vec<Vector3> = per_point.iter().map(|t| t.0).collect();
-    let variation = per_point.iter().map(|t| t.1).collect();
-    let degenerate = (0..points.len()).filter(|&i| per_point[i].2).collect();
+            let p = pca_of(centroid, &cov);
+            let flat = p.values[1] <= flat_below;
+            let n = if flat {
+                // collinear neighbourhood: any perpendicular of the line
+                p.axes[0].cross(&least_aligned_axis(&p.axes[0])).normalize()
+            } else {
+                p.axes[2]
+            };
+            (n, p.variation(), flat)
+        })
+        .collect();
+    // back to the input order
+    let mut normals = vec![Vector3::zeros(); n];
+    let mut variation = vec![0.0; n];
+    let mut flat = vec![false; n];
+    for (&i, r) in order.iter().zip(&per_point) {
+        let i = i as usize;
+        (normals[i], variation[i], flat[i]) = *r;
+    }
     drop(per_point);
+    let degenerate = (0..n).filter(|&i| flat[i]).collect();
     let mut components = 0;
     match config.orientation {
         Orientation::None => {}
@@ -193,7 +228,10 @@ pub fn estimate_normals_on(
     }
     let disagreement = match config.orientation {
         Orientation::None => None,
-        _ => disagreement(points, graph, &normals, order),
+        _ => {
+            let in_order: Vec<Vector3> = order.iter().map(|&i| normals[i as usize]).collect();
+            disagreement(pts, &at, graph, &in_order, order)
+        }
     };
     Ok(Normals {
         normals,
@@ -205,27 +243,31 @@ pub fn estimate_normals_on(
 }
 
 /// The share of same-sheet neighbour pairs whose normals disagree (see
-/// [`Normals::disagreement`]).
+/// [`Normals::disagreement`]), over the points and normals in the tree's
+/// order (`pts[t]`, `normals[t]` of the input point `order[t]`; `at` maps
+/// an input index to its place).
 fn disagreement(
-    points: &[Point3],
+    pts: &[[f64; 3]],
+    at: &[u32],
     graph: &super::neighbours::Neighbourhoods,
     normals: &[Vector3],
     order: &[u32],
 ) -> Option<f64> {
-    let (pairs, bad) = order
-        .par_chunks(1024)
-        .flat_map_iter(|chunk| chunk.iter().map(|&i| i as usize))
-        .map(|i| {
+    let (pairs, bad) = (0..pts.len())
+        .into_par_iter()
+        .with_min_len(1024)
+        .map(|t| {
             let (mut pairs, mut bad) = (0usize, 0usize);
-            for &j in graph.indices_of(i) {
-                let j = j as usize;
-                let d = points[j] - points[i];
+            let p = Vector3::from(pts[t]);
+            for &j in graph.indices_of(order[t] as usize) {
+                let s = at[j as usize] as usize;
+                let d = Vector3::from(pts[s]) - p;
                 let len = d.norm();
                 if len == 0.0 {
                     continue;
                 }
                 let d = d / len;
-                let (a, b) = (normals[i], normals[j]);
+                let (a, b) = (normals[t], normals[s]);
                 if a.dot(&d).abs() < 0.5 && b.dot(&d).abs() < 0.5 && a.dot(&b).abs() > 0.5 {
                     pairs += 1;
                     bad += usize::from(a.dot(&b) < 0.0);
@@ -235,17 +277,6 @@ fn disagreement(
         })
         .reduce(|| (0, 0), |x, y| (x.0 + y.0, x.1 + y.1));
     (pairs > 0).then(|| bad as f64 / pairs as f64)
-}
-
-fn least_aligned_axis(v: &Vector3) -> Vector3 {
-    let a = v.abs();
-    if a.x <= a.y && a.x <= a.z {
-        Vector3::x()
-    } else if a.y <= a.z {
-        Vector3::y()
-    } else {
-        Vector3::z()
-    }
 }
 
 /// Undirected adjacency of the k-NN graph in compressed rows: the

@@ -276,6 +276,7 @@ pub fn turntable(
         }
     }
     let uv = raw;
+    drop(inv);
     stage(6);
     let fitted_points: Vec<bool> = match cfg.ends {
         Ends::Exclude => inside.clone(),
@@ -306,6 +307,7 @@ pub fn turntable(
             ]
         })
         .collect();
+    drop(feet);
     let pick = |mask: &[bool]| -> Vec<f64> {
         distances
             .iter()
@@ -317,17 +319,28 @@ pub fn turntable(
     let errors = ErrorStats::of(&pick(&fitted_points));
     let errors_all = ErrorStats::of(&distances);
     let surface_to_cloud = surface_to_cloud(cloud, &surface)?;
-    let quality = parameterization_quality(&surface, &fp, &fuv)?;
-    let (pin, uvin) = subset(&inside);
-    let quality_inside = parameterization_quality(&surface, &pin, &uvin)?;
-    let (fp2, fuv2): (Vec<Point3>, Vec<[f64; 2]>) = points
+    // the fold-overs and stretch with the base surface's parameters and with
+    // the fitted surface's: two Delaunay triangulations of the parameters
+    // (serial each), side by side
+    let fuv2: Vec<[f64; 2]> = uv_fitted
         .iter()
-        .zip(&uv_fitted)
         .zip(&fitted_points)
         .filter(|(_, &m)| m)
-        .map(|((p, t), _)| (*p, *t))
-        .unzip();
-    let quality_fitted = parameterization_quality(&surface, &fp2, &fuv2)?;
+        .map(|(t, _)| *t)
+        .collect();
+    let (quality, quality_fitted) = rayon::join(
+        || parameterization_quality(&surface, &fp, &fuv),
+        || parameterization_quality(&surface, &fp, &fuv2),
+    );
+    let (quality, quality_fitted) = (quality?, quality_fitted?);
+    // with Ends::Exclude the fitted points are the inside ones: the same
+    // measure on the same points (measured once)
+    let quality_inside = if inside == fitted_points {
+        quality
+    } else {
+        let (pin, uvin) = subset(&inside);
+        parameterization_quality(&surface, &pin, &uvin)?
+    };
     Ok(Turntable {
         frame,
         views,

@@ -23,6 +23,8 @@
 
 use std::f64::consts::PI;
 
+use rayon::prelude::*;
+
 use crate::cloud::hpr::{hidden_point_removal, HprConfig};
 use crate::mba::{mba, Mba, MbaConfig};
 use crate::{Error, Point3, Result, Vector3};
@@ -150,7 +152,10 @@ pub fn turntable_views(
             cfg.view_distance
         )));
     }
-    (0..cfg.views)
+    // the views are independent: their hulls (serial each) run side by side;
+    // collected in view order, the first failing view's error is returned
+    let views: Vec<Result<View>> = (0..cfg.views)
+        .into_par_iter()
         .map(|k| {
             let angle = 2.0 * PI * k as f64 / cfg.views as f64;
             let (u, w) = turn_directions(frame, angle);
@@ -178,7 +183,8 @@ pub fn turntable_views(
             };
             Ok(view)
         })
-        .collect()
+        .collect();
+    views.into_iter().collect()
 }
 
 /// Wraps an angle into `(-pi, pi]`.
