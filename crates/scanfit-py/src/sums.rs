@@ -39,7 +39,7 @@ use crate::surfaces::{fit_config, mba_config};
 
 /// The points of a chunk: an `(N, 3)` array, `N = 0` allowed (an empty
 /// chunk adds nothing).
-fn chunk(obj: &Bound<'_, PyAny>) -> PyResult<Vec<Point3>> {
+pub(crate) fn chunk(obj: &Bound<'_, PyAny>) -> PyResult<Vec<Point3>> {
     let a = float_array(obj, "points")?;
     if a.shape() == [0, 3] {
         return Ok(Vec::new());
@@ -49,7 +49,11 @@ fn chunk(obj: &Bound<'_, PyAny>) -> PyResult<Vec<Point3>> {
 
 /// `(cls_restore, (kind, bytes))` for `__reduce__`: pickled as the exact
 /// bytes, restored by `scanfit.sums._restore`.
-fn reduce<'py>(py: Python<'py>, kind: &str, bytes: &[u8]) -> PyResult<Bound<'py, PyTuple>> {
+pub(crate) fn reduce<'py>(
+    py: Python<'py>,
+    kind: &str,
+    bytes: &[u8],
+) -> PyResult<Bound<'py, PyTuple>> {
     let restore = py.import("scanfit.sums")?.getattr("_restore")?;
     let args = PyTuple::new(
         py,
@@ -62,7 +66,7 @@ fn reduce<'py>(py: Python<'py>, kind: &str, bytes: &[u8]) -> PyResult<Bound<'py,
 }
 
 /// Reads a Python record: the tag, then `f` on the reader, then the end.
-fn read<T>(
+pub(crate) fn read<T>(
     bytes: &[u8],
     tag: &[u8; 8],
     what: &'static str,
@@ -87,7 +91,7 @@ fn read<T>(
 pub struct PyCentring {
     lo: Vector3,
     hi: Vector3,
-    inner: Centring,
+    pub(crate) inner: Centring,
 }
 
 impl PyCentring {
@@ -96,13 +100,13 @@ impl PyCentring {
         Self { lo, hi, inner }
     }
 
-    fn write(&self, w: &mut Writer) {
+    pub(crate) fn write(&self, w: &mut Writer) {
         for x in self.lo.iter().chain(self.hi.iter()) {
             w.f64(*x);
         }
     }
 
-    fn read(r: &mut Reader<'_>) -> scanfit::Result<Self> {
+    pub(crate) fn read(r: &mut Reader<'_>) -> scanfit::Result<Self> {
         let mut v = [0.0; 6];
         for x in &mut v {
             *x = r.f64()?;
@@ -114,7 +118,7 @@ impl PyCentring {
     }
 
     /// `points` moved by `-centre`.
-    fn apply(&self, points: Vec<Point3>) -> Vec<Point3> {
+    pub(crate) fn apply(&self, points: Vec<Point3>) -> Vec<Point3> {
         if self.inner.is_identity() {
             points
         } else {
@@ -254,7 +258,7 @@ impl PyFrameSums {
 #[pyclass(name = "ResidualSums", module = "scanfit.sums")]
 #[derive(Clone, Default)]
 pub struct PyResidualSums {
-    inner: ResidualSums,
+    pub(crate) inner: ResidualSums,
 }
 
 #[pymethods]
@@ -586,7 +590,8 @@ impl PyMbaLevels {
         if levels == 0 {
             return Err(value_err("levels must be at least 1".into()));
         }
-        let config = mba_config(levels, base.as_ref(), tolerance, hjelle)?;
+        // the mean: the start whose sums the level loop keeps exact
+        let config = mba_config(levels, base.as_ref(), tolerance, hjelle, "mean")?;
         let f = match domain {
             None => frame.inner.finish().map_err(err)?,
             Some((x0, y0, x1, y1)) => {
@@ -711,9 +716,9 @@ impl PyMbaLevels {
 #[pyclass(name = "NormalEquations", module = "scanfit.sums")]
 #[derive(Clone)]
 pub struct PyNormalEquations {
-    inner: NormalEquations,
-    smoothing: f64,
-    centring: PyCentring,
+    pub(crate) inner: NormalEquations,
+    pub(crate) smoothing: f64,
+    pub(crate) centring: PyCentring,
 }
 
 const NORMAL_TAG: &[u8; 8] = b"SFPYNEQ1";
