@@ -2,7 +2,7 @@
 process, bytes per worker per level (issue 17; BENCHMARKS.md, docs/scale-out.md).
 
     python benches/scale/dask_mba.py N [--chunk 1000000] [--levels 10] [--workers 2] [--single]
-        [--ply FILE] [--compare JSON]
+        [--base MxN] [--ply FILE] [--compare JSON]
 
 The points are generated on the workers (a deterministic terrain per chunk, seeded
 by the chunk's index), so nothing is read or sent by the client; with --ply FILE
@@ -70,6 +70,7 @@ def main():
     ap.add_argument("--levels", type=int, default=10)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--single", action="store_true")
+    ap.add_argument("--base", help="cells of the first lattice, MxN (as the CLI's --base)")
     ap.add_argument("--ply")
     ap.add_argument("--compare")
     a = ap.parse_args()
@@ -106,7 +107,8 @@ def main():
     ) as cluster, Client(cluster) as client:
         sent0 = client.run(lambda dask_worker: dask_worker.transfer_outgoing_bytes_total)
         t0 = time.perf_counter()
-        r = sd.mba(points, levels=a.levels)
+        base = tuple(int(v) for v in a.base.split("x")) if a.base else None
+        r = sd.mba(points, levels=a.levels, base=base)
         out["dask_seconds"] = time.perf_counter() - t0
         sent1 = client.run(lambda dask_worker: dask_worker.transfer_outgoing_bytes_total)
         out["dask_passes"] = r["passes"]
@@ -128,7 +130,7 @@ def main():
     if a.single:
         pts = np.concatenate([terrain_block(k, rows, a.n) for k, rows in enumerate(sizes)])
         t0 = time.perf_counter()
-        once = scanfit.mba(pts, levels=a.levels)
+        once = scanfit.mba(pts, levels=a.levels, base=base)
         out["single_seconds"] = time.perf_counter() - t0
         out["single_peak_rss_mb"] = peak_rss_mb()
         b = once["surface"].control_points

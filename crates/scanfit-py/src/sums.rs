@@ -28,14 +28,13 @@ use scanfit::mba::{
     lattice_surface, BaAccumulator, ControlFormula, Frame, FrameSums, Lattice, MbaLevels,
     ResidualSums,
 };
-use scanfit::pipeline::stream::check_fit;
 use scanfit::wire::{Reader, Writer};
 use scanfit::{Point3, Vector3};
 
 use crate::convert::{err, float_array, points, uv_columns, value_err, vec3};
 use crate::geometry::PySurface;
 use crate::report::stats;
-use crate::surfaces::{fit_config, mba_config};
+use crate::surfaces::mba_config;
 
 /// The points of a chunk: an `(N, 3)` array, `N = 0` allowed (an empty
 /// chunk adds nothing).
@@ -702,16 +701,14 @@ impl PyMbaLevels {
     }
 }
 
-/// The normal equations of the least-squares surface with uniform knots,
-/// configured by ``fit_surface``'s keywords for ``count`` points (the net
-/// from the density and the smoothing scaled to the data exactly as
-/// ``fit_surface`` resolves them); settings that need all points at once
-/// (``params="plane"``, ``knots="distribution"``, ``correct > 0``) are a
-/// ``ScanfitError`` saying why.
+/// The normal equations of the least-squares surface ([NURBS97] eq. 9.63)
+/// for ``fit_surface``'s keywords: made empty by ``FitSetup.equations()``
+/// (uniform knots, or those of a finished ``KnotSearch``), fed chunks of
+/// points with their parameters, merged, finished.
 ///
 /// Example::
 ///
-///     >>> eq = scanfit.sums.NormalEquations(len(pts), centring, ctrl=(8, 8), params="uv", knots="uniform")
+///     >>> eq = scanfit.sums.FitSetup(len(pts), centring, ctrl=(8, 8), params="uv", knots="uniform").equations()
 ///     >>> eq.add(pts, uv); eq.finish()
 #[pyclass(name = "NormalEquations", module = "scanfit.sums")]
 #[derive(Clone)]
@@ -738,39 +735,6 @@ impl PyNormalEquations {
 
 #[pymethods]
 impl PyNormalEquations {
-    /// Empty equations (see the class documentation).
-    #[new]
-    #[pyo3(signature = (count, centring, ctrl = None, degree = None, params = "plane", knots = "distribution", smooth = None, periodic_u = false, correct = 0))]
-    #[allow(clippy::too_many_arguments)]
-    fn new(
-        count: usize,
-        centring: &PyCentring,
-        ctrl: Option<Bound<'_, PyAny>>,
-        degree: Option<Bound<'_, PyAny>>,
-        params: &str,
-        knots: &str,
-        smooth: Option<f64>,
-        periodic_u: bool,
-        correct: usize,
-    ) -> PyResult<Self> {
-        let cfg = fit_config(
-            ctrl.as_ref(),
-            degree.as_ref(),
-            params,
-            knots,
-            smooth,
-            periodic_u,
-            correct,
-        )?;
-        check_fit(&cfg).map_err(err)?;
-        let fit = cfg.resolved_fit(count);
-        Ok(Self {
-            inner: fit.uniform_equations().map_err(err)?,
-            smoothing: fit.smoothing,
-            centring: centring.clone(),
-        })
-    }
-
     /// Adds an ``(N, 3)`` chunk (``N = 0`` allowed) with its ``(N, 2)``
     /// parameters.
     fn add(

@@ -263,7 +263,7 @@ def test_accumulators_pickle_exactly_and_merge_as_one_pass():
         S.BaSums.from_bytes(b"not sums at all")
     with pytest.raises(scanfit.ScanfitError, match="cut short"):
         S.BaSums.from_bytes(b2.to_bytes()[:-9])
-    eq = S.NormalEquations(100, c, ctrl=6, params="uv", knots="uniform")
+    eq = S.FitSetup(100, c, ctrl=6, params="uv", knots="uniform").equations()
     assert pickle.loads(pickle.dumps(eq)).to_bytes() == eq.to_bytes()
 
 
@@ -323,7 +323,7 @@ def test_plane_knot_and_correction_sums_by_hand_equal_the_single_process_fit():
     assert nxt.rounds == 1 and nxt.plane
     with pytest.raises(scanfit.ScanfitError, match="no fitted surface"):
         nxt.corrected()
-    with pytest.raises(scanfit.ScanfitError, match="another stage"):
+    with pytest.raises(scanfit.ScanfitError, match="different stages"):
         S.PlanePasses(c, p[0], len(p)).stage().accumulator().merge(
             S.PlaneSums.from_bytes(over(parts, task, stage).to_bytes())
         )

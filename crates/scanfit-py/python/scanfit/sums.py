@@ -17,12 +17,11 @@ additions (about 1e-15 relative).
   ``push(sums)`` finishes the level, ``finish()`` the surface.
 - ``BaSums``: one level's sums; ``add(state, points)`` returns the residual
   statistics of the level before (``ResidualSums``).
-- ``NormalEquations(count, centring, ...)``: ``fit_surface``'s keywords, uniform
-  knots; ``add(points, uv)``, ``merge``, ``finish() -> Surface``.
 - ``FitSetup(count, centring, ...)``: ``fit_surface``'s keywords resolved for
   ``count`` points; ``knot_search()`` (``KnotSearch``: the exact order statistics
   behind the distribution knots, NURBS Book eq. 9.69, in rounds of ``RankQuery``
-  / ``RankCounts``), ``equations(search)`` (empty ``NormalEquations``).
+  / ``RankCounts``), ``equations(search=None)`` (empty ``NormalEquations``).
+- ``NormalEquations``: ``add(points, uv)``, ``merge``, ``finish() -> Surface``.
 - ``PlanePasses(centring, first, count)``: the best-fit plane (``params="plane"``)
   in three passes of ``PlaneStage`` / ``PlaneSums`` (covariance, hull, extents).
 - ``Parameterization``: a chunk's ``(u, v)`` (plane or given), re-projected

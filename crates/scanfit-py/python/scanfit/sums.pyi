@@ -109,20 +109,8 @@ class MbaLevels:
         """``surface``, ``cells``, ``levels``."""
 
 class NormalEquations:
-    """The least-squares surface's normal equations (NURBS Book eq. 9.63)."""
+    """The least-squares surface's normal equations (NURBS Book eq. 9.63); made by FitSetup.equations()."""
 
-    def __init__(
-        self,
-        count: int,
-        centring: Centring,
-        ctrl: Optional[Pair] = None,
-        degree: Optional[Pair] = None,
-        params: str = "plane",
-        knots: str = "distribution",
-        smooth: Optional[float] = None,
-        periodic_u: bool = False,
-        correct: int = 0,
-    ) -> None: ...
     def add(self, points: ArrayLike, uv: ArrayLike) -> None: ...
     def copy(self) -> "NormalEquations": ...
     def merge(self, other: "NormalEquations") -> None: ...
