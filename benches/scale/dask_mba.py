@@ -2,7 +2,7 @@
 process, bytes per worker per level (issue 17; BENCHMARKS.md, docs/scale-out.md).
 
     python benches/scale/dask_mba.py N [--chunk 1000000] [--levels 10] [--workers 2] [--single]
-        [--base MxN] [--ply FILE] [--compare JSON]
+        [--base MxN] [--ply FILE] [--compare JSON] [--save JSON]
 
 The points are generated on the workers (a deterministic terrain per chunk, seeded
 by the chunk's index), so nothing is read or sent by the client; with --ply FILE
@@ -10,8 +10,8 @@ by the chunk's index), so nothing is read or sent by the client; with --ply FILE
 worker reads its chunks' rows of that file itself instead (the input the CLI
 reads). --single also runs scanfit.mba in this process on the same points (they
 must fit in memory) and compares the surfaces; --compare JSON compares with the
-surface of a `scanfit mba -o JSON` run (e.g. the streaming CLI's, run.py). Prints
-one JSON line.
+surface of a `scanfit mba -o JSON` run (e.g. the streaming CLI's, run.py); --save
+JSON writes the Dask surface (scanfit/1 JSON) to compare later. Prints one JSON line.
 """
 
 import argparse
@@ -73,6 +73,7 @@ def main():
     ap.add_argument("--base", help="cells of the first lattice, MxN (as the CLI's --base)")
     ap.add_argument("--ply")
     ap.add_argument("--compare")
+    ap.add_argument("--save")
     a = ap.parse_args()
 
     import dask.array as da
@@ -120,6 +121,8 @@ def main():
         out["client_peak_rss_mb_after_dask"] = peak_rss_mb()
         out["vertical_rmse"] = r["vertical"]["rmse"]
         dask_ctrl = r["surface"].control_points
+        if a.save:
+            r["surface"].to_json(a.save)
     if a.compare:
         b = scanfit.Surface.read_json(a.compare).control_points
         scale = np.abs(b).reshape(-1, 3).max(axis=0)
