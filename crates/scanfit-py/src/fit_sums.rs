@@ -46,7 +46,7 @@ enum Stage {
     /// The convex hull in the plane of these axes.
     Hull(PlaneAxes),
     /// The extents along the rectangle's axes.
-    Extents(PlaneExtents),
+    Extents(Box<PlaneExtents>),
 }
 
 const STAGE_TAG: &[u8; 8] = b"SFPYPLS1";
@@ -145,7 +145,9 @@ impl PyPlaneStage {
                 Stage::Hull(a)
             }
             // tag, centring (6 values), kind: the extents' record follows
-            2 => Stage::Extents(PlaneExtents::from_bytes(&data[8 + 6 * 8 + 8..]).map_err(err)?),
+            2 => Stage::Extents(Box::new(
+                PlaneExtents::from_bytes(&data[8 + 6 * 8 + 8..]).map_err(err)?,
+            )),
             x => return Err(err(r.corrupt(&format!("plane stage {x}")))),
         };
         Ok(Self { centring, stage })
@@ -169,7 +171,7 @@ impl PyPlaneStage {
 enum Sums {
     Moments(CovarianceSums),
     Hull(FlatHull),
-    Extents(PlaneExtents),
+    Extents(Box<PlaneExtents>),
 }
 
 const PLANE_SUMS_TAG: &[u8; 8] = b"SFPYPLA1";
@@ -261,7 +263,7 @@ impl PyPlaneSums {
         let inner = match kind {
             0 => Sums::Moments(CovarianceSums::from_bytes(rest).map_err(err)?),
             1 => Sums::Hull(FlatHull::from_bytes(rest).map_err(err)?),
-            2 => Sums::Extents(PlaneExtents::from_bytes(rest).map_err(err)?),
+            2 => Sums::Extents(Box::new(PlaneExtents::from_bytes(rest).map_err(err)?)),
             x => return Err(err(r.corrupt(&format!("plane sums kind {x}")))),
         };
         Ok(Self { inner })
@@ -349,7 +351,8 @@ impl PyPlanePasses {
                 self.stage = Stage::Hull(PlaneAxes::of(&pca).map_err(err)?);
             }
             (Stage::Hull(a), Sums::Hull(h)) => {
-                self.stage = Stage::Extents(PlaneExtents::new(a, h.rectangle_direction()));
+                self.stage =
+                    Stage::Extents(Box::new(PlaneExtents::new(a, h.rectangle_direction())));
             }
             (Stage::Extents(_), Sums::Extents(e)) => {
                 self.map = Some(e.finish().map_err(err)?);

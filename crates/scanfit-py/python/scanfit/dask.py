@@ -233,6 +233,16 @@ def _merge(*xs):
     return total
 
 
+def _shared(value):
+    """``value`` (a level state, a query, empty sums) as a constant of the task
+    graph: sent to the workers that need it (its size is the lattice's, never the
+    point count's), and kept by the scheduler, so a worker lost mid-pass costs
+    nothing (a scattered value would be lost with its last holder)."""
+    from dask import delayed
+
+    return delayed(value, pure=False, traverse=False)
+
+
 def _pass(client, parts, task, *args, merge=_merge):
     """One pass: ``task(part, *args)`` per part, merged in a fixed tree, computed."""
     from dask import delayed
@@ -333,7 +343,7 @@ def mba(
     while not run.done:
         state = run.state()
         sent.append(len(state.to_bytes()))
-        shared = client.scatter(state, broadcast=True, hash=False)
+        shared = _shared(state)
         acc, stats = _pass(client, parts, _level, shared)
         passes += 1
         if state.levels > 0:
@@ -343,7 +353,7 @@ def mba(
         run.push(acc)
         recorded = False
     state = run.state()
-    shared = client.scatter(state, broadcast=True, hash=False)
+    shared = _shared(state)
     vertical = _pass(client, parts, _vertical, shared)
     passes += 1
     if not recorded:
@@ -414,7 +424,7 @@ def fit_surface(
     if setup.plane:
         plane = PlanePasses(centring, tuple(map(float, first)), count)
         while not plane.done:
-            stage = client.scatter(plane.stage(), broadcast=True, hash=False)
+            stage = _shared(plane.stage())
             plane.push(_pass(client, parts, _plane, stage))
             passes += 1
         param = plane.parameterization()
@@ -425,16 +435,16 @@ def fit_surface(
         """One least-squares fit to the parameters of ``param``: the knots, the
         equations, the errors; returns (surface, fitted param, errors, passes)."""
         n = 0
-        shared = client.scatter(param, broadcast=True, hash=False)
+        shared = _shared(param)
         search = setup.knot_search()
         while search is not None and not search.done:
-            q = client.scatter(search.query(), broadcast=True, hash=False)
+            q = _shared(search.query())
             search.push(_pass(client, parts, _ranks, shared, q))
             n += 1
-        empty = client.scatter(setup.equations(search), broadcast=True, hash=False)
+        empty = _shared(setup.equations(search))
         eq = _pass(client, parts, _equations, shared, empty)
         fitted = param.fitted(eq)
-        errors = _pass(client, parts, _errors, client.scatter(fitted, broadcast=True, hash=False))
+        errors = _pass(client, parts, _errors, _shared(fitted))
         return eq, fitted, errors, n + 2
 
     # Hoschek's correction as scanfit::fit::correction::correct_parameters runs it

@@ -311,7 +311,7 @@ impl RankQuery {
             let mut ws = Vec::new();
             for _ in 0..m {
                 let (lo, hi, bins) = (r.f64()?, r.f64()?, r.usize()?);
-                if bins > MAX_BINS || !(lo <= hi) {
+                if bins > MAX_BINS || lo.is_nan() || hi.is_nan() || lo > hi {
                     return Err(r.corrupt("a window"));
                 }
                 ws.push(Window { lo, hi, bins });
