@@ -2,15 +2,21 @@
 process, bytes per worker per level (issue 17; BENCHMARKS.md, docs/scale-out.md).
 
     python benches/scale/dask_mba.py N [--chunk 1000000] [--levels 10] [--workers 2] [--single]
+        [--base MxN] [--ply FILE] [--compare JSON] [--save JSON]
 
 The points are generated on the workers (a deterministic terrain per chunk, seeded
-by the chunk's index), so nothing is read or sent by the client; --single also runs
-scanfit.mba in this process on the same points (they must fit in memory) and
-compares the surfaces. Prints one JSON line.
+by the chunk's index), so nothing is read or sent by the client; with --ply FILE
+(a binary little-endian PLY of x, y, z float64 only, e.g. make_franke.py's) each
+worker reads its chunks' rows of that file itself instead (the input the CLI
+reads). --single also runs scanfit.mba in this process on the same points (they
+must fit in memory) and compares the surfaces; --compare JSON compares with the
+surface of a `scanfit mba -o JSON` run (e.g. the streaming CLI's, run.py); --save
+JSON writes the Dask surface (scanfit/1 JSON) to compare later. Prints one JSON line.
 """
 
 import argparse
 import json
+import os
 import resource
 import time
 
@@ -25,8 +31,36 @@ def terrain_block(block_id, rows, total):
     return np.column_stack([x + 6.1e5, y + 5.2e6, z])
 
 
+def ply_layout(path):
+    """(header bytes, rows) of a binary little-endian PLY of x, y, z doubles."""
+    with open(path, "rb") as f:
+        head = b""
+        while not head.endswith(b"end_header\n"):
+            line = f.readline()
+            if not line:
+                raise SystemExit(f"{path}: no end_header")
+            head += line
+    text = head.decode("ascii")
+    props = [l.split()[-1] for l in text.splitlines() if l.startswith("property")]
+    if "binary_little_endian" not in text or props != ["x", "y", "z"] or "double" not in text:
+        raise SystemExit(f"{path}: expected a binary little-endian PLY of double x, y, z")
+    rows = int(next(l.split()[-1] for l in text.splitlines() if l.startswith("element vertex")))
+    return len(head), rows
+
+
+def ply_rows(path, offset, start, rows):
+    """Rows [start, start + rows) of the PLY body (read on the worker)."""
+    a = np.fromfile(path, dtype="<f8", count=3 * rows, offset=offset + 24 * start)
+    return a.reshape(rows, 3)
+
+
 def peak_rss_mb():
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def cpu_seconds():
+    r = resource.getrusage(resource.RUSAGE_SELF)
+    return r.ru_utime + r.ru_stime
 
 
 def main():
@@ -36,6 +70,10 @@ def main():
     ap.add_argument("--levels", type=int, default=10)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--single", action="store_true")
+    ap.add_argument("--base", help="cells of the first lattice, MxN (as the CLI's --base)")
+    ap.add_argument("--ply")
+    ap.add_argument("--compare")
+    ap.add_argument("--save")
     a = ap.parse_args()
 
     import dask.array as da
@@ -46,31 +84,56 @@ def main():
     import scanfit.dask as sd
 
     sizes = [a.chunk] * (a.n // a.chunk) + ([a.n % a.chunk] if a.n % a.chunk else [])
-    blocks = [
-        da.from_delayed(delayed(terrain_block)(k, r, a.n), shape=(r, 3), dtype=np.float64)
-        for k, r in enumerate(sizes)
-    ]
+    if a.ply:
+        offset, rows = ply_layout(a.ply)
+        if rows != a.n:
+            raise SystemExit(f"{a.ply} holds {rows} points, not {a.n}")
+        starts = np.cumsum([0] + sizes[:-1])
+        blocks = [
+            da.from_delayed(
+                delayed(ply_rows)(a.ply, offset, int(s0), r), shape=(r, 3), dtype=np.float64
+            )
+            for s0, r in zip(starts, sizes)
+        ]
+    else:
+        blocks = [
+            da.from_delayed(delayed(terrain_block)(k, r, a.n), shape=(r, 3), dtype=np.float64)
+            for k, r in enumerate(sizes)
+        ]
     points = da.concatenate(blocks)
-    out = {"points": a.n, "chunk": a.chunk, "levels": a.levels, "workers": a.workers}
+    out = {"points": a.n, "chunk": a.chunk, "levels": a.levels, "workers": a.workers,
+           "input": a.ply or "generated on the workers", "load_before": os.getloadavg()}
     with LocalCluster(
         n_workers=a.workers, threads_per_worker=1, processes=True, dashboard_address=None
     ) as cluster, Client(cluster) as client:
         sent0 = client.run(lambda dask_worker: dask_worker.transfer_outgoing_bytes_total)
         t0 = time.perf_counter()
-        r = sd.mba(points, levels=a.levels)
+        base = tuple(int(v) for v in a.base.split("x")) if a.base else None
+        r = sd.mba(points, levels=a.levels, base=base)
         out["dask_seconds"] = time.perf_counter() - t0
         sent1 = client.run(lambda dask_worker: dask_worker.transfer_outgoing_bytes_total)
         out["dask_passes"] = r["passes"]
         out["broadcast_bytes_per_level"] = r["broadcast_bytes"]
         out["worker_sent_bytes_total"] = {w: sent1[w] - sent0.get(w, 0) for w in sent1}
         out["worker_peak_rss_mb"] = client.run(peak_rss_mb)
+        out["worker_cpu_seconds"] = client.run(cpu_seconds)
+        out["load_after"] = os.getloadavg()
         out["client_peak_rss_mb_after_dask"] = peak_rss_mb()
         out["vertical_rmse"] = r["vertical"]["rmse"]
         dask_ctrl = r["surface"].control_points
+        if a.save:
+            r["surface"].to_json(a.save)
+    if a.compare:
+        b = scanfit.Surface.read_json(a.compare).control_points
+        scale = np.abs(b).reshape(-1, 3).max(axis=0)
+        out["compare"] = a.compare
+        out["max_relative_difference_to_compare"] = float(
+            (np.abs(dask_ctrl - b).reshape(-1, 3).max(axis=0) / scale).max()
+        )
     if a.single:
         pts = np.concatenate([terrain_block(k, rows, a.n) for k, rows in enumerate(sizes)])
         t0 = time.perf_counter()
-        once = scanfit.mba(pts, levels=a.levels)
+        once = scanfit.mba(pts, levels=a.levels, base=base)
         out["single_seconds"] = time.perf_counter() - t0
         out["single_peak_rss_mb"] = peak_rss_mb()
         b = once["surface"].control_points

@@ -7,7 +7,7 @@ make_franke.py.
     python3 benches/scale/make_franke.py 1000000 /tmp/franke_1000000.ply
     python3 benches/scale/make_franke.py 1000000 /tmp/franke_uv_1000000.ply --uv
     python3 benches/scale/make_franke.py 10000000 /tmp/franke_10000000.las
-    python3 benches/scale/run.py target/release/scanfit 1000000 [--repeat 3] [--only fit|mba|mba_las|mba_las_streamed] [-- EXTRA...]
+    python3 benches/scale/run.py target/release/scanfit 1000000 [--repeat 3] [--only fit|mba|mba_las|mba_las_streamed] [--out-dir /tmp] [-- EXTRA...]
 
 Each command runs `--repeat` times (default 3) under `/usr/bin/time -v`
 with SCANFIT_TIMINGS=1 (the CLI then prints each stage's wall time); the
@@ -52,16 +52,19 @@ def main():
     binary, n = args[0], int(args[1])
     repeat = int(args[args.index("--repeat") + 1]) if "--repeat" in args else 3
     only = args[args.index("--only") + 1] if "--only" in args else None
+    # where the commands write their JSON documents (e.g. a directory of one's own
+    # on a shared machine, to compare the surfaces afterwards)
+    out = args[args.index("--out-dir") + 1] if "--out-dir" in args else "/tmp"
     commands = {
         "fit": [binary, "fit", f"/tmp/franke_uv_{n}.ply", "--params", "uv-columns",
-                "--ctrl", "64x64", "-o", "/tmp/scale_fit.json", "--json", "-q"],
+                "--ctrl", "64x64", "-o", f"{out}/scale_fit.json", "--json", "-q"],
         "mba": [binary, "mba", f"/tmp/franke_{n}.ply", "--levels", "8", "--base", "1x1",
-                "-o", "/tmp/scale_mba.json", "--json", "-q"],
+                "-o", f"{out}/scale_mba.json", "--json", "-q"],
     }
     las = f"/tmp/franke_{n}.las"
     if os.path.exists(las):
         mba_las = [binary, "mba", las, "--levels", "8", "--base", "1x1",
-                   "-o", "/tmp/scale_mba_las.json", "--json", "-q"]
+                   "-o", f"{out}/scale_mba_las.json", "--json", "-q"]
         commands["mba_las"] = mba_las
         commands["mba_las_streamed"] = mba_las + ["--chunk-points", "1000000"]
     for name, cmd in commands.items():

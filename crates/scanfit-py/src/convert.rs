@@ -271,9 +271,16 @@ pub fn pair(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<(usize, usize)> {
     })
 }
 
-/// A 3-vector from a 3-sequence of numbers.
+/// A 3-vector from a 3-sequence of numbers (a tuple, list or numpy array).
 pub fn vec3(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vector3> {
-    let (x, y, z) = obj.extract::<(f64, f64, f64)>().map_err(|_| {
+    let three = obj
+        .extract::<(f64, f64, f64)>()
+        .ok()
+        .or_else(|| match obj.extract::<Vec<f64>>() {
+            Ok(v) if v.len() == 3 => Some((v[0], v[1], v[2])),
+            _ => None,
+        });
+    let (x, y, z) = three.ok_or_else(|| {
         PyTypeError::new_err(format!("{what} must be three numbers, e.g. (0, 0, 1)"))
     })?;
     if !(x.is_finite() && y.is_finite() && z.is_finite()) {

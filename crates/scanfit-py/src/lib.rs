@@ -22,6 +22,7 @@ use pyo3::prelude::*;
 pub mod cloud;
 pub mod convert;
 pub mod curves;
+pub mod fit_sums;
 pub mod geometry;
 pub mod reconstruct;
 pub mod report;
@@ -51,5 +52,6 @@ fn _scanfit(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(curves::compare_curves, m)?)?;
     m.add_function(wrap_pyfunction!(reconstruct::reconstruct, m)?)?;
     sums::register(m)?;
+    fit_sums::register(m)?;
     Ok(())
 }

@@ -28,18 +28,17 @@ use scanfit::mba::{
     lattice_surface, BaAccumulator, ControlFormula, Frame, FrameSums, Lattice, MbaLevels,
     ResidualSums,
 };
-use scanfit::pipeline::stream::check_fit;
 use scanfit::wire::{Reader, Writer};
 use scanfit::{Point3, Vector3};
 
 use crate::convert::{err, float_array, points, uv_columns, value_err, vec3};
 use crate::geometry::PySurface;
 use crate::report::stats;
-use crate::surfaces::{fit_config, mba_config};
+use crate::surfaces::mba_config;
 
 /// The points of a chunk: an `(N, 3)` array, `N = 0` allowed (an empty
 /// chunk adds nothing).
-fn chunk(obj: &Bound<'_, PyAny>) -> PyResult<Vec<Point3>> {
+pub(crate) fn chunk(obj: &Bound<'_, PyAny>) -> PyResult<Vec<Point3>> {
     let a = float_array(obj, "points")?;
     if a.shape() == [0, 3] {
         return Ok(Vec::new());
@@ -49,7 +48,11 @@ fn chunk(obj: &Bound<'_, PyAny>) -> PyResult<Vec<Point3>> {
 
 /// `(cls_restore, (kind, bytes))` for `__reduce__`: pickled as the exact
 /// bytes, restored by `scanfit.sums._restore`.
-fn reduce<'py>(py: Python<'py>, kind: &str, bytes: &[u8]) -> PyResult<Bound<'py, PyTuple>> {
+pub(crate) fn reduce<'py>(
+    py: Python<'py>,
+    kind: &str,
+    bytes: &[u8],
+) -> PyResult<Bound<'py, PyTuple>> {
     let restore = py.import("scanfit.sums")?.getattr("_restore")?;
     let args = PyTuple::new(
         py,
@@ -62,7 +65,7 @@ fn reduce<'py>(py: Python<'py>, kind: &str, bytes: &[u8]) -> PyResult<Bound<'py,
 }
 
 /// Reads a Python record: the tag, then `f` on the reader, then the end.
-fn read<T>(
+pub(crate) fn read<T>(
     bytes: &[u8],
     tag: &[u8; 8],
     what: &'static str,
@@ -87,7 +90,7 @@ fn read<T>(
 pub struct PyCentring {
     lo: Vector3,
     hi: Vector3,
-    inner: Centring,
+    pub(crate) inner: Centring,
 }
 
 impl PyCentring {
@@ -96,13 +99,13 @@ impl PyCentring {
         Self { lo, hi, inner }
     }
 
-    fn write(&self, w: &mut Writer) {
+    pub(crate) fn write(&self, w: &mut Writer) {
         for x in self.lo.iter().chain(self.hi.iter()) {
             w.f64(*x);
         }
     }
 
-    fn read(r: &mut Reader<'_>) -> scanfit::Result<Self> {
+    pub(crate) fn read(r: &mut Reader<'_>) -> scanfit::Result<Self> {
         let mut v = [0.0; 6];
         for x in &mut v {
             *x = r.f64()?;
@@ -114,7 +117,7 @@ impl PyCentring {
     }
 
     /// `points` moved by `-centre`.
-    fn apply(&self, points: Vec<Point3>) -> Vec<Point3> {
+    pub(crate) fn apply(&self, points: Vec<Point3>) -> Vec<Point3> {
         if self.inner.is_identity() {
             points
         } else {
@@ -254,7 +257,7 @@ impl PyFrameSums {
 #[pyclass(name = "ResidualSums", module = "scanfit.sums")]
 #[derive(Clone, Default)]
 pub struct PyResidualSums {
-    inner: ResidualSums,
+    pub(crate) inner: ResidualSums,
 }
 
 #[pymethods]
@@ -586,7 +589,8 @@ impl PyMbaLevels {
         if levels == 0 {
             return Err(value_err("levels must be at least 1".into()));
         }
-        let config = mba_config(levels, base.as_ref(), tolerance, hjelle)?;
+        // the mean: the start whose sums the level loop keeps exact
+        let config = mba_config(levels, base.as_ref(), tolerance, hjelle, "mean")?;
         let f = match domain {
             None => frame.inner.finish().map_err(err)?,
             Some((x0, y0, x1, y1)) => {
@@ -697,23 +701,21 @@ impl PyMbaLevels {
     }
 }
 
-/// The normal equations of the least-squares surface with uniform knots,
-/// configured by ``fit_surface``'s keywords for ``count`` points (the net
-/// from the density and the smoothing scaled to the data exactly as
-/// ``fit_surface`` resolves them); settings that need all points at once
-/// (``params="plane"``, ``knots="distribution"``, ``correct > 0``) are a
-/// ``ScanfitError`` saying why.
+/// The normal equations of the least-squares surface ([NURBS97] eq. 9.63)
+/// for ``fit_surface``'s keywords: made empty by ``FitSetup.equations()``
+/// (uniform knots, or those of a finished ``KnotSearch``), fed chunks of
+/// points with their parameters, merged, finished.
 ///
 /// Example::
 ///
-///     >>> eq = scanfit.sums.NormalEquations(len(pts), centring, ctrl=(8, 8), params="uv", knots="uniform")
+///     >>> eq = scanfit.sums.FitSetup(len(pts), centring, ctrl=(8, 8), params="uv", knots="uniform").equations()
 ///     >>> eq.add(pts, uv); eq.finish()
 #[pyclass(name = "NormalEquations", module = "scanfit.sums")]
 #[derive(Clone)]
 pub struct PyNormalEquations {
-    inner: NormalEquations,
-    smoothing: f64,
-    centring: PyCentring,
+    pub(crate) inner: NormalEquations,
+    pub(crate) smoothing: f64,
+    pub(crate) centring: PyCentring,
 }
 
 const NORMAL_TAG: &[u8; 8] = b"SFPYNEQ1";
@@ -733,39 +735,6 @@ impl PyNormalEquations {
 
 #[pymethods]
 impl PyNormalEquations {
-    /// Empty equations (see the class documentation).
-    #[new]
-    #[pyo3(signature = (count, centring, ctrl = None, degree = None, params = "plane", knots = "distribution", smooth = None, periodic_u = false, correct = 0))]
-    #[allow(clippy::too_many_arguments)]
-    fn new(
-        count: usize,
-        centring: &PyCentring,
-        ctrl: Option<Bound<'_, PyAny>>,
-        degree: Option<Bound<'_, PyAny>>,
-        params: &str,
-        knots: &str,
-        smooth: Option<f64>,
-        periodic_u: bool,
-        correct: usize,
-    ) -> PyResult<Self> {
-        let cfg = fit_config(
-            ctrl.as_ref(),
-            degree.as_ref(),
-            params,
-            knots,
-            smooth,
-            periodic_u,
-            correct,
-        )?;
-        check_fit(&cfg).map_err(err)?;
-        let fit = cfg.resolved_fit(count);
-        Ok(Self {
-            inner: fit.uniform_equations().map_err(err)?,
-            smoothing: fit.smoothing,
-            centring: centring.clone(),
-        })
-    }
-
     /// Adds an ``(N, 3)`` chunk (``N = 0`` allowed) with its ``(N, 2)``
     /// parameters.
     fn add(

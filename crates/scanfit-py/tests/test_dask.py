@@ -112,13 +112,74 @@ def test_fit_surface_on_two_workers_equals_the_single_process_fit(client, pts):
     assert r["smoothing"] == once["smoothing"]
     assert r["points"] == N
     assert r["errors"]["rmse"] == pytest.approx(once["quality"]["rmse"], rel=1e-9)
-    # the settings that need all points are refused before any pass, with the reason
-    with pytest.raises(scanfit.ScanfitError, match="best-fit plane"):
-        sd.fit_surface(da.from_array(pts, chunks=(CHUNKS, 3)))
-    with pytest.raises(scanfit.ScanfitError, match="9.69"):
-        sd.fit_surface(da.from_array(pts, chunks=(CHUNKS, 3)), uv=da.from_array(uv))
+    assert r["passes"] == 3 and r["rounds"] == []
+    # what stays single-process is refused before any pass, with the reason
     with pytest.raises(scanfit.ScanfitError, match="whole cloud"):
         sd.mba(da.from_array(pts), adjust=True)
+    with pytest.raises(scanfit.ScanfitError, match="start from the mean|starts from the mean"):
+        sd.mba(da.from_array(pts), start="fitted")
+    with pytest.raises(scanfit.ScanfitError, match="a plane cannot close"):
+        sd.fit_surface(da.from_array(pts), periodic_u=True)
+
+
+def knots_close(a, b, what):
+    for x, y in zip(a["surface"].knots, b["surface"].knots):
+        assert x.shape == y.shape, what
+        assert np.abs(x - y).max() <= 1e-12, f"{what}: knots differ by {np.abs(x - y).max():.3e}"
+
+
+def test_the_default_fit_plane_and_distribution_knots_equals_the_single_process_fit(client, pts):
+    # the single-process defaults: parameters from the best-fit plane (covariance,
+    # minimum-area rectangle), knots from their distribution (eq. 9.69), the net
+    # from the density and the smoothing scaled to the data
+    once = scanfit.fit_surface(pts)
+    r = sd.fit_surface(client.persist(da.from_array(pts, chunks=(CHUNKS, 3))))
+    close(r["surface"].control_points, once["surface"].control_points, "control points")
+    knots_close(r, once, "distribution knots")
+    # the knots are not the uniform ones (the test would not see a wrong rank otherwise)
+    uniform = np.linspace(0, 1, len(once["surface"].knots[0]) - 6)
+    assert np.abs(once["surface"].knots[0][3:-3] - uniform).max() > 1e-4
+    assert r["smoothing"] == once["smoothing"]
+    assert r["errors"]["rmse"] == pytest.approx(once["quality"]["rmse"], rel=1e-9)
+    # box, 3 plane passes, 2 rounds of knot counts at 10^6 points, equations, errors
+    assert r["passes"] == 1 + 3 + 2 + 2
+    # the same on a rotated copy: the plane and its rectangle are not the axes
+    c, s = np.cos(0.4), np.sin(0.4)
+    rot = pts @ np.array([[c, s, 0.1], [-s, c, 0.0], [-0.1, 0.0, 1.0]]).T
+    rot = rot[:200_000]
+    once = scanfit.fit_surface(rot, ctrl=(20, 14))
+    r = sd.fit_surface(da.from_array(rot, chunks=(70_000, 3)), ctrl=(20, 14))
+    close(r["surface"].control_points, once["surface"].control_points, "rotated")
+    knots_close(r, once, "rotated")
+
+
+def test_parameter_correction_on_the_workers_equals_the_single_process_correction(client, pts):
+    # Hoschek's correction: per round the workers re-project their points onto
+    # the accepted surfaces in turn; given uv and distribution knots (both
+    # recomputed per round, as the single-process fit does)
+    sample = pts[:300_000]
+    lo, hi = sample.min(axis=0), sample.max(axis=0)
+    uv = (sample[:, :2] - lo[:2]) / (hi[:2] - lo[:2])
+    uv = uv**1.3  # a poor parameterization that the correction improves
+    once = scanfit.fit_surface(sample, uv=uv, ctrl=(16, 12), correct=2)
+    r = sd.fit_surface(
+        client.persist(da.from_array(sample, chunks=(100_000, 3))),
+        uv=client.persist(da.from_array(uv, chunks=(100_000, 2))),
+        ctrl=(16, 12),
+        correct=2,
+    )
+    assert len(r["rounds"]) == len(once["rounds"]) >= 2
+    for a, b in zip(r["rounds"], once["rounds"]):
+        assert a["round"] == b["round"]
+        assert a["rmse"] == pytest.approx(b["rmse"], rel=1e-9)
+    assert once["rounds"][1]["rmse"] < once["rounds"][0]["rmse"]
+    close(r["surface"].control_points, once["surface"].control_points, "corrected")
+    knots_close(r, once, "corrected")
+    # the default plane with one round
+    once = scanfit.fit_surface(sample, ctrl=(16, 12), correct=1)
+    r = sd.fit_surface(da.from_array(sample, chunks=(150_000, 3)), ctrl=(16, 12), correct=1)
+    close(r["surface"].control_points, once["surface"].control_points, "plane, corrected")
+    assert [x["round"] for x in r["rounds"]] == [x["round"] for x in once["rounds"]]
 
 
 def slow(block):
@@ -202,5 +263,71 @@ def test_accumulators_pickle_exactly_and_merge_as_one_pass():
         S.BaSums.from_bytes(b"not sums at all")
     with pytest.raises(scanfit.ScanfitError, match="cut short"):
         S.BaSums.from_bytes(b2.to_bytes()[:-9])
-    eq = S.NormalEquations(100, c, ctrl=6, params="uv", knots="uniform")
+    eq = S.FitSetup(100, c, ctrl=6, params="uv", knots="uniform").equations()
     assert pickle.loads(pickle.dumps(eq)).to_bytes() == eq.to_bytes()
+
+
+def test_plane_knot_and_correction_sums_by_hand_equal_the_single_process_fit():
+    p = terrain(40_000, seed=4)
+    c = S.Centring(tuple(p.min(axis=0)), tuple(p.max(axis=0)))
+    parts = [p[:9_000], p[9_000:9_000], p[9_000:31_000], p[31_000:]]
+
+    def over(parts, task, empty):
+        total = None
+        for part in parts:
+            x = task(part, pickle.loads(pickle.dumps(empty)))
+            x = pickle.loads(pickle.dumps(x))
+            total = x if total is None else (total.merge(x) or total)
+        return total
+
+    plane = S.PlanePasses(c, p[0], len(p))
+    while not plane.done:
+        stage = pickle.loads(pickle.dumps(plane.stage()))
+
+        def task(part, stage):
+            s = stage.accumulator()
+            s.add(stage, part)
+            return s
+
+        plane.push(over(parts, task, stage))
+    param = pickle.loads(pickle.dumps(plane.parameterization()))
+    first = scanfit.fit_surface(p, ctrl=(9, 7))
+    # the plane's parameters, computed per chunk
+    got = np.concatenate([param.uv(x) for x in parts])
+    close(got, np.column_stack([first["u"], first["v"]]), "plane parameters")
+    setup = S.FitSetup(len(p), c, ctrl=(9, 7), correct=1)
+    search = setup.knot_search()
+    while not search.done:
+        q = pickle.loads(pickle.dumps(search.query()))
+
+        def count(part, q):
+            k = q.counts()
+            k.add(q, param.uv(part))
+            return k
+
+        search.push(over(parts, count, q))
+    assert search.rounds == 2
+    eq = setup.equations(search)
+
+    def add(part, eq):
+        e = eq.copy()
+        e.add(part, param.uv(part))
+        return e
+
+    merged = over(parts, add, eq)
+    close(merged.finish().control_points, first["surface"].control_points, "by hand")
+    fitted = pickle.loads(pickle.dumps(param.fitted(merged)))
+    e = over(parts, lambda part, f: f.errors(part), fitted)
+    assert e.stats()["rmse"] == pytest.approx(first["quality"]["rmse"], rel=1e-9)
+    nxt = pickle.loads(pickle.dumps(fitted.corrected()))
+    assert nxt.rounds == 1 and nxt.plane
+    with pytest.raises(scanfit.ScanfitError, match="no fitted surface"):
+        nxt.corrected()
+    with pytest.raises(scanfit.ScanfitError, match="different stages"):
+        S.PlanePasses(c, p[0], len(p)).stage().accumulator().merge(
+            S.PlaneSums.from_bytes(over(parts, task, stage).to_bytes())
+        )
+    with pytest.raises(scanfit.ScanfitError, match="at least 3|needs 3|3 points"):
+        S.PlanePasses(c, p[0], 2)
+    with pytest.raises(scanfit.ScanfitError, match="rank counts"):
+        S.RankCounts.from_bytes(b"junk at all, and more")

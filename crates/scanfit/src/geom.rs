@@ -1,5 +1,6 @@
 //! The one point/vector type of the library, and input validation shared by all algorithms.
 
+use crate::wire::{Reader, Writer};
 use crate::{Error, Result};
 
 /// A point in 3D space (f64).
@@ -144,8 +145,142 @@ pub(crate) fn covariance(points: impl IntoIterator<Item = Vector3>) -> Option<(P
 /// about the first point and then re-centred, which keeps it accurate for
 /// coordinates far from the origin (georeferenced scans).
 pub fn pca<'a>(points: impl IntoIterator<Item = &'a Point3>) -> Option<Pca> {
-    let (centroid, cov) = covariance(points.into_iter().map(|p| p.coords))?;
-    Some(pca_of(centroid, &cov))
+    let mut it = points.into_iter();
+    let first = it.next()?;
+    // the first point adds zeros: the same sums as starting the count at 1
+    let mut sums = CovarianceSums::new(*first);
+    sums.add(first);
+    for p in it {
+        sums.add(p);
+    }
+    sums.finish()
+}
+
+/// The sums behind [`pca`] (count, sum of `p - r` and of `(p - r)(p - r)^T`
+/// about a reference point `r`), which can be built in pieces: points added
+/// chunk by chunk, and the sums of other chunks with the same reference
+/// merged, give the PCA of all of them (equal to [`pca`] with `r` its first
+/// point up to the rounding of the merged additions).
+///
+/// ```
+/// use scanfit::{pca, CovarianceSums, Point3};
+/// let pts: Vec<Point3> = (0..50).map(|k| Point3::new(k as f64, (k * k % 7) as f64, 0.5)).collect();
+/// let (mut a, mut b) = (CovarianceSums::new(pts[0]), CovarianceSums::new(pts[0]));
+/// pts[..20].iter().for_each(|p| a.add(p));
+/// pts[20..].iter().for_each(|p| b.add(p));
+/// a.merge(&b)?;
+/// let (merged, once) = (a.finish().unwrap(), pca(&pts).unwrap());
+/// assert!((merged.centroid - once.centroid).norm() < 1e-12);
+/// assert!((merged.values[0] - once.values[0]).abs() < 1e-12 * once.values[0]);
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CovarianceSums {
+    reference: Vector3,
+    n: f64,
+    sum: Vector3,
+    cov: nalgebra::Matrix3<f64>,
+}
+
+const COVARIANCE_TAG: &[u8; 8] = b"SFCOVS01";
+
+impl CovarianceSums {
+    /// No points yet; sums about `reference` (a point of the data keeps them
+    /// accurate far from the origin).
+    pub fn new(reference: Point3) -> Self {
+        Self {
+            reference: reference.coords,
+            n: 0.0,
+            sum: Vector3::zeros(),
+            cov: nalgebra::Matrix3::zeros(),
+        }
+    }
+
+    /// Adds one point.
+    #[inline]
+    pub fn add(&mut self, p: &Point3) {
+        let d = p.coords - self.reference;
+        self.sum += d;
+        self.cov += d * d.transpose();
+        self.n += 1.0;
+    }
+
+    /// Points added (over all merged sums).
+    pub fn count(&self) -> f64 {
+        self.n
+    }
+
+    /// Adds the sums of other points (the same reference point, bit for bit).
+    pub fn merge(&mut self, other: &Self) -> Result<()> {
+        if self.reference != other.reference {
+            return Err(Error::InvalidInput(format!(
+                "cannot merge covariance sums about different reference points ({:?} and {:?}); every chunk must be summed about the same point",
+                self.reference, other.reference
+            )));
+        }
+        self.sum += other.sum;
+        self.cov += other.cov;
+        self.n += other.n;
+        Ok(())
+    }
+
+    /// The PCA of the points added (`None` for none).
+    pub fn finish(&self) -> Option<Pca> {
+        if self.n == 0.0 {
+            return None;
+        }
+        let n = self.n;
+        let m = self.sum / n;
+        let c = self.cov / n - m * m.transpose();
+        let cov = [
+            c[(0, 0)],
+            c[(1, 1)],
+            c[(2, 2)],
+            c[(0, 1)],
+            c[(0, 2)],
+            c[(1, 2)],
+        ];
+        Some(pca_of(Point3::from(self.reference + m), &cov))
+    }
+
+    /// The sums as exact bytes ([`crate::wire`]).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut w = Writer::new(COVARIANCE_TAG);
+        self.write(&mut w);
+        w.finish()
+    }
+
+    /// Reads what [`to_bytes`](Self::to_bytes) wrote.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
+        let mut r = Reader::new(bytes, COVARIANCE_TAG, "covariance sums")?;
+        let s = Self::read(&mut r)?;
+        r.end()?;
+        Ok(s)
+    }
+
+    /// Writes the fields into a record.
+    pub fn write(&self, w: &mut Writer) {
+        w.f64s(self.reference.as_slice());
+        w.f64(self.n);
+        w.f64s(self.sum.as_slice());
+        w.f64s(self.cov.as_slice());
+    }
+
+    /// Reads the fields [`write`](Self::write) wrote.
+    pub fn read(r: &mut Reader<'_>) -> Result<Self> {
+        let reference = r.f64s()?;
+        let n = r.f64()?;
+        let (sum, cov) = (r.f64s()?, r.f64s()?);
+        if reference.len() != 3 || sum.len() != 3 || cov.len() != 9 {
+            return Err(r.corrupt("the vectors of covariance sums"));
+        }
+        Ok(Self {
+            reference: Vector3::from_column_slice(&reference),
+            n,
+            sum: Vector3::from_column_slice(&sum),
+            cov: nalgebra::Matrix3::from_column_slice(&cov),
+        })
+    }
 }
 
 /// The PCA of a covariance from [`covariance`] (nalgebra's iterative

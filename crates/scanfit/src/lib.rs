@@ -72,4 +72,4 @@ pub mod wire;
 
 pub use cloud::PointCloud;
 pub use error::{Error, Result};
-pub use geom::{pca, validate_points, Pca, Point3, Vector3};
+pub use geom::{pca, validate_points, CovarianceSums, Pca, Point3, Vector3};

@@ -16,10 +16,17 @@ paths the workers can read) that each worker reads itself, once per pass; a tile
 fails to read raises a ``ScanfitError`` naming the tile.
 
 The keywords are those of ``scanfit.mba`` and ``scanfit.fit_surface``, with their
-defaults; a setting that needs all points at once is a ``ScanfitError`` saying why
-(MBA's ``adjust``; the fit's ``params="plane"``, ``knots="distribution"`` and
-``correct``). The surface equals the single-process one up to the rounding of the
-merged additions (about 1e-15 relative, tested at 1e-12 on 10^6 points).
+defaults. The fit's settings that look at all points at once run as more passes of
+mergeable sums: ``params="plane"`` (covariance sums for the plane, the convex hull
+in it for the minimum-area rectangle, the extents along its axes; then every
+worker computes its points' parameters), ``knots="distribution"`` (the few order
+statistics eq. 9.69 needs, found exactly by rounds of histograms) and ``correct``
+(per round, the workers re-project their points onto the surfaces of the accepted
+rounds in turn, as the single-process correction does). MBA's ``adjust`` (the
+nearest points of the whole cloud per knot) and ``start="fitted"`` remain
+single-process and are a ``ScanfitError`` saying why. The surface equals the
+single-process one up to the rounding of the merged additions (about 1e-15
+relative, tested at 1e-12 on 10^6 points).
 
 Example::
 
@@ -37,8 +44,14 @@ import numpy as np
 
 from . import read_cloud
 from ._scanfit import ScanfitError
-from .sums import Centring, FrameSums, MbaLevels, NormalEquations, ResidualSums, surface_errors
-from ._scanfit import Surface
+from .sums import (
+    Centring,
+    FitSetup,
+    FrameSums,
+    MbaLevels,
+    Parameterization,
+    PlanePasses,
+)
 
 __all__ = ["mba", "fit_surface"]
 
@@ -150,19 +163,21 @@ def _parts(points, uv, params):
 
 
 def _bounds(part):
+    """Bounding box, count and first point of a part (``None`` when empty)."""
     pts, _ = _load(part)
     if len(pts) == 0:
         return None
-    return pts.min(axis=0), pts.max(axis=0), len(pts)
+    return pts.min(axis=0), pts.max(axis=0), len(pts), pts[0].copy()
 
 
 def _merge_bounds(*bs):
+    """Merged in part order: the first point is the first part's."""
     bs = [b for b in bs if b is not None]
     if not bs:
         return None
     lo = np.min([b[0] for b in bs], axis=0)
     hi = np.max([b[1] for b in bs], axis=0)
-    return lo, hi, sum(b[2] for b in bs)
+    return lo, hi, sum(b[2] for b in bs), bs[0][3]
 
 
 def _frame(part, centring):
@@ -181,17 +196,30 @@ def _vertical(part, state):
     return state.residuals(_load(part)[0])
 
 
-def _equations(part, empty):
+def _plane(part, stage):
+    sums = stage.accumulator()
+    sums.add(stage, _load(part)[0])
+    return sums
+
+
+def _ranks(part, param, query):
+    pts, uv = _load(part)
+    counts = query.counts()
+    counts.add(query, param.uv(pts, uv))
+    return counts
+
+
+def _equations(part, param, empty):
     pts, uv = _load(part)
     eq = empty.copy()
     if len(pts):
-        eq.add(pts, uv)
+        eq.add(pts, param.uv(pts, uv))
     return eq
 
 
-def _errors(part, surface_json):
+def _errors(part, param):
     pts, uv = _load(part)
-    return surface_errors(Surface.from_json(surface_json), pts, uv)
+    return param.errors(pts, uv)
 
 
 def _merge(*xs):
@@ -203,6 +231,16 @@ def _merge(*xs):
     for x in xs[1:]:
         total.merge(x)
     return total
+
+
+def _shared(value):
+    """``value`` (a level state, a query, empty sums) as a constant of the task
+    graph: sent to the workers that need it (its size is the lattice's, never the
+    point count's), and kept by the scheduler, so a worker lost mid-pass costs
+    nothing (a scattered value would be lost with its last holder)."""
+    from dask import delayed
+
+    return delayed(value, pure=False, traverse=False)
 
 
 def _pass(client, parts, task, *args, merge=_merge):
@@ -218,16 +256,16 @@ def _pass(client, parts, task, *args, merge=_merge):
 
 
 def _centring(client, parts, domain):
-    """The centring (and the point count when a pass ran) from a bounding-box
-    pass or the given domain."""
+    """The centring, the point count and the first point (these two when a
+    pass ran) from a bounding-box pass or the given domain."""
     if domain is not None:
         x0, y0, x1, y1 = (float(v) for v in domain)
-        return Centring((x0, y0, 0.0), (x1, y1, 0.0)), None
+        return Centring((x0, y0, 0.0), (x1, y1, 0.0)), None, None
     b = _pass(client, parts, _bounds, merge=_merge_bounds)
     if b is None:
         raise ScanfitError("the points are empty: no chunk or tile holds a point")
-    lo, hi, n = b
-    return Centring(tuple(map(float, lo)), tuple(map(float, hi))), n
+    lo, hi, n, first = b
+    return Centring(tuple(map(float, lo)), tuple(map(float, hi))), n, first
 
 
 # ---- the fits (run on the client) ----------------------------------------------
@@ -243,6 +281,7 @@ def mba(
     alpha=1.49,
     weight="moon",
     adjust_steps=5,
+    start="mean",
     *,
     domain=None,
     client=None,
@@ -250,9 +289,10 @@ def mba(
     """Multilevel B-spline approximation ``z = f(x, y)`` on the current Dask client.
 
     The keywords are ``scanfit.mba``'s (``levels``, ``base``, ``tolerance``,
-    ``hjelle``); ``adjust=True`` is refused (the projection adjustment finds the
-    nearest points of the whole cloud per knot; ``alpha``, ``weight`` and
-    ``adjust_steps`` belong to it).
+    ``hjelle``, ``start``); ``adjust=True`` is refused (the projection adjustment
+    finds the nearest points of the whole cloud per knot; ``alpha``, ``weight``
+    and ``adjust_steps`` belong to it), and so is ``start="fitted"`` (it runs the
+    constant through the levels beside the heights, in memory only).
 
     Parameters:
         points: a Dask array ``(N, 3)`` chunked by rows, or a list of point files.
@@ -281,11 +321,18 @@ def mba(
             "adjust=True projects the knot grid onto the whole cloud (nearest points along z) "
             "and needs all points at once; leave it out on Dask (scanfit.mba has it)"
         )
+    if start != "mean":
+        if start != "fitted":
+            raise ScanfitError(f"start must be 'mean' or 'fitted'; got {start!r}")
+        raise ScanfitError(
+            "start='fitted' runs the constant 1 through the levels beside the heights in memory "
+            "(scanfit.mba has it); on Dask the level loop starts from the mean: leave start out"
+        )
     del alpha, weight, adjust_steps  # the adjustment's settings
     t0 = time.perf_counter()
     client = _client(client)
     parts = _parts(points, None, None)
-    centring, _ = _centring(client, parts, domain)
+    centring, _, _ = _centring(client, parts, domain)
     frame = _pass(client, parts, _frame, centring)
     run = MbaLevels(
         frame, centring, levels=levels, base=base, tolerance=tolerance, hjelle=hjelle, domain=domain
@@ -296,7 +343,7 @@ def mba(
     while not run.done:
         state = run.state()
         sent.append(len(state.to_bytes()))
-        shared = client.scatter(state, broadcast=True, hash=False)
+        shared = _shared(state)
         acc, stats = _pass(client, parts, _level, shared)
         passes += 1
         if state.levels > 0:
@@ -306,7 +353,7 @@ def mba(
         run.push(acc)
         recorded = False
     state = run.state()
-    shared = client.scatter(state, broadcast=True, hash=False)
+    shared = _shared(state)
     vertical = _pass(client, parts, _vertical, shared)
     passes += 1
     if not recorded:
@@ -336,49 +383,96 @@ def fit_surface(
     """Least-squares B-spline surface on the current Dask client.
 
     The keywords are ``scanfit.fit_surface``'s, with its defaults and rules (the
-    net from the point density, the smoothing scaled to the data). The points'
-    parameters must be given, per point: ``uv=`` a Dask array ``(N, 2)`` with a
-    Dask array of points, or ``params="uv"`` with tiles that have ``u`` and ``v``
-    columns; and ``knots="uniform"``. The defaults ``params="plane"`` and
-    ``knots="distribution"``, and ``correct > 0``, need all points at once and
-    are a ``ScanfitError`` saying so.
+    net from the point density, the smoothing scaled to the data), and give its
+    surface: ``params="plane"`` (the default: the best-fit plane's parameters),
+    or given parameters (``uv=`` a Dask array ``(N, 2)`` with a Dask array of
+    points, or ``params="uv"`` with tiles that have ``u`` and ``v`` columns);
+    ``knots="distribution"`` (the default, NURBS Book eq. 9.69) or
+    ``"uniform"``; ``correct=k`` rounds of Hoschek's parameter correction.
 
-    Passes over the points: bounding box and count, the normal equations, one to
-    measure the errors at the parameters.
+    Passes over the points: bounding box, count and first point; with the
+    plane 3 (covariance sums, convex hull, extents); then per fit (one, plus
+    one per correction round): with distribution knots 2 to 3 rounds of
+    counts (more above about 10^9 points), the normal equations, the errors at
+    the parameters. Correction round ``r`` re-projects every point onto the
+    surfaces of the ``r`` accepted rounds before, in turn (no parameter is
+    stored between passes), so its passes cost ``r`` projections per point.
 
     Returns a dict: ``surface``, ``smoothing`` (the weight used), ``points``,
-    ``errors`` (statistics of ``|p - S(u, v)|``: ``count``, ``mean``, ``max``,
-    ``max_index``, ``rmse``), ``passes``, ``seconds``, ``equation_bytes`` (the size
+    ``errors`` (statistics of ``|p - S(u, v)|`` at the final parameters:
+    ``count``, ``mean``, ``max``, ``max_index``, ``rmse``), ``rounds`` (per
+    fit: ``round``, ``rmse``, ``max``; as ``scanfit.fit_surface``'s, empty
+    without correction), ``passes``, ``seconds``, ``equation_bytes`` (the size
     of the sums each task returns).
 
     Example::
 
-        >>> r = scanfit.dask.fit_surface(pts, uv=uv, ctrl=(30, 30), knots="uniform")
+        >>> r = scanfit.dask.fit_surface(pts, ctrl=(30, 30))   # plane, distribution knots
         >>> r["errors"]["rmse"]  # doctest: +SKIP
+        >>> r = scanfit.dask.fit_surface(pts, uv=uv, knots="uniform", correct=2)
     """
     t0 = time.perf_counter()
     client = _client(client)
-    # refuse what needs all points before any pass (the count only sizes the net)
     given = "uv" if uv is not None else params
-    NormalEquations(
-        1 << 20, Centring((0, 0, 0), (1, 1, 1)), ctrl, degree, given, knots, smooth, periodic_u, correct
-    )
+    # the keywords checked before any pass (the count only sizes the net)
+    FitSetup(1 << 20, Centring((0, 0, 0), (1, 1, 1)), ctrl, degree, given, knots, smooth,
+             periodic_u, correct)
     parts = _parts(points, uv, given)
-    centring, count = _centring(client, parts, None)
-    empty = NormalEquations(
-        count, centring, ctrl, degree, given, knots, smooth, periodic_u, correct
-    )
-    shared = client.scatter(empty, broadcast=True, hash=False)
-    eq = _pass(client, parts, _equations, shared)
-    surface = eq.finish()
-    text = client.scatter(surface.to_json(), broadcast=True, hash=False)
-    errors = _pass(client, parts, _errors, text)
+    centring, count, first = _centring(client, parts, None)
+    setup = FitSetup(count, centring, ctrl, degree, given, knots, smooth, periodic_u, correct)
+    passes = 1
+    if setup.plane:
+        plane = PlanePasses(centring, tuple(map(float, first)), count)
+        while not plane.done:
+            stage = _shared(plane.stage())
+            plane.push(_pass(client, parts, _plane, stage))
+            passes += 1
+        param = plane.parameterization()
+    else:
+        param = Parameterization.given(centring)
+
+    def fit(param):
+        """One least-squares fit to the parameters of ``param``: the knots, the
+        equations, the errors; returns (surface, fitted param, errors, passes)."""
+        n = 0
+        shared = _shared(param)
+        search = setup.knot_search()
+        while search is not None and not search.done:
+            q = _shared(search.query())
+            search.push(_pass(client, parts, _ranks, shared, q))
+            n += 1
+        empty = _shared(setup.equations(search))
+        eq = _pass(client, parts, _equations, shared, empty)
+        fitted = param.fitted(eq)
+        errors = _pass(client, parts, _errors, _shared(fitted))
+        return eq, fitted, errors, n + 2
+
+    # Hoschek's correction as scanfit::fit::correction::correct_parameters runs it
+    eq, best, errors, n = fit(param)
+    passes += n
+    rounds = []
+    if setup.correct > 0:
+        rounds.append({"round": 0, "rmse": errors.stats()["rmse"], "max": errors.stats()["max"]})
+    for k in range(1, setup.correct + 1):
+        cand_eq, cand, e, n = fit(best.corrected())
+        passes += n
+        s = e.stats()
+        rounds.append({"round": k, "rmse": s["rmse"], "max": s["max"]})
+        old = errors.stats()["rmse"]
+        if s["rmse"] < old:
+            gain = (old - s["rmse"]) / max(old, np.finfo(float).tiny)
+            eq, best, errors = cand_eq, cand, e
+            if gain < setup.min_improvement:
+                break
+        else:
+            break
     return {
-        "surface": surface,
+        "surface": eq.finish(),
         "smoothing": eq.smoothing,
         "points": eq.points,
         "errors": errors.stats(),
-        "passes": 3,
+        "rounds": rounds,
+        "passes": passes,
         "seconds": time.perf_counter() - t0,
         "equation_bytes": eq.nbytes,
     }

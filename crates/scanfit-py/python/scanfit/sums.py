@@ -17,8 +17,15 @@ additions (about 1e-15 relative).
   ``push(sums)`` finishes the level, ``finish()`` the surface.
 - ``BaSums``: one level's sums; ``add(state, points)`` returns the residual
   statistics of the level before (``ResidualSums``).
-- ``NormalEquations(count, centring, ...)``: ``fit_surface``'s keywords, uniform
-  knots; ``add(points, uv)``, ``merge``, ``finish() -> Surface``.
+- ``FitSetup(count, centring, ...)``: ``fit_surface``'s keywords resolved for
+  ``count`` points; ``knot_search()`` (``KnotSearch``: the exact order statistics
+  behind the distribution knots, NURBS Book eq. 9.69, in rounds of ``RankQuery``
+  / ``RankCounts``), ``equations(search=None)`` (empty ``NormalEquations``).
+- ``NormalEquations``: ``add(points, uv)``, ``merge``, ``finish() -> Surface``.
+- ``PlanePasses(centring, first, count)``: the best-fit plane (``params="plane"``)
+  in three passes of ``PlaneStage`` / ``PlaneSums`` (covariance, hull, extents).
+- ``Parameterization``: a chunk's ``(u, v)`` (plane or given), re-projected
+  onto the surfaces of the accepted correction rounds; ``errors`` at them.
 - ``surface_errors(surface, points, uv) -> ResidualSums``: errors at the parameters.
 
 Example (two "workers" by hand)::
@@ -41,10 +48,18 @@ Example (two "workers" by hand)::
 from ._scanfit import (
     BaSums,
     Centring,
+    FitSetup,
     FrameSums,
+    KnotSearch,
     MbaLevels,
     MbaState,
     NormalEquations,
+    Parameterization,
+    PlanePasses,
+    PlaneStage,
+    PlaneSums,
+    RankCounts,
+    RankQuery,
     ResidualSums,
     surface_errors,
 )
@@ -52,10 +67,18 @@ from ._scanfit import (
 __all__ = [
     "BaSums",
     "Centring",
+    "FitSetup",
     "FrameSums",
+    "KnotSearch",
     "MbaLevels",
     "MbaState",
     "NormalEquations",
+    "Parameterization",
+    "PlanePasses",
+    "PlaneStage",
+    "PlaneSums",
+    "RankCounts",
+    "RankQuery",
     "ResidualSums",
     "surface_errors",
 ]
@@ -66,6 +89,11 @@ _KINDS = {
     "FrameSums": FrameSums,
     "MbaState": MbaState,
     "NormalEquations": NormalEquations,
+    "Parameterization": Parameterization,
+    "PlaneStage": PlaneStage,
+    "PlaneSums": PlaneSums,
+    "RankCounts": RankCounts,
+    "RankQuery": RankQuery,
     "ResidualSums": ResidualSums,
 }
 

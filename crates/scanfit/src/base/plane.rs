@@ -6,6 +6,7 @@
 //! field over its best-fit plane (terrain, a face seen from the front, a gently
 //! curved panel); it folds over where the patch turns back over that plane.
 
+use crate::wire::{Reader, Writer};
 use crate::{Error, Point3, Result, Vector3};
 
 /// The plane and the parameters it gives.
@@ -28,6 +29,10 @@ pub struct PlaneParameterization {
 /// Parameters of `points` on their best-fit plane. Axis signs are made
 /// deterministic (largest component positive), so the result does not depend
 /// on the eigen solver.
+///
+/// The steps are those of a chunked or distributed run ([`PlaneAxes`] from
+/// the covariance sums, [`FlatHull`], [`PlaneExtents`], [`PlaneMap`]), each
+/// fed all points at once here.
 pub fn plane_parameters(points: &[Point3]) -> Result<PlaneParameterization> {
     crate::validate_points(points)?;
     if points.len() < 3 {
@@ -42,85 +47,317 @@ pub fn plane_parameters(points: &[Point3]) -> Result<PlaneParameterization> {
         needed: 3,
         what: "a best-fit plane".into(),
     })?;
-    let c = pca.centroid.coords;
-    let orient = |v: Vector3| {
-        let j = v.iamax();
-        if v[j] < 0.0 {
-            -v
-        } else {
-            v
-        }
-    };
-    let a1 = orient(pca.axes[0]);
-    let normal = orient(pca.axes[2]);
-    let a2 = normal.cross(&a1);
-    let (l1, l2) = (pca.values[0], pca.values[1]);
-    if l2.is_nan() || l2 <= 1e-24 * l1.max(f64::MIN_POSITIVE) {
-        return Err(Error::InvalidInput(
-            "the points are collinear (or coincide): they span no plane to parameterize over"
-                .into(),
-        ));
-    }
-    // in-plane axes of the minimum-area bounding rectangle
-    let flat: Vec<[f64; 2]> = points
-        .iter()
-        .map(|p| [(p.coords - c).dot(&a1), (p.coords - c).dot(&a2)])
-        .collect();
-    let (cos, sin) = min_area_rectangle_direction(&flat);
-    let mut e1 = a1 * cos + a2 * sin;
-    let extent = |e: &Vector3| {
-        let (lo, hi) = points
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-                let s = (p.coords - c).dot(e);
-                (lo.min(s), hi.max(s))
-            });
-        hi - lo
-    };
-    if extent(&normal.cross(&e1)) > extent(&e1) {
-        e1 = normal.cross(&e1);
-    }
-    let e1 = orient(e1);
-    let e2 = normal.cross(&e1);
-    let proj: Vec<(f64, f64)> = points
-        .iter()
-        .map(|p| ((p.coords - c).dot(&e1), (p.coords - c).dot(&e2)))
-        .collect();
-    let (mut lo1, mut hi1, mut lo2, mut hi2) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for &(s, t) in &proj {
-        lo1 = lo1.min(s);
-        hi1 = hi1.max(s);
-        lo2 = lo2.min(t);
-        hi2 = hi2.max(t);
-    }
-    let uv = proj
-        .iter()
-        .map(|&(s, t)| {
-            [
-                ((s - lo1) / (hi1 - lo1)).clamp(0.0, 1.0),
-                ((t - lo2) / (hi2 - lo2)).clamp(0.0, 1.0),
-            ]
-        })
-        .collect();
+    let axes = PlaneAxes::of(&pca)?;
+    let mut hull = FlatHull::default();
+    hull.add(&axes, points);
+    let mut extents = PlaneExtents::new(&axes, hull.rectangle_direction());
+    extents.add(points);
+    let map = extents.finish()?;
+    let uv = points.iter().map(|p| map.uv(p)).collect();
     Ok(PlaneParameterization {
-        origin: Point3::from(c),
-        e1,
-        e2,
-        normal,
-        bounds: [(lo1, hi1), (lo2, hi2)],
+        origin: map.origin,
+        e1: map.e1,
+        e2: map.e2,
+        normal: map.normal,
+        bounds: map.bounds,
         uv,
     })
 }
 
+/// `v` with its largest component made positive (deterministic signs).
+fn orient(v: Vector3) -> Vector3 {
+    let j = v.iamax();
+    if v[j] < 0.0 {
+        -v
+    } else {
+        v
+    }
+}
+
+/// The best-fit plane's frame from the points' PCA: the centroid, the
+/// first principal axis `a1`, the normal (the last axis) and `a2 = normal x
+/// a1`, signs made deterministic. The in-plane axes are provisional: the
+/// parameter axes are those of the minimum-area rectangle ([`FlatHull`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlaneAxes {
+    /// Centroid of the points.
+    pub origin: Point3,
+    /// First principal direction.
+    pub a1: Vector3,
+    /// `normal x a1`.
+    pub a2: Vector3,
+    /// The plane's normal (least principal direction).
+    pub normal: Vector3,
+}
+
+impl PlaneAxes {
+    /// The frame of `pca`; errors for collinear or coincident points.
+    pub fn of(pca: &crate::Pca) -> Result<Self> {
+        let a1 = orient(pca.axes[0]);
+        let normal = orient(pca.axes[2]);
+        let a2 = normal.cross(&a1);
+        let (l1, l2) = (pca.values[0], pca.values[1]);
+        if l2.is_nan() || l2 <= 1e-24 * l1.max(f64::MIN_POSITIVE) {
+            return Err(Error::InvalidInput(
+                "the points are collinear (or coincide): they span no plane to parameterize over"
+                    .into(),
+            ));
+        }
+        Ok(Self {
+            origin: pca.centroid,
+            a1,
+            a2,
+            normal,
+        })
+    }
+
+    /// Coordinates of `p` along `a1` and `a2` about the centroid.
+    pub fn flat(&self, p: &Point3) -> [f64; 2] {
+        let d = p.coords - self.origin.coords;
+        [d.dot(&self.a1), d.dot(&self.a2)]
+    }
+}
+
+/// The convex hull of points in the plane's coordinates ([`PlaneAxes::flat`]):
+/// mergeable (the hull of two hulls is the hull of all their points), and
+/// what the minimum-area rectangle needs.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct FlatHull {
+    hull: Vec<[f64; 2]>,
+}
+
+const HULL_TAG: &[u8; 8] = b"SFHULL01";
+
+impl FlatHull {
+    /// Adds points (in space; flattened by `axes`).
+    pub fn add(&mut self, axes: &PlaneAxes, points: &[Point3]) {
+        let mut flat = std::mem::take(&mut self.hull);
+        flat.extend(points.iter().map(|p| axes.flat(p)));
+        self.hull = convex_hull(&flat);
+    }
+
+    /// Adds the hull of other points.
+    pub fn merge(&mut self, other: &Self) {
+        let mut flat = std::mem::take(&mut self.hull);
+        flat.extend_from_slice(&other.hull);
+        self.hull = convex_hull(&flat);
+    }
+
+    /// Vertices of the hull, counter-clockwise.
+    pub fn vertices(&self) -> &[[f64; 2]] {
+        &self.hull
+    }
+
+    /// Direction `(cos, sin)`, in the `a1, a2` frame, of an edge of the
+    /// minimum-area rectangle enclosing the points.
+    pub fn rectangle_direction(&self) -> (f64, f64) {
+        rectangle_direction(&self.hull)
+    }
+
+    /// The hull as exact bytes ([`crate::wire`]).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut w = Writer::new(HULL_TAG);
+        let flat: Vec<f64> = self.hull.iter().flatten().copied().collect();
+        w.f64s(&flat);
+        w.finish()
+    }
+
+    /// Reads what [`to_bytes`](Self::to_bytes) wrote.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
+        let mut r = Reader::new(bytes, HULL_TAG, "a convex hull")?;
+        let flat = r.f64s()?;
+        if flat.len() % 2 != 0 {
+            return Err(r.corrupt("the hull's coordinates"));
+        }
+        r.end()?;
+        Ok(Self {
+            hull: flat.chunks_exact(2).map(|c| [c[0], c[1]]).collect(),
+        })
+    }
+}
+
+/// Mergeable extents of the points along the candidate parameter axes of
+/// the minimum-area rectangle: its edge direction `e` and `normal x e`
+/// (the longer becomes `u`), oriented, and the bounds along the chosen
+/// axes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlaneExtents {
+    axes: PlaneAxes,
+    /// `e`, `normal x e`, then the oriented `(e1, e2)` pair of each choice.
+    dirs: [Vector3; 6],
+    lo: [f64; 6],
+    hi: [f64; 6],
+}
+
+const EXTENTS_TAG: &[u8; 8] = b"SFPLEXT1";
+
+impl PlaneExtents {
+    /// No points yet; `direction` from [`FlatHull::rectangle_direction`].
+    pub fn new(axes: &PlaneAxes, direction: (f64, f64)) -> Self {
+        let (cos, sin) = direction;
+        let e = axes.a1 * cos + axes.a2 * sin;
+        let f = axes.normal.cross(&e);
+        let (ea, fa) = (orient(e), orient(f));
+        Self {
+            axes: *axes,
+            dirs: [e, f, ea, axes.normal.cross(&ea), fa, axes.normal.cross(&fa)],
+            lo: [f64::INFINITY; 6],
+            hi: [f64::NEG_INFINITY; 6],
+        }
+    }
+
+    /// Adds points.
+    pub fn add(&mut self, points: &[Point3]) {
+        let c = self.axes.origin.coords;
+        for p in points {
+            let d = p.coords - c;
+            for k in 0..6 {
+                let s = d.dot(&self.dirs[k]);
+                self.lo[k] = self.lo[k].min(s);
+                self.hi[k] = self.hi[k].max(s);
+            }
+        }
+    }
+
+    /// Adds the extents of other points (the same axes and direction).
+    pub fn merge(&mut self, other: &Self) -> Result<()> {
+        if self.axes != other.axes || self.dirs != other.dirs {
+            return Err(Error::InvalidInput(
+                "cannot merge plane extents along different axes; every chunk must use the same plane".into(),
+            ));
+        }
+        for k in 0..6 {
+            self.lo[k] = self.lo[k].min(other.lo[k]);
+            self.hi[k] = self.hi[k].max(other.hi[k]);
+        }
+        Ok(())
+    }
+
+    /// The parameter map: `u` along the longer side of the rectangle.
+    pub fn finish(&self) -> Result<PlaneMap> {
+        if self.lo[0] > self.hi[0] {
+            return Err(Error::InvalidInput(
+                "the plane's extents hold no point".into(),
+            ));
+        }
+        let extent = |k: usize| self.hi[k] - self.lo[k];
+        let k = if extent(1) > extent(0) { 4 } else { 2 };
+        Ok(PlaneMap {
+            origin: self.axes.origin,
+            e1: self.dirs[k],
+            e2: self.dirs[k + 1],
+            normal: self.axes.normal,
+            bounds: [(self.lo[k], self.hi[k]), (self.lo[k + 1], self.hi[k + 1])],
+        })
+    }
+
+    /// The extents as exact bytes ([`crate::wire`]).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut w = Writer::new(EXTENTS_TAG);
+        let a = &self.axes;
+        let mut v: Vec<f64> = a.origin.coords.iter().copied().collect();
+        for x in [a.a1, a.a2, a.normal].iter().chain(&self.dirs) {
+            v.extend(x.iter());
+        }
+        v.extend(self.lo);
+        v.extend(self.hi);
+        w.f64s(&v);
+        w.finish()
+    }
+
+    /// Reads what [`to_bytes`](Self::to_bytes) wrote.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
+        let mut r = Reader::new(bytes, EXTENTS_TAG, "plane extents")?;
+        let v = r.f64s()?;
+        if v.len() != 3 * 10 + 12 {
+            return Err(r.corrupt("the plane extents' values"));
+        }
+        r.end()?;
+        let vec = |k: usize| Vector3::new(v[3 * k], v[3 * k + 1], v[3 * k + 2]);
+        let mut lo = [0.0; 6];
+        let mut hi = [0.0; 6];
+        lo.copy_from_slice(&v[30..36]);
+        hi.copy_from_slice(&v[36..42]);
+        Ok(Self {
+            axes: PlaneAxes {
+                origin: Point3::from(vec(0)),
+                a1: vec(1),
+                a2: vec(2),
+                normal: vec(3),
+            },
+            dirs: [vec(4), vec(5), vec(6), vec(7), vec(8), vec(9)],
+            lo,
+            hi,
+        })
+    }
+}
+
+/// The map from a point to its parameters on the best-fit plane: the
+/// projection on `e1`, `e2` about the centroid, scaled from `bounds` to
+/// `[0, 1]` (clamped).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlaneMap {
+    /// Centroid of the points.
+    pub origin: Point3,
+    /// The `u` axis.
+    pub e1: Vector3,
+    /// The `v` axis (`normal x e1`).
+    pub e2: Vector3,
+    /// The plane's normal.
+    pub normal: Vector3,
+    /// `(min, max)` of the projections on `e1` and `e2`.
+    pub bounds: [(f64, f64); 2],
+}
+
+impl PlaneMap {
+    /// The parameters of `p`.
+    #[inline]
+    pub fn uv(&self, p: &Point3) -> [f64; 2] {
+        let d = p.coords - self.origin.coords;
+        let (s, t) = (d.dot(&self.e1), d.dot(&self.e2));
+        let [(lo1, hi1), (lo2, hi2)] = self.bounds;
+        [
+            ((s - lo1) / (hi1 - lo1)).clamp(0.0, 1.0),
+            ((t - lo2) / (hi2 - lo2)).clamp(0.0, 1.0),
+        ]
+    }
+
+    /// Writes the fields into a record ([`crate::wire`]).
+    pub fn write(&self, w: &mut Writer) {
+        let mut v: Vec<f64> = self.origin.coords.iter().copied().collect();
+        for x in [self.e1, self.e2, self.normal] {
+            v.extend(x.iter());
+        }
+        v.extend([
+            self.bounds[0].0,
+            self.bounds[0].1,
+            self.bounds[1].0,
+            self.bounds[1].1,
+        ]);
+        w.f64s(&v);
+    }
+
+    /// Reads the fields [`write`](Self::write) wrote.
+    pub fn read(r: &mut Reader<'_>) -> Result<Self> {
+        let v = r.f64s()?;
+        if v.len() != 16 {
+            return Err(r.corrupt("the plane map's values"));
+        }
+        let vec = |k: usize| Vector3::new(v[3 * k], v[3 * k + 1], v[3 * k + 2]);
+        Ok(Self {
+            origin: Point3::from(vec(0)),
+            e1: vec(1),
+            e2: vec(2),
+            normal: vec(3),
+            bounds: [(v[12], v[13]), (v[14], v[15])],
+        })
+    }
+}
+
 /// Direction `(cos, sin)` of an edge of the minimum-area rectangle enclosing
-/// `pts` (Freeman & Shapira 1975: one side is collinear with a hull edge).
-fn min_area_rectangle_direction(pts: &[[f64; 2]]) -> (f64, f64) {
-    let hull = convex_hull(pts);
+/// the convex polygon `hull` (Freeman & Shapira 1975: one side is collinear
+/// with a hull edge).
+fn rectangle_direction(hull: &[[f64; 2]]) -> (f64, f64) {
     let mut best = (f64::INFINITY, (1.0, 0.0));
     for k in 0..hull.len() {
         let (a, b) = (hull[k], hull[(k + 1) % hull.len()]);
@@ -136,7 +373,7 @@ fn min_area_rectangle_direction(pts: &[[f64; 2]]) -> (f64, f64) {
             f64::INFINITY,
             f64::NEG_INFINITY,
         );
-        for p in &hull {
+        for p in hull {
             let (x, y) = (p[0] * c + p[1] * s, -p[0] * s + p[1] * c);
             lo1 = lo1.min(x);
             hi1 = hi1.max(x);
@@ -207,6 +444,57 @@ mod tests {
             Point3::new(2., 2., 2.)
         ])
         .is_err());
+    }
+
+    #[test]
+    fn the_passes_over_chunks_give_the_one_call_parameters() {
+        // a tilted, rotated patch in three chunks: covariance sums about the
+        // first point, hulls and extents merged, then the map per point
+        let (c, s) = (0.6f64.cos(), 0.6f64.sin());
+        let pts: Vec<Point3> = (0..3000)
+            .map(|k| {
+                let (x, y) = ((k * 37 % 101) as f64 * 0.7, (k * 53 % 89) as f64 * 0.4);
+                let z = 0.3 * x + 0.05 * (x * 0.2).sin() * y;
+                Point3::new(x * c - y * s + 50.0, x * s + y * c - 20.0, z)
+            })
+            .collect();
+        let once = plane_parameters(&pts).unwrap();
+        let chunks = [&pts[..700], &pts[700..700], &pts[700..2100], &pts[2100..]];
+        let mut cov = crate::CovarianceSums::new(pts[0]);
+        for ch in chunks {
+            let mut part = crate::CovarianceSums::new(pts[0]);
+            ch.iter().for_each(|p| part.add(p));
+            let part = crate::CovarianceSums::from_bytes(&part.to_bytes()).unwrap();
+            cov.merge(&part).unwrap();
+        }
+        let axes = PlaneAxes::of(&cov.finish().unwrap()).unwrap();
+        let mut hull = FlatHull::default();
+        for ch in chunks {
+            let mut part = FlatHull::default();
+            part.add(&axes, ch);
+            hull.merge(&FlatHull::from_bytes(&part.to_bytes()).unwrap());
+        }
+        let mut ext = PlaneExtents::new(&axes, hull.rectangle_direction());
+        for ch in chunks {
+            let mut part = PlaneExtents::new(&axes, hull.rectangle_direction());
+            part.add(ch);
+            ext.merge(&PlaneExtents::from_bytes(&part.to_bytes()).unwrap())
+                .unwrap();
+        }
+        let map = ext.finish().unwrap();
+        let worst = pts
+            .iter()
+            .zip(&once.uv)
+            .map(|(p, t)| {
+                let q = map.uv(p);
+                (q[0] - t[0]).abs().max((q[1] - t[1]).abs())
+            })
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-12, "{worst}");
+        assert!((map.e1 - once.e1).norm() < 1e-12 && (map.normal - once.normal).norm() < 1e-12);
+        // different reference points do not merge
+        let mut other = crate::CovarianceSums::new(pts[1]);
+        assert!(other.merge(&cov).is_err());
     }
 
     #[test]

@@ -13,6 +13,7 @@ pub mod cyclic;
 pub mod gram;
 pub mod grid;
 mod interpolate;
+pub mod knot_ranks;
 mod least_squares;
 pub mod surface;
 

@@ -202,14 +202,7 @@ impl SurfaceFitConfig {
             return Err(Error::InvalidSetting {
                 setting: "knots",
                 value: "distribution".into(),
-                hint: "knots from the parameter distribution (NURBS Book eq. 9.69) need all parameters sorted at once; use uniform knots for points read in chunks".into(),
-            });
-        }
-        if self.weights.is_some() {
-            return Err(Error::InvalidSetting {
-                setting: "weights",
-                value: "given".into(),
-                hint: "give the weights of points read in chunks with each chunk (NormalEquations::add)".into(),
+                hint: "knots from the parameter distribution (NURBS Book eq. 9.69) need all parameters sorted at once; use uniform knots for points read in chunks, or find the parameters' order statistics first (scanfit::fit::knot_ranks::KnotSearch)".into(),
             });
         }
         let ((p, q), (nu, nv)) = (self.degree, self.ctrl);
@@ -218,7 +211,23 @@ impl SurfaceFitConfig {
         } else {
             KnotVector::uniform_clamped(p, nu)?
         };
-        NormalEquations::new(ku, KnotVector::uniform_clamped(q, nv)?, self.periodic_u)
+        self.equations_with(ku, KnotVector::uniform_clamped(q, nv)?)
+    }
+
+    /// Empty normal equations for this configuration's net and periodicity
+    /// with the given knot vectors (e.g. from
+    /// [`KnotSearch`](super::knot_ranks::KnotSearch)); the checks of
+    /// [`uniform_equations`](Self::uniform_equations).
+    pub fn equations_with(&self, ku: KnotVector, kv: KnotVector) -> Result<NormalEquations> {
+        check_net(self)?;
+        if self.weights.is_some() {
+            return Err(Error::InvalidSetting {
+                setting: "weights",
+                value: "given".into(),
+                hint: "give the weights of points read in chunks with each chunk (NormalEquations::add)".into(),
+            });
+        }
+        NormalEquations::new(ku, kv, self.periodic_u)
     }
 }
 
@@ -231,10 +240,23 @@ pub fn distribution_knots(
 ) -> Result<KnotVector> {
     let mut s: Vec<f64> = params.filter(|u| u.is_finite()).collect();
     s.sort_by(f64::total_cmp);
-    if s.len() < count || count <= p + 1 {
+    if !distribution_applies(s.len(), p, count) {
         return KnotVector::uniform_clamped(p, count);
     }
-    let mut interior = crate::param::knots::eq_9_69_interior(&s, p, count);
+    knots_from_interior(crate::param::knots::eq_9_69_interior(&s, p, count), p)
+}
+
+/// Whether [`distribution_knots`] follows `len` parameters for `count`
+/// control points of degree `p` (otherwise its knots are uniform: fewer
+/// parameters than control points, or no interior knot).
+pub fn distribution_applies(len: usize, p: usize, count: usize) -> bool {
+    len >= count && count > p + 1
+}
+
+/// The clamped knot vector on `[0, 1]` with the interior knots of eq. 9.69,
+/// kept strictly inside `(0, 1)` and strictly increasing (the last step of
+/// [`distribution_knots`]).
+pub fn knots_from_interior(mut interior: Vec<f64>, p: usize) -> Result<KnotVector> {
     // keep interior knots strictly inside (0, 1) and below multiplicity p
     let eps = 1e-9;
     for t in interior.iter_mut() {

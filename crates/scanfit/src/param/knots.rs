@@ -47,17 +47,34 @@ pub fn least_squares(params: &[f64], p: usize, ctrl_count: usize) -> Result<Knot
 /// The interior knots of eqs. 9.68-9.69 for `ctrl_count` control points over the
 /// sorted `params` (needs `p + 1 <= ctrl_count <= params.len()`).
 pub fn eq_9_69_interior(params: &[f64], p: usize, ctrl_count: usize) -> Vec<f64> {
-    let m = params.len() - 1;
+    eq_9_69_ranks(params.len(), p, ctrl_count)
+        .into_iter()
+        .map(|(i, alpha)| eq_9_69_knot(params[i - 1], params[i], alpha))
+        .collect()
+}
+
+/// The ranks behind eq. 9.69 for `len` sorted parameters: per interior knot
+/// `(i, alpha)`, the knot being [`eq_9_69_knot`] of the parameters of ranks
+/// `i - 1` and `i` (0-based). What a chunked fit looks up when it cannot sort
+/// all parameters at once (`scanfit::fit::knot_ranks`). Needs `p + 1 <=
+/// ctrl_count <= len`.
+pub fn eq_9_69_ranks(len: usize, p: usize, ctrl_count: usize) -> Vec<(usize, f64)> {
+    let m = len - 1;
     let n = ctrl_count - 1;
     let d = (m + 1) as f64 / (n - p + 1) as f64;
     (1..=n.saturating_sub(p))
         .map(|j| {
             let jd = j as f64 * d;
             let i = (jd.floor() as usize).clamp(1, m);
-            let alpha = jd - i as f64;
-            (1.0 - alpha) * params[i - 1] + alpha * params[i]
+            (i, jd - i as f64)
         })
         .collect()
+}
+
+/// Eq. 9.69's knot between the parameters `a` (rank `i - 1`) and `b` (rank `i`).
+#[inline]
+pub fn eq_9_69_knot(a: f64, b: f64, alpha: f64) -> f64 {
+    (1.0 - alpha) * a + alpha * b
 }
 
 /// Knots for interpolation with prescribed first derivatives at both ends
