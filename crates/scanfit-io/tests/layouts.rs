@@ -413,7 +413,7 @@ fn grid_3x3_beats_one_patch_on_a_panel_with_a_badge() {
     );
     // measured: 921 control points, rmse 0.0614 against 0.0798 for one
     // 31 x 31 patch (23% lower; the noise is 0.05): the badge's patch gets
-    // a 27 x 19 net, the smooth ones 7 to 11 a side
+    // a 19 x 27 net, the smooth ones 7 x 11
     assert!(total <= n * n && total > 850, "{total}");
     assert!(g < 0.85 * s, "grid rmse {g} vs one patch {s}");
     assert!((0.055..0.068).contains(&g), "{g}");

@@ -164,23 +164,13 @@ fn allocate(
     cols: usize,
 ) -> (Vec<usize>, Vec<usize>, Vec<(usize, usize)>) {
     let want = |k: usize| (lambda * rho[k] * len[k].0, lambda * rho[k] * len[k].1);
+    // the largest power of two not above the least any patch of a row (column) wants
+    let least = |w: &mut dyn Iterator<Item = f64>| pow2_floor(w.fold(f64::INFINITY, f64::min));
     let row: Vec<usize> = (0..rows)
-        .map(|r| {
-            pow2_floor(
-                (0..cols)
-                    .map(|c| want(r * cols + c).0)
-                    .fold(f64::INFINITY, f64::min),
-            )
-        })
+        .map(|r| least(&mut (0..cols).map(|c| want(r * cols + c).0)))
         .collect();
     let col: Vec<usize> = (0..cols)
-        .map(|c| {
-            pow2_floor(
-                (0..rows)
-                    .map(|r| want(r * cols + c).1)
-                    .fold(f64::INFINITY, f64::min),
-            )
-        })
+        .map(|c| least(&mut (0..rows).map(|r| want(r * cols + c).1)))
         .collect();
     let patch = (0..rows * cols)
         .map(|k| {
@@ -424,32 +414,31 @@ impl GridFrame {
         for e in &mut net.edges {
             let ((i1, j1), (i2, j2)) = (at[e.start], at[e.end]);
             let ends = (node(i1, j1), node(i2, j2));
-            let curve = if i1 == i2 && j1.abs_diff(j2) == 1 {
-                let j = j1.min(j2);
-                let range = (g.col_cuts[j], g.col_cuts[j + 1]);
-                let ctrl = iso_curve(s, false, g.row_cuts[i1]);
-                let (lo, hi) = if j1 < j2 { ends } else { (ends.1, ends.0) };
-                along.push(false);
-                let c = piece(s.knots_v(), ctrl, range, self.col_spans[j], (lo, hi))?;
-                (c, j1 > j2)
+            // which cut the edge runs along, and its two crossings on it
+            let (along_u, (a, b)) = if i1 == i2 && j1.abs_diff(j2) == 1 {
+                (false, (j1, j2))
             } else if j1 == j2 && i1.abs_diff(i2) == 1 {
-                let i = i1.min(i2);
-                let range = (g.row_cuts[i], g.row_cuts[i + 1]);
-                let ctrl = iso_curve(s, true, g.col_cuts[j1]);
-                let (lo, hi) = if i1 < i2 { ends } else { (ends.1, ends.0) };
-                along.push(true);
-                let c = piece(s.knots_u(), ctrl, range, self.row_spans[i], (lo, hi))?;
-                (c, i1 > i2)
+                (true, (i1, i2))
             } else {
                 return Err(Error::InvalidInput(format!(
                     "the grid's patch network has an edge from the crossing ({i1}, {j1}) to ({i2}, {j2}), not along one cut between neighbouring crossings; its patches do not meet as a grid"
                 )));
             };
-            e.curve = if curve.1 {
-                crate::bspline::ops::reversed(&curve.0)?
+            let (cuts, at_cut, knots, spans) = if along_u {
+                (&g.row_cuts, g.col_cuts[j1], s.knots_u(), &self.row_spans)
             } else {
-                curve.0
+                (&g.col_cuts, g.row_cuts[i1], s.knots_v(), &self.col_spans)
             };
+            let k = a.min(b);
+            let ctrl = iso_curve(s, along_u, at_cut);
+            let (lo, hi) = if a < b { ends } else { (ends.1, ends.0) };
+            let c = piece(knots, ctrl, (cuts[k], cuts[k + 1]), spans[k], (lo, hi))?;
+            e.curve = if a > b {
+                crate::bspline::ops::reversed(&c)?
+            } else {
+                c
+            };
+            along.push(along_u);
         }
         for (v, &(i, j)) in net.vertices.iter_mut().zip(&at) {
             *v = node(i, j);
