@@ -63,8 +63,8 @@ pub struct GridOptions {
     /// rather than from the border points of the two patches along each cut.
     pub frame: bool,
     /// Least-squares route with a frame: control nets by the detail of each
-    /// patch within the uniform grid's total (default true), rather than
-    /// the same net (rounded to the frame's spans) for all.
+    /// patch within the uniform grid's total (default true), rather than one
+    /// control-point density per unit length for all.
     pub detail_ctrl: bool,
 }
 
@@ -87,7 +87,7 @@ impl GridOptions {
         }
     }
 
-    /// The frame's edges, one net (rounded to the frame's spans) for every patch.
+    /// The frame's edges, one control-point density for every patch.
     pub fn frame_only() -> Self {
         Self {
             frame: true,
@@ -526,15 +526,18 @@ mod tests {
     }
 
     #[test]
-    fn without_detail_every_patch_has_the_same_net() {
+    fn without_detail_equal_patches_get_nets_within_one_multiple() {
         let pts = sheet();
         let g = grid_labels(&PointCloud::new(pts.clone()).unwrap(), 3, 3, 1.0 / 60.0).unwrap();
-        // one density per unit length: equal patches get equal nets, the
-        // long side (2 against 1) twice the spans, within the uniform count
+        // one density per unit length: equal patches get nets within one
+        // multiple of each other (the largest scale within the budget may
+        // lift some of them, e.g. one column, and not the rest)
         let f = grid_frame(&pts, &g, (12, 12), false).unwrap();
-        assert!(f.ctrl.iter().all(|&c| c == f.ctrl[0]), "{:?}", f.ctrl);
-        let (a, b) = (f.ctrl[0].0 - 3, f.ctrl[0].1 - 3);
-        assert_eq!(a.max(b), 2 * a.min(b), "{:?}", f.ctrl);
+        let spans: Vec<(usize, usize)> = f.ctrl.iter().map(|&(a, b)| (a - 3, b - 3)).collect();
+        let (lo, hi) = spans.iter().fold((usize::MAX, 0), |(l, h), &(a, b)| {
+            (l.min(a * b), h.max(a * b))
+        });
+        assert!(hi <= 2 * lo, "{:?}", f.ctrl);
         let budget = grid_count(&[9; 3], &[9; 3], &[(12, 12); 9]);
         assert!(grid_count(&f.row_spans, &f.col_spans, &f.ctrl) <= budget);
         let e = grid_frame(&pts, &g, (3, 12), false).unwrap_err();
