@@ -47,7 +47,9 @@ case-insensitive, or the one named by --labels); negative ids and the ids of
 --ignore are left out. Without labels: --segment cuts the cloud at its sharp
 edges (as `scanfit cloud segment`), --layout cube lays six patches over a
 closed star-shaped object, --layout grid:RxC cuts a four-sided sheet along
-iso-lines of its Coons base, --layout revolve:SxL cuts an object about its axis
+iso-lines of its Coons base (corners and edge curves from one least-squares
+surface of the whole sheet; with --fit bspline each patch's net follows its
+detail within R x C nets of --ctrl), --layout revolve:SxL cuts an object about its axis
 (--axis, default the principal axis) into S sectors x L bands with S three-sided
 caps at each closed end; their ids replace the file's and take the same path.
 Pipeline: each patch's border (alpha shape), the patch across every border
@@ -122,7 +124,8 @@ pub struct ReconstructArgs {
     /// Make the patch ids by a layout for a smooth object: `cube` (six
     /// four-sided patches by central projection onto a box about the centre;
     /// closed star-shaped objects), `grid:RxC` (a four-sided sheet cut along
-    /// iso-lines of its Coons base into R x C patches), `revolve:SxL` (S
+    /// iso-lines of its Coons base into R x C patches, control points where
+    /// the detail is), `revolve:SxL` (S
     /// sectors x L bands about the axis, S three-sided caps at each closed
     /// end).
     #[arg(long, value_name = "LAYOUT", value_parser = LAYOUT)]
@@ -254,9 +257,11 @@ fn source(a: &ReconstructArgs) -> Result<LabelSource> {
     Ok(match (a.segment, a.layout) {
         (true, _) => LabelSource::Segment(a.segment_options.config()),
         (false, Some(LayoutArg::Cube)) => LabelSource::Layout(Layout::Cube),
-        (false, Some(LayoutArg::Grid(rows, cols))) => {
-            LabelSource::Layout(Layout::Grid { rows, cols })
-        }
+        (false, Some(LayoutArg::Grid(rows, cols))) => LabelSource::Layout(Layout::Grid {
+            rows,
+            cols,
+            options: Default::default(),
+        }),
         (false, Some(LayoutArg::Revolve(sectors, bands))) => LabelSource::Layout(Layout::Revolve {
             sectors,
             bands,

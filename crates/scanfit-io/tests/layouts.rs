@@ -318,25 +318,59 @@ fn open_pot_as_revolve_is_the_pde_papers_twelve_subsets() {
     assert_eq!(occ["free_edges"], 4, "{occ}");
 }
 
-#[test]
-fn grid_3x3_against_one_patch_with_as_many_control_points() {
+/// One least-squares patch of `n x n` control points (the `coons` pipeline,
+/// closest-point parameters on its Coons base), as a one-face model.
+fn one_patch(cloud: &PointCloud, n: usize) -> scanfit::topology::PatchComplex {
     use scanfit::base::CoonsProjection;
-    use scanfit::network::FaceFit;
     use scanfit::pipeline::coons::{self, CoonsConfig, CoonsRoute};
-    // a four-sided sheet with detail everywhere: the Jacksboro fault DEM
-    let (cloud, _) = read("terrain_50k.xyz", None);
+    use scanfit::topology::{FaceCorners, PatchComplex};
+    let mut one = CoonsConfig::default();
+    one.route = CoonsRoute::bspline((3, 3), (n, n));
+    one.ctrl_from_density = false;
+    one.relative_smoothing = None;
+    one.projection = Some(CoonsProjection::Inversion(Default::default()));
+    let s = coons::run(cloud, &one, &NoProgress).unwrap().surface;
+    let c = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)].map(|(u, v)| s.point(u, v));
+    PatchComplex::assemble(
+        c.to_vec(),
+        vec![FaceCorners {
+            id: 0,
+            surface: s,
+            corners: [0, 1, 2, 3],
+        }],
+    )
+    .unwrap()
+}
+
+/// The orthogonal RMSE of `model` over `cloud` by the model measure
+/// (`scanfit report`), each point measured against its own patch.
+fn model_rmse(model: &scanfit::topology::PatchComplex, cloud: &PointCloud) -> f64 {
+    use scanfit::pipeline::measure_model::{self, ModelMeasureConfig};
+    measure_model::run(model, cloud, &ModelMeasureConfig::default(), &NoProgress)
+        .unwrap()
+        .totals
+        .orthogonal
+        .rmse
+}
+
+/// The grid's model and its RMSE, each point against its own patch.
+fn grid_fit(
+    cloud: &PointCloud,
+    options: scanfit::network::layout::GridOptions,
+    fit: scanfit::network::FaceFit,
+) -> (scanfit::pipeline::reconstruct::ReconstructReport, f64) {
     let mut cfg = ReconstructConfig::default();
-    cfg.source = LabelSource::Layout(Layout::Grid { rows: 3, cols: 3 });
-    cfg.fit = FaceFit::Bspline { ctrl: (8, 8) };
-    let grid = run(&cloud, &cfg, &NoProgress).unwrap();
-    assert_eq!(grid.patches.len(), 9);
-    assert!(
-        grid.patches.iter().all(|p| p.sides == 4),
-        "{:?}",
-        grid.patches
-    );
-    assert!(grid.totals.max_gap <= 1e-9 * grid.totals.diagonal);
-    for p in &grid.patches {
+    cfg.source = LabelSource::Layout(Layout::Grid {
+        rows: 3,
+        cols: 3,
+        options,
+    });
+    cfg.fit = fit;
+    let r = run(cloud, &cfg, &NoProgress).unwrap();
+    assert_eq!(r.patches.len(), 9);
+    assert!(r.patches.iter().all(|p| p.sides == 4), "{:?}", r.patches);
+    assert!(r.totals.max_gap <= 1e-9 * r.totals.diagonal);
+    for p in &r.patches {
         assert!(
             p.fold_overs * 200 <= p.points,
             "patch {}: {} folded",
@@ -344,54 +378,96 @@ fn grid_3x3_against_one_patch_with_as_many_control_points() {
             p.fold_overs
         );
     }
-    // every control point of every face counts (shared boundary rows twice)
-    let total: usize = grid
-        .faces
-        .iter()
-        .map(|f| f.surface.control_points().len())
-        .sum();
+    let mut label = vec![-1.0; cloud.len()];
+    for p in &r.network.patches {
+        for &i in &p.points {
+            label[i] = p.id as f64;
+        }
+    }
+    let labelled = cloud.clone().with_attribute("label", label).unwrap();
+    let e = model_rmse(&r.complex, &labelled);
+    (r, e)
+}
+
+#[test]
+fn grid_3x3_beats_one_patch_on_a_panel_with_a_badge() {
+    use scanfit::network::layout::GridOptions;
+    use scanfit::network::FaceFit;
+    // a bent car panel with a badge off its centre (make_sheet.py)
+    let (cloud, _) = read("panel_20k.ply", None);
+    let fit = FaceFit::Bspline { ctrl: (11, 11) };
+    let (grid, g) = grid_fit(&cloud, GridOptions::default(), fit);
+    // control points counted once, the same way for the grid and one patch
+    let total = grid.complex.control_point_count();
+    assert_eq!(total, grid.totals.control_points);
     let n = (total as f64).sqrt().ceil() as usize;
-    let mut one = CoonsConfig::default();
-    one.route = CoonsRoute::bspline((3, 3), (n, n));
-    one.ctrl_from_density = false;
-    one.relative_smoothing = None;
-    one.projection = Some(CoonsProjection::Inversion(Default::default()));
-    let single = coons::run(&cloud, &one, &NoProgress).unwrap();
-    let (g, s) = (
-        grid.totals.orthogonal.rmse,
-        single.assessment.quality.orthogonal.rmse,
-    );
+    let one = one_patch(&cloud, n);
+    assert_eq!(one.control_point_count(), n * n);
+    let s = model_rmse(&one, &cloud);
+    // the same nets everywhere, edges from the frame or from the border points
+    let (_, frame) = grid_fit(&cloud, GridOptions::frame_only(), fit);
+    let (_, plain) = grid_fit(&cloud, GridOptions::plain(), fit);
     println!(
-        "grid 3x3: {total} control points, orthogonal rmse {g:.3}; one patch {n}x{n}: rmse {s:.3}"
+        "panel: grid 3x3 {total} control points rmse {g:.4}; one {n}x{n} rmse {s:.4}; same nets: frame {frame:.4}, border edges {plain:.4}; {}",
+        grid.layout.as_deref().unwrap_or("")
     );
-    assert!(single.surface.control_points().len() >= total);
+    // measured: 921 control points, rmse 0.0614 against 0.0798 for one
+    // 31 x 31 patch (23% lower; the noise is 0.05): the badge's patch gets
+    // a 19 x 27 net, the smooth ones 7 x 11
+    assert!(total <= n * n && total > 850, "{total}");
+    assert!(g < 0.85 * s, "grid rmse {g} vs one patch {s}");
+    assert!((0.055..0.068).contains(&g), "{g}");
+    // without the detail nets the grid does not win (0.0861, 0.0971)
+    assert!(frame > s && plain > frame, "{frame} {plain} vs {s}");
+}
+
+#[test]
+fn grid_3x3_against_one_patch_on_terrain() {
+    use scanfit::network::layout::GridOptions;
+    use scanfit::network::FaceFit;
+    use scanfit::pipeline::coons::{self, CoonsConfig, CoonsRoute};
+    // a sheet with detail everywhere: the Jacksboro fault DEM
+    let (cloud, _) = read("terrain_50k.xyz", None);
+    let (grid, g) = grid_fit(
+        &cloud,
+        GridOptions::default(),
+        FaceFit::Bspline { ctrl: (11, 11) },
+    );
+    let total = grid.totals.control_points;
+    let n = (total as f64).sqrt().ceil() as usize;
+    let s = model_rmse(&one_patch(&cloud, n), &cloud);
+    println!("terrain: grid 3x3 {total} control points rmse {g:.3}; one {n}x{n} rmse {s:.3}");
     // the PDE route: 9 patches of 5 x 5 terms against one of 15 x 15
-    let mut cfg = ReconstructConfig::default();
-    cfg.source = LabelSource::Layout(Layout::Grid { rows: 3, cols: 3 });
-    let grid_pde = run(&cloud, &cfg, &NoProgress).unwrap();
+    let (_, gp) = grid_fit(&cloud, GridOptions::default(), FaceFit::default());
+    let (_, gp_plain) = grid_fit(&cloud, GridOptions::plain(), FaceFit::default());
     let mut one = CoonsConfig::default();
     one.route = CoonsRoute::pde(15, 15);
-    let single_pde = coons::run(&cloud, &one, &NoProgress).unwrap();
-    let (gp, sp) = (
-        grid_pde.totals.orthogonal.rmse,
-        single_pde.assessment.quality.orthogonal.rmse,
+    let sp = coons::run(&cloud, &one, &NoProgress)
+        .unwrap()
+        .assessment
+        .quality
+        .orthogonal
+        .rmse;
+    println!(
+        "PDE: grid 3x3 of 5x5 terms: rmse {gp:.3} (border edges {gp_plain:.3}); one patch of 15x15 terms: rmse {sp:.3}"
     );
-    println!("PDE: grid 3x3 of 5x5 terms: rmse {gp:.3}; one patch of 15x15 terms: rmse {sp:.3}");
     // Measured, not the hoped-for result: on this terrain (detail at every
-    // scale, a near-planar base) the grid does NOT beat one patch with as
-    // many control points. Least squares: grid 40.99 m against 36.56 m (the
-    // grid's shared boundary rows count twice and its patches join only
-    // C0); PDE route: 61.02 m against 61.82 m (1.3% better, the edge curves
-    // adding freedom the term count does not show). These bounds guard the
-    // measurement.
+    // scale, everywhere) the grid does NOT beat one patch with as many
+    // control points: least squares 40.50 m with 933 control points
+    // against 38.97 m for one 31 x 31 patch (+3.9%: the detail nets have
+    // nothing to concentrate on, and the grid's C0 joints cost spans); PDE
+    // 64.97 m against 61.82 m (+5.1%; with the border-point edges 61.02 m,
+    // -1.3%). These bounds guard the measurement.
+    assert!(total <= n * n);
     assert!(
-        (1.05..1.20).contains(&(g / s)),
+        (1.0..1.10).contains(&(g / s)),
         "grid rmse {g} vs one patch {s}"
     );
     assert!(
-        (0.95..1.0).contains(&(gp / sp)),
+        (1.0..1.10).contains(&(gp / sp)),
         "PDE grid rmse {gp} vs one patch {sp}"
     );
+    assert!((0.95..1.0).contains(&(gp_plain / sp)), "{gp_plain} vs {sp}");
 }
 
 #[test]

@@ -17,6 +17,7 @@ use rayon::prelude::*;
 use crate::bspline::{BasisWorkspace, Curve, Surface};
 use crate::metrics::ErrorStats;
 use crate::network::folds::fold_overs;
+use crate::network::layout::grid_frame::grid_frame;
 use crate::network::layout::{generate_labels, LabelSource, GENERATED_LABEL};
 use crate::network::{
     build_network, fit_face, group_sides, side_curve, side_ranges, FaceConfig, FaceFit,
@@ -26,6 +27,11 @@ use crate::progress::Progress;
 use crate::project::InversionConfig;
 use crate::topology::{self, PatchComplex};
 use crate::{Error, Point3, PointCloud, Result, Vector3};
+
+/// Uniform spans per row and column of a grid frame on the PDE route (the
+/// network's own edge curves have at most 16, a power of two near the square
+/// root of their points).
+const GRID_PDE_FRAME_SPANS: usize = 8;
 
 /// Settings of [`run`].
 #[derive(Debug, Clone, PartialEq)]
@@ -48,6 +54,10 @@ pub struct ReconstructConfig {
     pub tolerance: Option<f64>,
     /// Samples per edge for the gap and normal-angle measures (default 65).
     pub edge_samples: usize,
+    /// Per-patch fits replacing [`ReconstructConfig::fit`] for the patches
+    /// named (by label), e.g. a denser control net where the data carry more
+    /// detail (default none).
+    pub patch_fit: Vec<(i64, FaceFit)>,
 }
 
 impl Default for ReconstructConfig {
@@ -59,6 +69,7 @@ impl Default for ReconstructConfig {
             inversion: InversionConfig::default(),
             tolerance: None,
             edge_samples: 65,
+            patch_fit: Vec::new(),
         }
     }
 }
@@ -118,6 +129,9 @@ pub struct Totals {
     pub diagonal: f64,
     /// Whether every edge has two patches.
     pub closed: bool,
+    /// Control points of the model, each counted once
+    /// ([`PatchComplex::control_point_count`]).
+    pub control_points: usize,
 }
 
 /// The result of [`run`].
@@ -210,8 +224,9 @@ fn run_centred(
     // generated ids go into the label attribute of a copy, read as hand labels are
     let labelled;
     let mut net_cfg = cfg.network.clone();
-    let generated = generate_labels(cloud, &cfg.source, progress)?;
+    let mut generated = generate_labels(cloud, &cfg.source, progress)?;
     let layout = generated.as_ref().map(|g| g.summary.clone());
+    let grid = generated.as_mut().and_then(|g| g.grid.take());
     let cloud = match generated {
         None => cloud,
         Some(g) => {
@@ -223,7 +238,22 @@ fn run_centred(
             &labelled
         }
     };
-    let network = build_network(cloud, &net_cfg, progress)?;
+    let mut network = build_network(cloud, &net_cfg, progress)?;
+    let frame = match &grid {
+        Some((g, options)) if options.frame => {
+            progress.stage("grid frame", None);
+            let ctrl = match cfg.fit {
+                FaceFit::Bspline { ctrl } => ctrl,
+                // the PDE route: frame spans as the network's own edge curves
+                _ => (GRID_PDE_FRAME_SPANS + 3, GRID_PDE_FRAME_SPANS + 3),
+            };
+            let detail = options.detail_ctrl && matches!(cfg.fit, FaceFit::Bspline { .. });
+            let f = grid_frame(cloud.points(), g, ctrl, detail)?;
+            let along_u = f.apply(g, &mut network)?;
+            Some((f, along_u))
+        }
+        _ => None,
+    };
     let (lo, hi) = network
         .patches
         .iter()
@@ -257,24 +287,63 @@ fn run_centred(
         .iter()
         .map(|p| group_sides(&p.cycle, &curves, p.id))
         .collect::<Result<_>>()?;
+    // a grid frame's nets, turned to each patch's own (u, v): its side 0
+    // runs along the base's u or v
+    let frame_fit: Vec<Option<FaceFit>> = network
+        .patches
+        .iter()
+        .zip(&sides)
+        .map(|(p, s)| match (&frame, cfg.fit) {
+            (Some((f, along_u)), FaceFit::Bspline { .. }) => {
+                let (a, b) = *f.ctrl.get(p.id as usize)?;
+                let ctrl = if along_u[s[0][0].edge] {
+                    (a, b)
+                } else {
+                    (b, a)
+                };
+                Some(FaceFit::Bspline { ctrl })
+            }
+            _ => None,
+        })
+        .collect();
     let face_cfg = FaceConfig {
         fit: cfg.fit,
         inversion: cfg.inversion,
         tolerance,
         ..FaceConfig::new(tolerance)
     };
+    if let Some((id, _)) = cfg
+        .patch_fit
+        .iter()
+        .find(|(id, _)| !network.patches.iter().any(|p| p.id == *id))
+    {
+        return Err(Error::InvalidInput(format!(
+            "a fit is given for patch {id}, but no patch has that label"
+        )));
+    }
     progress.stage("patches", Some(network.patches.len() as u64));
     let faces: Vec<FaceSurface> = network
         .patches
         .par_iter()
         .zip(&sides)
-        .map(|(p, s)| {
+        .zip(&frame_fit)
+        .map(|((p, s), ff)| {
             let side_curves: Vec<Curve> = s
                 .iter()
                 .map(|uses| side_curve(uses, &curves))
                 .collect::<Result<_>>()?;
             let pts: Vec<Point3> = p.points.iter().map(|&i| cloud.points()[i]).collect();
-            let f = fit_face(&pts, &side_curves, &face_cfg, p.id);
+            let own = FaceConfig {
+                fit: cfg
+                    .patch_fit
+                    .iter()
+                    .find(|(id, _)| *id == p.id)
+                    .map(|x| x.1)
+                    .or(*ff)
+                    .unwrap_or(face_cfg.fit),
+                ..face_cfg
+            };
+            let f = fit_face(&pts, &side_curves, &own, p.id);
             progress.advance(1);
             f
         })
@@ -317,8 +386,28 @@ fn run_centred(
         max_angle: edges.iter().map(|e| e.max_angle).fold(0.0, f64::max),
         diagonal,
         closed: network.is_closed(),
+        control_points: 0,
     };
     let complex = complex(&network, &sides, &faces);
+    let control_points = complex.control_point_count();
+    let totals = Totals {
+        control_points,
+        ..totals
+    };
+    let layout = match (layout, &frame) {
+        (Some(l), Some((f, _))) => Some(format!(
+            "{l}; edges from a frame surface of the whole sheet ({} x {} spans), control nets {}; {control_points} control points counted once",
+            f.row_spans.iter().sum::<usize>(),
+            f.col_spans.iter().sum::<usize>(),
+            if f.density.iter().all(|&d| d == f.density[0]) {
+                "the same for every patch".to_string()
+            } else {
+                let nets: Vec<String> = f.ctrl.iter().map(|(a, b)| format!("{a}x{b}")).collect();
+                format!("by detail ({})", nets.join(" "))
+            }
+        )),
+        (l, _) => l,
+    };
     Ok(ReconstructReport {
         network,
         sides,

@@ -49,6 +49,7 @@
 //! [`PatchComplex::signed_volume`] integrates the enclosed volume of a closed
 //! complex by the divergence theorem (see [`volume`]).
 
+mod count;
 mod gaps;
 pub mod volume;
 

@@ -26,7 +26,7 @@ use crate::{Error, Point3, PointCloud, Result, Vector3};
 use super::revolve::MIN_PATCH_POINTS;
 
 /// The labels of the grid layout and the Coons base they come from.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct GridLayout {
     /// Per point its patch, `row C + column`.
     pub labels: Vec<i64>,
@@ -34,6 +34,13 @@ pub struct GridLayout {
     pub uv: Vec<[f64; 2]>,
     /// The base's four corners (where the sheet's boundary turns most).
     pub corners: [Point3; 4],
+    /// The cuts along `u`, `u_i = i / R`: row `r` is `u_r <= u < u_(r+1)`.
+    pub row_cuts: Vec<f64>,
+    /// The cuts along `v`, `v_j = j / C`.
+    pub col_cuts: Vec<f64>,
+    /// The lengths of the base along `u` and `v` (the means of the corner
+    /// distances of opposite sides), for densities per unit length.
+    pub side_lengths: (f64, f64),
 }
 
 /// The grid layout of `cloud` with `rows x cols` patches (see the module
@@ -81,6 +88,8 @@ pub fn grid_labels(
     let surface = base.patch.to_bspline()?;
     let par = coons_parameters(&surface, pts, &CoonsParamConfig::default())?;
     one_layer(pts, &par.uv, &surface, spacing)?;
+    let uniform = |n: usize| (0..=n).map(|i| i as f64 / n as f64).collect::<Vec<f64>>();
+    let (row_cuts, col_cuts) = (uniform(rows), uniform(cols));
     let labels: Vec<i64> = par
         .uv
         .iter()
@@ -105,10 +114,18 @@ pub fn grid_labels(
             k % cols
         )));
     }
+    let c = base.patch.corners();
+    let side_lengths = (
+        0.5 * ((c[1] - c[0]).norm() + (c[2] - c[3]).norm()),
+        0.5 * ((c[3] - c[0]).norm() + (c[2] - c[1]).norm()),
+    );
     Ok(GridLayout {
         labels,
         uv: par.uv,
-        corners: base.patch.corners(),
+        corners: c,
+        row_cuts,
+        col_cuts,
+        side_lengths,
     })
 }
 

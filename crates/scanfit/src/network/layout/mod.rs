@@ -14,7 +14,10 @@
 
 pub mod cube;
 pub mod grid;
+pub mod grid_frame;
 pub mod revolve;
+
+pub use grid_frame::GridOptions;
 
 use crate::base::turntable::AxisChoice;
 use crate::cloud::segment::{segment, SegmentConfig};
@@ -33,12 +36,15 @@ pub enum Layout {
     /// ([`cube::cube_labels`]); for closed star-shaped objects.
     Cube,
     /// A sheet cut along iso-parameter lines of its Coons base into
-    /// `rows x cols` patches ([`grid::grid_labels`]).
+    /// `rows x cols` patches ([`grid::grid_labels`]), its edges and control
+    /// nets as `options` say ([`grid_frame`]).
     Grid {
         /// Patches along the base's `u`.
         rows: usize,
         /// Patches along the base's `v`.
         cols: usize,
+        /// Cuts, edge curves and control nets.
+        options: GridOptions,
     },
     /// A cylinder-like object cut into `sectors x bands` patches about its
     /// axis, each closed end into `sectors` three-sided caps
@@ -74,6 +80,8 @@ pub struct GeneratedLabels {
     /// One line on what was found (regions, the axis and ends of a revolve
     /// layout, ...), for the report.
     pub summary: String,
+    /// The grid layout's cuts, parameters and detail (grid layouts only).
+    pub grid: Option<(grid::GridLayout, GridOptions)>,
 }
 
 /// The patch id of every point from `source`, or `None` for
@@ -110,10 +118,12 @@ pub fn generate_labels(
                     "segmentation: {} regions between sharp edges",
                     s.regions.len()
                 ),
+                grid: None,
             }))
         }
         LabelSource::Layout(layout) => {
             let spacing = cloud.spacing()?.median;
+            let mut grid = None;
             let (labels, summary) = match *layout {
                 Layout::Cube => {
                     progress.stage("cube layout", None);
@@ -123,14 +133,20 @@ pub fn generate_labels(
                         "cube: 6 four-sided patches by central projection".into(),
                     )
                 }
-                Layout::Grid { rows, cols } => {
+                Layout::Grid {
+                    rows,
+                    cols,
+                    options,
+                } => {
                     progress.stage("grid layout (Coons base)", None);
                     let g = grid::grid_labels(cloud, rows, cols, spacing)?;
                     let summary = format!(
                         "grid {rows}x{cols} along iso-lines of the sheet's Coons base; {} patches",
                         rows * cols
                     );
-                    (g.labels, summary)
+                    let labels = g.labels.clone();
+                    grid = Some((g, options));
+                    (labels, summary)
                 }
                 Layout::Revolve {
                     sectors,
@@ -143,7 +159,11 @@ pub fn generate_labels(
                     (r.labels, summary)
                 }
             };
-            Ok(Some(GeneratedLabels { labels, summary }))
+            Ok(Some(GeneratedLabels {
+                labels,
+                summary,
+                grid,
+            }))
         }
     }
 }
