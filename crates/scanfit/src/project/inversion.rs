@@ -64,6 +64,17 @@ pub struct Inversion {
     pub converged: bool,
 }
 
+/// What [`SurfaceInverter::invert_near`] returns.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NearInversion {
+    /// `S(uv0) - P`: the residual at the parameters given.
+    pub at_start: Vector3,
+    /// Distance from the point to its foot point.
+    pub distance: f64,
+    /// Whether a convergence criterion was met.
+    pub converged: bool,
+}
+
 /// Reusable evaluation memory for one thread (the surface's derivative
 /// workspace, up to second order).
 #[derive(Debug, Clone)]
@@ -195,6 +206,133 @@ impl<'s, S: ParametricSurface + ?Sized> SurfaceInverter<'s, S> {
         }
         best.iterations = iterations;
         best
+    }
+
+    /// Projects `p`, a point near its own parameters `uv0` (a point the
+    /// surface was fitted to, whose foot point is close to `S(uv0)`), and
+    /// returns the residual at `uv0` too, from the same evaluation.
+    ///
+    /// The fast path costs two evaluations: one Newton step (eq. 6.6) from
+    /// `uv0` with the derivatives up to second order there, then at the new
+    /// parameters the point and tangents, one Gauss-Newton step, and the
+    /// distance to the tangent plane there (the residual's component normal
+    /// to both tangents). That distance is taken when the iteration
+    /// contracts (the second step at most half the first) and the
+    /// surface's bend over the second step, `|S_uu| du^2 + 2 |S_uv| |du dv|
+    /// + |S_vv| dv^2` (twice the Taylor remainder, with the second
+    /// derivatives at `uv0`), is at most `tolerance` x the distance (plus
+    /// `tolerance^2` x the surface's extent): the distance is then that of
+    /// the foot point to a relative `tolerance` (1e-12 by default), tighter
+    /// than [`SurfaceInverter::invert_from`]'s stopping rule. Otherwise
+    /// (the step leaves the domain's interior, the Hessian is not positive
+    /// definite, the steps do not contract), [`SurfaceInverter::invert_from`]
+    /// from `uv0`, and where that does not converge
+    /// [`SurfaceInverter::invert`] with its restarts; the better result
+    /// counts.
+    ///
+    /// ```
+    /// use scanfit::bspline::{KnotVector, Surface};
+    /// use scanfit::project::{InversionConfig, InversionWorkspace, SurfaceInverter};
+    /// use scanfit::Point3;
+    /// let k = KnotVector::uniform_clamped(2, 3).unwrap();
+    /// // the bowl z = x^2 + y^2 over [-1, 1]^2, a biquadratic Bezier patch
+    /// let z = [1.0, -1.0, 1.0];
+    /// let c: Vec<Point3> = (0..3)
+    ///     .flat_map(|i| (0..3).map(move |j| (i, j)))
+    ///     .map(|(i, j)| Point3::new(i as f64 - 1.0, j as f64 - 1.0, z[i] + z[j]))
+    ///     .collect();
+    /// let s = Surface::new(k.clone(), k, c).unwrap();
+    /// let inv = SurfaceInverter::new(&s, InversionConfig::default()).unwrap();
+    /// let mut ws = InversionWorkspace::new(&s);
+    /// let p = Point3::new(0.1, -0.2, 0.3);
+    /// let near = inv.invert_near(&p, [0.55, 0.4], &mut ws);
+    /// let full = inv.invert(&p, &mut ws);
+    /// assert!(near.converged && (near.distance - full.distance).abs() < 1e-12);
+    /// assert_eq!(near.at_start, s.point(0.55, 0.4) - p);
+    /// ```
+    pub fn invert_near(
+        &self,
+        p: &Point3,
+        uv0: [f64; 2],
+        ws: &mut InversionWorkspace<S::Workspace>,
+    ) -> NearInversion {
+        let mut d = [Vector3::zeros(); 9];
+        self.surface
+            .derivatives(uv0[0], uv0[1], 2, &mut ws.ws, &mut d);
+        let at_start = d[0] - p.coords;
+        if let Some(distance) = self.one_step(p, uv0, &d, ws) {
+            return NearInversion {
+                at_start,
+                distance,
+                converged: true,
+            };
+        }
+        let mut r = self.invert_from(p, uv0, ws);
+        if !r.converged {
+            let again = self.invert(p, ws);
+            if again.converged || again.distance < r.distance {
+                r = again;
+            }
+        }
+        NearInversion {
+            at_start,
+            distance: r.distance,
+            converged: r.converged,
+        }
+    }
+
+    /// The fast path of [`SurfaceInverter::invert_near`] from the
+    /// derivatives `d` at `uv0` (layout of [`ParametricSurface::derivatives`]
+    /// of order 2): the distance, or `None` where the general iteration
+    /// must decide.
+    fn one_step(
+        &self,
+        p: &Point3,
+        uv0: [f64; 2],
+        d: &[Vector3; 9],
+        ws: &mut InversionWorkspace<S::Workspace>,
+    ) -> Option<f64> {
+        let ((ua, ub), (va, vb)) = self.surface.domain();
+        let inside = |u: f64, v: f64| u > ua && u < ub && v > va && v < vb;
+        // Newton (eq. 6.6) from uv0
+        let r = d[0] - p.coords;
+        let (su, sv, suu, suv, svv) = (d[3], d[1], d[6], d[4], d[2]);
+        let (f, g) = (r.dot(&su), r.dot(&sv));
+        let a = su.norm_squared() + r.dot(&suu);
+        let b = su.dot(&sv) + r.dot(&suv);
+        let c = sv.norm_squared() + r.dot(&svv);
+        let det = a * c - b * b;
+        if !(a > 0.0 && det > 0.0) {
+            return None;
+        }
+        let (du, dv) = (-(c * f - b * g) / det, -(a * g - b * f) / det);
+        let (u, v) = (uv0[0] + du, uv0[1] + dv);
+        if !inside(u, v) {
+            return None;
+        }
+        // Gauss-Newton on the tangent plane at the new parameters
+        let mut e = [Vector3::zeros(); 4];
+        self.surface.derivatives(u, v, 1, &mut ws.ws, &mut e);
+        let r1 = e[0] - p.coords;
+        let (tu, tv) = (e[2], e[1]);
+        let (a1, b1, c1) = (tu.norm_squared(), tu.dot(&tv), tv.norm_squared());
+        let det1 = a1 * c1 - b1 * b1;
+        if !(det1 > 0.0) {
+            return None;
+        }
+        let (f1, g1) = (r1.dot(&tu), r1.dot(&tv));
+        let (eu, ev) = (-(c1 * f1 - b1 * g1) / det1, -(a1 * g1 - b1 * f1) / det1);
+        if !inside(u + eu, v + ev) {
+            return None;
+        }
+        let second = tu * eu + tv * ev;
+        let distance = (r1 + second).norm();
+        let first = (su * du + sv * dv).norm();
+        let tol = self.cfg.tolerance;
+        let bend = suu.norm() * eu * eu + 2.0 * suv.norm() * (eu * ev).abs() + svv.norm() * ev * ev;
+        let contracts = second.norm() <= 0.5 * first || second.norm() <= tol * self.scale;
+        (contracts && bend <= tol * (distance + tol * self.scale) && distance.is_finite())
+            .then_some(distance)
     }
 
     /// Projects every point, in parallel (results in input order).

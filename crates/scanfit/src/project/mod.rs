@@ -11,4 +11,6 @@ pub use directed::{
     WeightFactor,
 };
 pub use grid_iteration::{grid_iteration, GridIterationConfig};
-pub use inversion::{Inversion, InversionConfig, InversionWorkspace, SurfaceInverter};
+pub use inversion::{
+    Inversion, InversionConfig, InversionWorkspace, NearInversion, SurfaceInverter,
+};
