@@ -65,6 +65,7 @@ use crate::metrics::{
     parameterization_quality, parameterization_quality_where, ErrorStats, ParamQuality,
 };
 use crate::progress::{NoProgress, Progress};
+use crate::project::power_form::PowerForm;
 use crate::project::{Inversion, InversionConfig, InversionWorkspace, SurfaceInverter};
 use crate::sampling::{sample_indices, CellSample, DEFAULT_SEED};
 use crate::spatial::KdTree;
@@ -444,6 +445,8 @@ fn assess(
             None,
         );
         let inverter = SurfaceInverter::new(surface, config.inversion)?;
+        // the fast path evaluates the polynomial pieces (no basis functions)
+        let form = PowerForm::new(surface);
         let (pass, parameterization) = rayon::join(
             || {
                 per_point(
@@ -452,7 +455,13 @@ fn assess(
                     true,
                     || InversionWorkspace::new(surface),
                     |i, ws| {
-                        let r = inverter.invert_near(&points[i], uv[i], ws);
+                        let (p, t) = (&points[i], uv[i]);
+                        let r = match &form {
+                            Some(f) => inverter.invert_near_with(p, t, ws, |u, v, o, out, _| {
+                                f.derivatives(u, v, o, out)
+                            }),
+                            None => inverter.invert_near(p, t, ws),
+                        };
                         (error(i), Some((r.distance, r.converged)))
                     },
                 )

@@ -256,11 +256,32 @@ impl<'s, S: ParametricSurface + ?Sized> SurfaceInverter<'s, S> {
         uv0: [f64; 2],
         ws: &mut InversionWorkspace<S::Workspace>,
     ) -> NearInversion {
+        let surface = self.surface;
+        self.invert_near_with(p, uv0, ws, |u, v, order, out, ws| {
+            surface.derivatives(u, v, order, &mut ws.ws, out)
+        })
+    }
+
+    /// [`SurfaceInverter::invert_near`] whose fast path evaluates the
+    /// surface's derivatives (of order 1 or 2, in the layout of
+    /// [`ParametricSurface::derivatives`]) by `eval`: the B-spline's power
+    /// form in the assessment.
+    pub(crate) fn invert_near_with(
+        &self,
+        p: &Point3,
+        uv0: [f64; 2],
+        ws: &mut InversionWorkspace<S::Workspace>,
+        mut eval: impl FnMut(f64, f64, usize, &mut [Vector3], &mut InversionWorkspace<S::Workspace>),
+    ) -> NearInversion {
         let mut d = [Vector3::zeros(); 9];
-        self.surface
-            .derivatives(uv0[0], uv0[1], 2, &mut ws.ws, &mut d);
+        eval(uv0[0], uv0[1], 2, &mut d, ws);
         let at_start = d[0] - p.coords;
-        if let Some(distance) = self.one_step(p, uv0, &d, ws) {
+        let first_order = |u: f64, v: f64| {
+            let mut e = [Vector3::zeros(); 4];
+            eval(u, v, 1, &mut e, ws);
+            e
+        };
+        if let Some(distance) = self.one_step(p, uv0, &d, first_order) {
             return NearInversion {
                 at_start,
                 distance,
@@ -283,14 +304,14 @@ impl<'s, S: ParametricSurface + ?Sized> SurfaceInverter<'s, S> {
 
     /// The fast path of [`SurfaceInverter::invert_near`] from the
     /// derivatives `d` at `uv0` (layout of [`ParametricSurface::derivatives`]
-    /// of order 2): the distance, or `None` where the general iteration
-    /// must decide.
+    /// of order 2), with `first_order` the point and tangents elsewhere: the
+    /// distance, or `None` where the general iteration must decide.
     fn one_step(
         &self,
         p: &Point3,
         uv0: [f64; 2],
         d: &[Vector3; 9],
-        ws: &mut InversionWorkspace<S::Workspace>,
+        mut first_order: impl FnMut(f64, f64) -> [Vector3; 4],
     ) -> Option<f64> {
         let ((ua, ub), (va, vb)) = self.surface.domain();
         let inside = |u: f64, v: f64| u > ua && u < ub && v > va && v < vb;
@@ -311,8 +332,7 @@ impl<'s, S: ParametricSurface + ?Sized> SurfaceInverter<'s, S> {
             return None;
         }
         // Gauss-Newton on the tangent plane at the new parameters
-        let mut e = [Vector3::zeros(); 4];
-        self.surface.derivatives(u, v, 1, &mut ws.ws, &mut e);
+        let e = first_order(u, v);
         let r1 = e[0] - p.coords;
         let (tu, tv) = (e[2], e[1]);
         let (a1, b1, c1) = (tu.norm_squared(), tu.dot(&tv), tv.norm_squared());

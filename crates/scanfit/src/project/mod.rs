@@ -5,6 +5,7 @@
 mod directed;
 mod grid_iteration;
 mod inversion;
+pub(crate) mod power_form;
 
 pub use directed::{
     project_directed, project_directed_batch, DirectedConfig, Neighbourhood, Projected,
