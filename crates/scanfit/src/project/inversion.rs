@@ -218,12 +218,14 @@ impl<'s, S: ParametricSurface + ?Sized> SurfaceInverter<'s, S> {
     /// distance to the tangent plane there (the residual's component normal
     /// to both tangents). That distance is taken when the iteration
     /// contracts (the second step at most half the first) and the
-    /// surface's bend over the second step, `|S_uu| du^2 + 2 |S_uv| |du dv|
-    /// + |S_vv| dv^2` (twice the Taylor remainder, with the second
-    /// derivatives at `uv0`), is at most `tolerance` x the distance (plus
-    /// `tolerance^2` x the surface's extent): the distance is then that of
-    /// the foot point to a relative `tolerance` (1e-12 by default), tighter
-    /// than [`SurfaceInverter::invert_from`]'s stopping rule. Otherwise
+    /// surface's bend over the second step,
+    /// `|S_uu| du^2 + 2 |S_uv| |du dv| + |S_vv| dv^2` (twice the Taylor
+    /// remainder, with the second derivatives at `uv0`), is at most
+    /// `tolerance` x the distance (plus `tolerance^2` x the surface's
+    /// extent): the distance is then that of the foot point to a relative
+    /// `tolerance` (1e-12 by default) beyond the rounding of the surface's
+    /// evaluation, tighter than [`SurfaceInverter::invert_from`]'s stopping
+    /// rule. Otherwise
     /// (the step leaves the domain's interior, the Hessian is not positive
     /// definite, the steps do not contract), [`SurfaceInverter::invert_from`]
     /// from `uv0`, and where that does not converge
@@ -337,7 +339,7 @@ impl<'s, S: ParametricSurface + ?Sized> SurfaceInverter<'s, S> {
         let (tu, tv) = (e[2], e[1]);
         let (a1, b1, c1) = (tu.norm_squared(), tu.dot(&tv), tv.norm_squared());
         let det1 = a1 * c1 - b1 * b1;
-        if !(det1 > 0.0) {
+        if det1.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return None;
         }
         let (f1, g1) = (r1.dot(&tu), r1.dot(&tv));
