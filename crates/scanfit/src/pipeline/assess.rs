@@ -39,10 +39,11 @@
 //! of a cluster sample of about `sample_points / 4` points that are triangles of
 //! the whole set's triangulation too; [`Assessment::sample`] says so.
 //! Everything else stays exact over every point: the errors at the
-//! parameters, the orthogonal distances (one Newton step from the points'
-//! own parameters checked by a Gauss-Newton step there,
+//! parameters, the orthogonal distances (two Newton steps from the points'
+//! own parameters with an error estimate, on the surface's power form,
 //! [`SurfaceInverter::invert_near`], falling back to the full iteration and
-//! its KD-tree start where that does not settle it), eq. 17 and the sample-grid distances (nearest points over
+//! its KD-tree start where that does not settle it), eq. 17 and the
+//! sample-grid distances (nearest points over
 //! the cloud's KD-tree when it is built already, as after the MBA level
 //! check, else over KD-trees of chunks of [`CHUNK_POINTS`] points, so no
 //! index of all points is held). The per-point pass and the serial

@@ -213,21 +213,20 @@ impl<'s, S: ParametricSurface + ?Sized> SurfaceInverter<'s, S> {
     /// returns the residual at `uv0` too, from the same evaluation.
     ///
     /// The fast path costs two evaluations: one Newton step (eq. 6.6) from
-    /// `uv0` with the derivatives up to second order there, then at the new
-    /// parameters the point and tangents, one Gauss-Newton step, and the
-    /// distance to the tangent plane there (the residual's component normal
-    /// to both tangents). That distance is taken when the iteration
-    /// contracts (the second step at most half the first) and the
-    /// surface's bend over the second step,
-    /// `|S_uu| du^2 + 2 |S_uv| |du dv| + |S_vv| dv^2` (twice the Taylor
-    /// remainder, with the second derivatives at `uv0`), is at most
-    /// `tolerance` x the distance (plus `tolerance^2` x the surface's
-    /// extent): the distance is then that of the foot point to a relative
-    /// `tolerance` (1e-12 by default) beyond the rounding of the surface's
-    /// evaluation, tighter than [`SurfaceInverter::invert_from`]'s stopping
-    /// rule. Otherwise
-    /// (the step leaves the domain's interior, the Hessian is not positive
-    /// definite, the steps do not contract), [`SurfaceInverter::invert_from`]
+    /// `uv0` with the derivatives up to second order there, a second one
+    /// with those at the new parameters, and the distance at its end by the
+    /// second-order Taylor model there. That distance is taken when the
+    /// iteration contracts (the second step at most half the first) and its
+    /// estimated error (the third-order remainder, with the third
+    /// derivatives estimated by the change of the second ones over the
+    /// first step, plus the second-order effect of the offset left from the
+    /// foot point) is at most `tolerance` x the distance (plus
+    /// `tolerance^2` x the surface's extent): the distance of the foot
+    /// point to a relative `tolerance` (1e-12 by default) beyond the
+    /// rounding of the surface's evaluation, tighter than
+    /// [`SurfaceInverter::invert_from`]'s stopping rule. Otherwise (a step
+    /// leaves the domain's interior, a Hessian is not positive definite,
+    /// the steps do not contract), [`SurfaceInverter::invert_from`]
     /// from `uv0`, and where that does not converge
     /// [`SurfaceInverter::invert`] with its restarts; the better result
     /// counts.
@@ -278,12 +277,12 @@ impl<'s, S: ParametricSurface + ?Sized> SurfaceInverter<'s, S> {
         let mut d = [Vector3::zeros(); 9];
         eval(uv0[0], uv0[1], 2, &mut d, ws);
         let at_start = d[0] - p.coords;
-        let first_order = |u: f64, v: f64| {
-            let mut e = [Vector3::zeros(); 4];
-            eval(u, v, 1, &mut e, ws);
+        let second_order = |u: f64, v: f64| {
+            let mut e = [Vector3::zeros(); 9];
+            eval(u, v, 2, &mut e, ws);
             e
         };
-        if let Some(distance) = self.one_step(p, uv0, &d, first_order) {
+        if let Some(distance) = self.one_step(p, uv0, &d, second_order) {
             return NearInversion {
                 at_start,
                 distance,
@@ -313,7 +312,7 @@ impl<'s, S: ParametricSurface + ?Sized> SurfaceInverter<'s, S> {
         p: &Point3,
         uv0: [f64; 2],
         d: &[Vector3; 9],
-        mut first_order: impl FnMut(f64, f64) -> [Vector3; 4],
+        mut second_order: impl FnMut(f64, f64) -> [Vector3; 9],
     ) -> Option<f64> {
         let ((ua, ub), (va, vb)) = self.surface.domain();
         let inside = |u: f64, v: f64| u > ua && u < ub && v > va && v < vb;
@@ -333,27 +332,46 @@ impl<'s, S: ParametricSurface + ?Sized> SurfaceInverter<'s, S> {
         if !inside(u, v) {
             return None;
         }
-        // Gauss-Newton on the tangent plane at the new parameters
-        let e = first_order(u, v);
+        // a second Newton step, with the derivatives at the new parameters
+        let e = second_order(u, v);
         let r1 = e[0] - p.coords;
-        let (tu, tv) = (e[2], e[1]);
-        let (a1, b1, c1) = (tu.norm_squared(), tu.dot(&tv), tv.norm_squared());
+        let (tu, tv, tuu, tuv, tvv) = (e[3], e[1], e[6], e[4], e[2]);
+        let (f1, g1) = (r1.dot(&tu), r1.dot(&tv));
+        let a1 = tu.norm_squared() + r1.dot(&tuu);
+        let b1 = tu.dot(&tv) + r1.dot(&tuv);
+        let c1 = tv.norm_squared() + r1.dot(&tvv);
         let det1 = a1 * c1 - b1 * b1;
-        if det1.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        if !(a1 > 0.0 && det1 > 0.0) {
             return None;
         }
-        let (f1, g1) = (r1.dot(&tu), r1.dot(&tv));
         let (eu, ev) = (-(c1 * f1 - b1 * g1) / det1, -(a1 * g1 - b1 * f1) / det1);
         if !inside(u + eu, v + ev) {
             return None;
         }
+        // the distance at the second step's end by the second-order Taylor
+        // model at (u, v)
+        let bend = |uu: Vector3, uv: Vector3, vv: Vector3| {
+            uu * (eu * eu) + uv * (2.0 * eu * ev) + vv * (ev * ev)
+        };
+        let (q1, q0) = (bend(tuu, tuv, tvv), bend(suu, suv, svv));
         let second = tu * eu + tv * ev;
-        let distance = (r1 + second).norm();
+        let distance = (r1 + second + q1 * 0.5).norm();
         let first = (su * du + sv * dv).norm();
         let tol = self.cfg.tolerance;
-        let bend = suu.norm() * eu * eu + 2.0 * suv.norm() * (eu * ev).abs() + svv.norm() * ev * ev;
+        // its errors: the third-order remainder (the third derivatives
+        // estimated by the change of the second ones over the first step)
+        // and the second order of the offset left from the foot point
+        // (about the bend over the step)
+        let moved = du.hypot(dv);
+        let third = if moved > 0.0 {
+            (q1 - q0).norm() * eu.hypot(ev) / moved
+        } else {
+            0.0
+        };
+        let offset = q1.norm();
+        let error = third + offset * offset / (2.0 * distance).max(f64::MIN_POSITIVE);
         let contracts = second.norm() <= 0.5 * first || second.norm() <= tol * self.scale;
-        (contracts && bend <= tol * (distance + tol * self.scale) && distance.is_finite())
+        (contracts && error <= tol * (distance + tol * self.scale) && distance.is_finite())
             .then_some(distance)
     }
 
