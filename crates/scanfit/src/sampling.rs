@@ -23,6 +23,8 @@
 /// configuration gives another.
 pub const DEFAULT_SEED: u64 = 18;
 
+use rayon::prelude::*;
+
 /// Points per cell of a [`CellSample`] on average (32 x 32 points: a
 /// triangle's circumcircle is a few spacings wide, so most triangles of a
 /// taken cell are kept).
@@ -111,14 +113,21 @@ impl CellSample {
         if n <= target || target == 0 {
             return None;
         }
-        let mut lo = [f64::INFINITY; 2];
-        let mut hi = [f64::NEG_INFINITY; 2];
-        for t in uv {
+        let bounds = |(mut lo, mut hi): ([f64; 2], [f64; 2]), t: &[f64; 2]| {
             for k in 0..2 {
-                lo[k] = lo[k].min(t[k]);
-                hi[k] = hi[k].max(t[k]);
+                lo[k] = f64::min(lo[k], t[k]);
+                hi[k] = f64::max(hi[k], t[k]);
             }
-        }
+            (lo, hi)
+        };
+        let empty = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        let (lo, hi) = uv.par_iter().fold(|| empty, bounds).reduce(
+            || empty,
+            |a, b| {
+                let (lo, hi) = bounds(a, &b.0);
+                bounds((lo, hi), &b.1)
+            },
+        );
         let span = [hi[0] - lo[0], hi[1] - lo[1]];
         if !(span[0] > 0.0 && span[1] > 0.0 && span[0].is_finite() && span[1].is_finite()) {
             return None;
@@ -142,7 +151,10 @@ impl CellSample {
             taken,
             indices: Vec::new(),
         };
-        s.indices = (0..n).filter(|&i| s.contains(uv[i])).collect();
+        s.indices = (0..n)
+            .into_par_iter()
+            .filter(|&i| s.contains(uv[i]))
+            .collect();
         Some(s)
     }
 

@@ -11,6 +11,7 @@
 //! knot grid ([`knot_grid`]), as the adjustment measures it.
 
 use crate::centring::Centring;
+use rayon::prelude::*;
 use std::time::Instant;
 
 use crate::bspline::Surface;
@@ -216,18 +217,17 @@ fn run_centred(
     };
     let surface = lattice_surface(&result.frame, &result.lattice)?;
     let seconds = t0.elapsed().as_secs_f64();
-    progress.stage("measuring", None);
+    progress.stage("measuring: parameters", None);
     let frame = result.frame;
-    let uv: Vec<[f64; 2]> = pts.iter().map(|p| frame.unit(p)).collect();
-    let vertical: Vec<f64> = pts
-        .iter()
-        .zip(&uv)
-        .map(|(p, t)| (p.z - surface.point(t[0], t[1]).z).abs())
-        .collect();
-    // eq. 17 at the lattice's knot grid, in the assessment's pass
+    let uv: Vec<[f64; 2]> = pts.par_iter().map(|p| frame.unit(p)).collect();
+    // eq. 17 at the lattice's knot grid, and the vertical errors, in the
+    // assessment's pass
     let eq17 = knot_grid(&frame, &result.lattice);
     let mut assessment = assess_cloud_eq17(&surface, cloud, &uv, eq17, &config.assess, progress)?;
-    assessment.quality.at_parameters = ErrorStats::of(&vertical);
+    let vertical = std::mem::take(&mut assessment.residuals);
+    if config.assess.per_point {
+        assessment.residuals.clone_from(&vertical);
+    }
     Ok(MbaReport {
         surface,
         frame,

@@ -64,6 +64,17 @@ pub struct Inversion {
     pub converged: bool,
 }
 
+/// What [`SurfaceInverter::invert_near`] returns.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NearInversion {
+    /// `S(uv0) - P`: the residual at the parameters given.
+    pub at_start: Vector3,
+    /// Distance from the point to its foot point.
+    pub distance: f64,
+    /// Whether a convergence criterion was met.
+    pub converged: bool,
+}
+
 /// Reusable evaluation memory for one thread (the surface's derivative
 /// workspace, up to second order).
 #[derive(Debug, Clone)]
@@ -195,6 +206,173 @@ impl<'s, S: ParametricSurface + ?Sized> SurfaceInverter<'s, S> {
         }
         best.iterations = iterations;
         best
+    }
+
+    /// Projects `p`, a point near its own parameters `uv0` (a point the
+    /// surface was fitted to, whose foot point is close to `S(uv0)`), and
+    /// returns the residual at `uv0` too, from the same evaluation.
+    ///
+    /// The fast path costs two evaluations: one Newton step (eq. 6.6) from
+    /// `uv0` with the derivatives up to second order there, a second one
+    /// with those at the new parameters, and the distance at its end by the
+    /// second-order Taylor model there. That distance is taken when the
+    /// iteration contracts (the second step at most half the first) and its
+    /// estimated error (the third-order remainder, with the third
+    /// derivatives estimated by the change of the second ones over the
+    /// first step, plus the second-order effect of the offset left from the
+    /// foot point) is at most `tolerance` x the distance (plus
+    /// `tolerance^2` x the surface's extent): the distance of the foot
+    /// point to a relative `tolerance` (1e-12 by default) beyond the
+    /// rounding of the surface's evaluation, tighter than
+    /// [`SurfaceInverter::invert_from`]'s stopping rule. Otherwise (a step
+    /// leaves the domain's interior, a Hessian is not positive definite,
+    /// the steps do not contract), [`SurfaceInverter::invert_from`]
+    /// from `uv0`, and where that does not converge
+    /// [`SurfaceInverter::invert`] with its restarts; the better result
+    /// counts.
+    ///
+    /// ```
+    /// use scanfit::bspline::{KnotVector, Surface};
+    /// use scanfit::project::{InversionConfig, InversionWorkspace, SurfaceInverter};
+    /// use scanfit::Point3;
+    /// let k = KnotVector::uniform_clamped(2, 3).unwrap();
+    /// // the bowl z = x^2 + y^2 over [-1, 1]^2, a biquadratic Bezier patch
+    /// let z = [1.0, -1.0, 1.0];
+    /// let c: Vec<Point3> = (0..3)
+    ///     .flat_map(|i| (0..3).map(move |j| (i, j)))
+    ///     .map(|(i, j)| Point3::new(i as f64 - 1.0, j as f64 - 1.0, z[i] + z[j]))
+    ///     .collect();
+    /// let s = Surface::new(k.clone(), k, c).unwrap();
+    /// let inv = SurfaceInverter::new(&s, InversionConfig::default()).unwrap();
+    /// let mut ws = InversionWorkspace::new(&s);
+    /// let p = Point3::new(0.1, -0.2, 0.3);
+    /// let near = inv.invert_near(&p, [0.55, 0.4], &mut ws);
+    /// let full = inv.invert(&p, &mut ws);
+    /// assert!(near.converged && (near.distance - full.distance).abs() < 1e-12);
+    /// assert!((near.at_start - (s.point(0.55, 0.4) - p)).norm() < 1e-15);
+    /// ```
+    pub fn invert_near(
+        &self,
+        p: &Point3,
+        uv0: [f64; 2],
+        ws: &mut InversionWorkspace<S::Workspace>,
+    ) -> NearInversion {
+        let surface = self.surface;
+        self.invert_near_with(p, uv0, ws, |u, v, order, out, ws| {
+            surface.derivatives(u, v, order, &mut ws.ws, out)
+        })
+    }
+
+    /// [`SurfaceInverter::invert_near`] whose fast path evaluates the
+    /// surface's derivatives (of order 1 or 2, in the layout of
+    /// [`ParametricSurface::derivatives`]) by `eval`: the B-spline's power
+    /// form in the assessment.
+    pub(crate) fn invert_near_with(
+        &self,
+        p: &Point3,
+        uv0: [f64; 2],
+        ws: &mut InversionWorkspace<S::Workspace>,
+        mut eval: impl FnMut(f64, f64, usize, &mut [Vector3], &mut InversionWorkspace<S::Workspace>),
+    ) -> NearInversion {
+        let mut d = [Vector3::zeros(); 9];
+        eval(uv0[0], uv0[1], 2, &mut d, ws);
+        let at_start = d[0] - p.coords;
+        let second_order = |u: f64, v: f64| {
+            let mut e = [Vector3::zeros(); 9];
+            eval(u, v, 2, &mut e, ws);
+            e
+        };
+        if let Some(distance) = self.one_step(p, uv0, &d, second_order) {
+            return NearInversion {
+                at_start,
+                distance,
+                converged: true,
+            };
+        }
+        let mut r = self.invert_from(p, uv0, ws);
+        if !r.converged {
+            let again = self.invert(p, ws);
+            if again.converged || again.distance < r.distance {
+                r = again;
+            }
+        }
+        NearInversion {
+            at_start,
+            distance: r.distance,
+            converged: r.converged,
+        }
+    }
+
+    /// The fast path of [`SurfaceInverter::invert_near`] from the
+    /// derivatives `d` at `uv0` (layout of [`ParametricSurface::derivatives`]
+    /// of order 2), with `first_order` the point and tangents elsewhere: the
+    /// distance, or `None` where the general iteration must decide.
+    fn one_step(
+        &self,
+        p: &Point3,
+        uv0: [f64; 2],
+        d: &[Vector3; 9],
+        mut second_order: impl FnMut(f64, f64) -> [Vector3; 9],
+    ) -> Option<f64> {
+        let ((ua, ub), (va, vb)) = self.surface.domain();
+        let inside = |u: f64, v: f64| u > ua && u < ub && v > va && v < vb;
+        // Newton (eq. 6.6) from uv0
+        let r = d[0] - p.coords;
+        let (su, sv, suu, suv, svv) = (d[3], d[1], d[6], d[4], d[2]);
+        let (f, g) = (r.dot(&su), r.dot(&sv));
+        let a = su.norm_squared() + r.dot(&suu);
+        let b = su.dot(&sv) + r.dot(&suv);
+        let c = sv.norm_squared() + r.dot(&svv);
+        let det = a * c - b * b;
+        if !(a > 0.0 && det > 0.0) {
+            return None;
+        }
+        let (du, dv) = (-(c * f - b * g) / det, -(a * g - b * f) / det);
+        let (u, v) = (uv0[0] + du, uv0[1] + dv);
+        if !inside(u, v) {
+            return None;
+        }
+        // a second Newton step, with the derivatives at the new parameters
+        let e = second_order(u, v);
+        let r1 = e[0] - p.coords;
+        let (tu, tv, tuu, tuv, tvv) = (e[3], e[1], e[6], e[4], e[2]);
+        let (f1, g1) = (r1.dot(&tu), r1.dot(&tv));
+        let a1 = tu.norm_squared() + r1.dot(&tuu);
+        let b1 = tu.dot(&tv) + r1.dot(&tuv);
+        let c1 = tv.norm_squared() + r1.dot(&tvv);
+        let det1 = a1 * c1 - b1 * b1;
+        if !(a1 > 0.0 && det1 > 0.0) {
+            return None;
+        }
+        let (eu, ev) = (-(c1 * f1 - b1 * g1) / det1, -(a1 * g1 - b1 * f1) / det1);
+        if !inside(u + eu, v + ev) {
+            return None;
+        }
+        // the distance at the second step's end by the second-order Taylor
+        // model at (u, v)
+        let bend = |uu: Vector3, uv: Vector3, vv: Vector3| {
+            uu * (eu * eu) + uv * (2.0 * eu * ev) + vv * (ev * ev)
+        };
+        let (q1, q0) = (bend(tuu, tuv, tvv), bend(suu, suv, svv));
+        let second = tu * eu + tv * ev;
+        let distance = (r1 + second + q1 * 0.5).norm();
+        let first = (su * du + sv * dv).norm();
+        let tol = self.cfg.tolerance;
+        // its errors: the third-order remainder (the third derivatives
+        // estimated by the change of the second ones over the first step)
+        // and the second order of the offset left from the foot point
+        // (about the bend over the step)
+        let moved = du.hypot(dv);
+        let third = if moved > 0.0 {
+            (q1 - q0).norm() * eu.hypot(ev) / moved
+        } else {
+            0.0
+        };
+        let offset = q1.norm();
+        let error = third + offset * offset / (2.0 * distance).max(f64::MIN_POSITIVE);
+        let contracts = second.norm() <= 0.5 * first || second.norm() <= tol * self.scale;
+        (contracts && error <= tol * (distance + tol * self.scale) && distance.is_finite())
+            .then_some(distance)
     }
 
     /// Projects every point, in parallel (results in input order).

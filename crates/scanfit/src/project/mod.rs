@@ -5,10 +5,13 @@
 mod directed;
 mod grid_iteration;
 mod inversion;
+pub(crate) mod power_form;
 
 pub use directed::{
     project_directed, project_directed_batch, DirectedConfig, Neighbourhood, Projected,
     WeightFactor,
 };
 pub use grid_iteration::{grid_iteration, GridIterationConfig};
-pub use inversion::{Inversion, InversionConfig, InversionWorkspace, SurfaceInverter};
+pub use inversion::{
+    Inversion, InversionConfig, InversionWorkspace, NearInversion, SurfaceInverter,
+};
