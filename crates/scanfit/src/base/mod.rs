@@ -12,5 +12,5 @@ pub use coons::{
 };
 pub use coons_cloud::{coons_from_cloud, CoonsFromCloud, CoonsFromCloudConfig};
 pub use coons_param::{coons_parameters, CoonsParamConfig, CoonsParameters, CoonsProjection};
-pub use plane::{plane_parameters, PlaneParameterization};
+pub use plane::{plane_frame, plane_parameters, PlaneFrame, PlaneParameterization};
 pub mod turntable;

@@ -25,10 +25,44 @@ pub struct PlaneParameterization {
     pub uv: Vec<[f64; 2]>,
 }
 
-/// Parameters of `points` on their best-fit plane. Axis signs are made
-/// deterministic (largest component positive), so the result does not depend
-/// on the eigen solver.
-pub fn plane_parameters(points: &[Point3]) -> Result<PlaneParameterization> {
+/// The best-fit plane's frame: the centroid, the in-plane axes along the
+/// minimum-area bounding rectangle and the normal, without the parameters
+/// (no per-point array is kept: the points are streamed).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlaneFrame {
+    /// Centroid of the points.
+    pub origin: Point3,
+    /// First in-plane axis (the long side of the minimum-area rectangle).
+    pub e1: Vector3,
+    /// Second in-plane axis (`normal x e1`).
+    pub e2: Vector3,
+    /// Normal (`e1 x e2`; the covariance's smallest principal direction).
+    pub normal: Vector3,
+}
+
+/// The frame of [`plane_parameters`] alone: PCA normal and the axes of the
+/// minimum-area rectangle of the projections (Freeman & Shapira 1975). Axis
+/// signs are deterministic (largest component positive).
+///
+/// The rectangle needs the convex hull of the projections only; points
+/// strictly inside the octagon of the extreme projections in eight
+/// directions cannot be hull vertices and are dropped before the hull
+/// (Akl & Toussaint 1978), so the memory is that of the few points near the
+/// outline, not a copy of the cloud.
+///
+/// Errors: invalid coordinates, fewer than 3 points, collinear points.
+///
+/// ```
+/// use scanfit::base::plane_frame;
+/// use scanfit::Point3;
+/// let pts: Vec<Point3> = (0..60)
+///     .map(|k| Point3::new((k % 10) as f64 * 2.0, (k / 10) as f64, 5.0))
+///     .collect();
+/// let f = plane_frame(&pts).unwrap();
+/// assert!((f.normal.z - 1.0).abs() < 1e-12);
+/// assert!((f.e1.x - 1.0).abs() < 1e-12); // the long side is along x
+/// ```
+pub fn plane_frame(points: &[Point3]) -> Result<PlaneFrame> {
     crate::validate_points(points)?;
     if points.len() < 3 {
         return Err(Error::TooFewPoints {
@@ -62,11 +96,8 @@ pub fn plane_parameters(points: &[Point3]) -> Result<PlaneParameterization> {
         ));
     }
     // in-plane axes of the minimum-area bounding rectangle
-    let flat: Vec<[f64; 2]> = points
-        .iter()
-        .map(|p| [(p.coords - c).dot(&a1), (p.coords - c).dot(&a2)])
-        .collect();
-    let (cos, sin) = min_area_rectangle_direction(&flat);
+    let flat = |p: &Point3| [(p.coords - c).dot(&a1), (p.coords - c).dot(&a2)];
+    let (cos, sin) = min_area_rectangle_direction(&hull_candidates(points.iter().map(flat)));
     let mut e1 = a1 * cos + a2 * sin;
     let extent = |e: &Vector3| {
         let (lo, hi) = points
@@ -82,6 +113,25 @@ pub fn plane_parameters(points: &[Point3]) -> Result<PlaneParameterization> {
     }
     let e1 = orient(e1);
     let e2 = normal.cross(&e1);
+    Ok(PlaneFrame {
+        origin: Point3::from(c),
+        e1,
+        e2,
+        normal,
+    })
+}
+
+/// Parameters of `points` on their best-fit plane. Axis signs are made
+/// deterministic (largest component positive), so the result does not depend
+/// on the eigen solver.
+pub fn plane_parameters(points: &[Point3]) -> Result<PlaneParameterization> {
+    let PlaneFrame {
+        origin,
+        e1,
+        e2,
+        normal,
+    } = plane_frame(points)?;
+    let c = origin.coords;
     let proj: Vec<(f64, f64)> = points
         .iter()
         .map(|p| ((p.coords - c).dot(&e1), (p.coords - c).dot(&e2)))
@@ -108,7 +158,7 @@ pub fn plane_parameters(points: &[Point3]) -> Result<PlaneParameterization> {
         })
         .collect();
     Ok(PlaneParameterization {
-        origin: Point3::from(c),
+        origin,
         e1,
         e2,
         normal,
@@ -149,6 +199,48 @@ fn min_area_rectangle_direction(pts: &[[f64; 2]]) -> (f64, f64) {
         }
     }
     best.1
+}
+
+/// The points of `pts` that can be vertices of their convex hull: all but
+/// those strictly inside the octagon of the extreme points in the directions
+/// `x`, `y`, `x + y` and `x - y` (Akl & Toussaint 1978), with a margin of
+/// 1e-9 of the extent so that rounding never drops a hull vertex. The hull
+/// of the candidates is the hull of all points.
+fn hull_candidates(pts: impl Iterator<Item = [f64; 2]> + Clone) -> Vec<[f64; 2]> {
+    let dirs = [[1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [-1.0, 1.0]];
+    // extreme point per direction and sign, in counter-clockwise order of
+    // the outward directions (+x, +x+y, +y, -x+y, -x, -x-y, -y, x-y)
+    let mut ext = [[f64::NAN; 2]; 8];
+    let mut best = [f64::NEG_INFINITY; 8];
+    let mut scale = 0.0f64;
+    for p in pts.clone() {
+        scale = scale.max(p[0].abs()).max(p[1].abs());
+        for (k, d) in dirs.iter().enumerate() {
+            let s = p[0] * d[0] + p[1] * d[1];
+            if s > best[k] {
+                (best[k], ext[k]) = (s, p);
+            }
+            if -s > best[k + 4] {
+                (best[k + 4], ext[k + 4]) = (-s, p);
+            }
+        }
+    }
+    let mut octagon: Vec<[f64; 2]> = Vec::with_capacity(8);
+    for q in ext {
+        if octagon.last() != Some(&q) && octagon.first() != Some(&q) {
+            octagon.push(q);
+        }
+    }
+    let tol = 1e-9 * scale * scale;
+    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
+        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+    };
+    let inside = |p: [f64; 2]| {
+        octagon.len() >= 3
+            && (0..octagon.len())
+                .all(|k| cross(octagon[k], octagon[(k + 1) % octagon.len()], p) > tol)
+    };
+    pts.filter(|&p| !inside(p)).collect()
 }
 
 /// Convex hull (Andrew's monotone chain), counter-clockwise, no collinear points.
