@@ -27,19 +27,29 @@
 //! their starting points' distances, so the result does not depend on the
 //! order the points or edges come in.
 //!
-//! # Cost proportional to the boundary
+//! # Big clouds: the band along the boundary
 //!
 //! Up to [`BoundaryConfig::sample_above`] points (default 200,000) the whole
-//! projection is triangulated. Above, only a band along the boundary is, and
-//! the loops are the same ([`band`] proves it): the boundary vertices are
-//! the points on the circle of an empty disc of radius `alpha` (the
-//! circumdisc of a dropped triangle, or a half-plane beyond the hull), such a
-//! disc holds a whole cell of a grid of cell size `alpha / 2`, and a kept
+//! projection is triangulated. Above, only a band of grid cells is, and the
+//! loops are the same ([`band`] proves it): the boundary vertices are the
+//! points on the circle of an empty disc of radius `alpha` (the circumdisc
+//! of a dropped triangle, or a half-plane beyond the hull), such a disc
+//! holds a whole cell of a grid of cell size `alpha / 2`, and a kept
 //! triangle at a boundary vertex lies within `2 alpha` of it. The spacing
 //! that sets the default alpha is then the median Delaunay edge of a seeded
 //! cluster sample ([`spacing`]): over 8 seeds on 250,000 random points its
 //! difference to the full median had a standard deviation of 0.5% and was
 //! at most 1.0%.
+//!
+//! The band is small where the cells of side `alpha / 2` are occupied
+//! inside the patch (grids, even scans). On a uniform random sample at the
+//! default alpha such a cell holds 1.8 points on average and is empty with
+//! probability `exp(-1.8) = 17%`, so empty cells lie near every point and
+//! the band is most of the cloud: the measured gain there (BENCHMARKS.md)
+//! comes from the frame and the passes that keep no per-point array, not
+//! from the band. A test on empty blocks of finer cells (an empty disc of
+//! radius alpha holds an aligned empty square of side about `1.1 alpha`)
+//! would shrink it; it is not done yet.
 
 mod band;
 mod spacing;
@@ -315,7 +325,7 @@ fn full_loops(points: &[Point3], frame: &Frame, config: &BoundaryConfig) -> Resu
         * frame.extent;
     let alpha = config.alpha.unwrap_or(config.alpha_factor * spacing);
     let a = tri.alpha_loops(alpha / frame.extent)?;
-    a.into_boundary(&tri, frame, alpha, spacing, a.kept)
+    a.to_boundary(&tri, frame, alpha, spacing, a.kept)
 }
 
 /// The median length of the triangulation's edges accepted by `take`
@@ -450,7 +460,7 @@ struct AlphaLoops {
 }
 
 impl AlphaLoops {
-    fn into_boundary(
+    fn to_boundary(
         &self,
         tri: &SiteTriangulation,
         frame: &Frame,

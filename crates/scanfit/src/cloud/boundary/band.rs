@@ -101,7 +101,7 @@ pub(super) fn band_loops(
         .filter(|&v| tri.sites[v].inner && a.on_kept[v] && !on_loop[v])
         .count();
     let inner = (points.len() - candidates - tri.outer_repeats + inner_candidates) as i64;
-    let b = a.into_boundary(&tri, frame, alpha, spacing, 0)?;
+    let b = a.to_boundary(&tri, frame, alpha, spacing, 0)?;
     let chi: i64 = b.areas.iter().map(|&x| if x > 0.0 { 1 } else { -1 }).sum();
     let triangles = (2 * inner + loop_edges - 2 * chi).max(0) as usize;
     Ok(Some(Boundary { triangles, ..b }))
