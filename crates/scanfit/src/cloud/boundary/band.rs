@@ -1,17 +1,18 @@
 //! The band of a big cloud's projection that holds its alpha shape's
 //! boundary, and the loops from the triangulation of that band alone.
 //!
-//! Grid the projection with square cells of side `h = alpha / 2`.
+//! Grid the projection with square cells of side `h = alpha / 6`.
 //!
 //! * A boundary vertex `p` lies on the circle of an open disc of radius
 //!   `alpha` that holds no point: across a boundary edge lies a triangle
 //!   with circumradius `R >= alpha` (its open circumdisc holds no point and
 //!   contains the disc of radius `alpha` tangent to its circle at `p`) or the
 //!   open half-plane beyond the hull (which contains that disc too). The
-//!   disc's inscribed square has side `alpha sqrt(2) > 2 h`, so it holds a
-//!   whole grid cell, which is therefore empty and lies within `2 alpha`
-//!   (4 cells) of `p`. Hence every boundary vertex is in a *candidate* cell:
-//!   an occupied cell with an empty one within [`REACH`] cells (cells beyond
+//!   disc's inscribed square has side `alpha sqrt(2) = 8.49 h >= 8 h`, so it
+//!   holds an aligned block of 7 x 7 whole cells, which are therefore empty,
+//!   and whose centre cell lies within `2 alpha` (13 cells) of `p`. Hence
+//!   every boundary vertex is in a *candidate* cell: an occupied cell with
+//!   the centre of an empty 7 x 7 block within [`REACH`] cells (cells beyond
 //!   the points' bounding box are empty; the grid is padded by `REACH`).
 //! * A kept triangle (`R < alpha`) with a vertex `p` has its circumdisc, and
 //!   so its other vertices, within `2R < 2 alpha` of `p`. If the triangulated
@@ -30,27 +31,39 @@
 //! share one circumradius, so they are all kept or all dropped and the
 //! boundary edges, sides of the cells, are the same. Only a circumradius
 //! within rounding, ~1e-15 relative, of `alpha` could be decided apart.)
-//! `REACH` is 5 cells rather than 4 to leave room for the rounding of the
+//! `REACH` is 14 cells rather than 13 to leave room for the rounding of the
 //! cell index.
 //!
-//! The grid costs one byte per cell, about half a byte per point on a
-//! cloud that fills its bounding box; a grid of more than `4 n + 2^20`
-//! cells (an outlier stretching the box, or a tiny alpha) is not built and
-//! the whole cloud is triangulated instead.
+//! Why blocks of small cells: a single empty cell of side `alpha / 2` would
+//! do for the proof, but on a uniform random sample at the default alpha
+//! such a cell is empty with probability 17%, so nearly every point would
+//! be a candidate; an empty 7 x 7 block (side 1.17 alpha, about 10 points
+//! expected) is rare inside a patch. The grid costs two bytes per cell
+//! (flags and one row buffer), about five cells per point on a cloud that
+//! fills its bounding box; a grid of more than `8 n + 2^20` cells (an
+//! outlier stretching the box, or a tiny alpha) is not built and the whole
+//! cloud is triangulated instead.
 
 use super::{Boundary, Frame, Site, SiteTriangulation};
 use crate::{Point3, Result};
 
+/// Cells per alpha.
+const CELLS_PER_ALPHA: f64 = 6.0;
+/// Half the side of the empty blocks, in cells (7 x 7 blocks).
+const HALF_BLOCK: usize = 3;
 /// Cells between a point's cell and the cells that decide about it.
-const REACH: usize = 5;
+const REACH: usize = 14;
 /// Occupied cell.
 const OCC: u8 = 1;
-/// An empty cell lies within `REACH`.
-const NEAR_EMPTY: u8 = 2;
-/// A candidate cell (occupied, empty cell near).
+/// An occupied cell lies within `HALF_BLOCK` (else the cell is the centre
+/// of an empty block).
+const NEAR_OCC: u8 = 2;
+/// The centre of an empty block lies within `REACH`.
+const NEAR_EMPTY: u8 = 4;
+/// A candidate cell (occupied, empty block near).
 const CANDIDATE: u8 = OCC | NEAR_EMPTY;
 /// A candidate cell lies within `REACH`: its points are triangulated.
-const BAND: u8 = 4;
+const BAND: u8 = 8;
 
 /// The loops of the alpha shape of radius `alpha` from the triangulation of
 /// the band; `None` when the grid would be too large.
@@ -61,15 +74,16 @@ pub(super) fn band_loops(
     spacing: f64,
 ) -> Result<Option<Boundary>> {
     let alpha_unit = alpha / frame.extent;
-    let Some(mut grid) = Grid::new(frame, alpha_unit / 2.0, points.len()) else {
+    let Some(mut grid) = Grid::new(frame, alpha_unit / CELLS_PER_ALPHA, points.len()) else {
         return Ok(None);
     };
     for p in points {
         let c = grid.cell(frame.unit(p));
         grid.flags[c] |= OCC;
     }
-    grid.dilate(|f| f & OCC == 0, NEAR_EMPTY);
-    grid.dilate(|f| f & CANDIDATE == CANDIDATE, BAND);
+    grid.dilate(|f| f & OCC != 0, HALF_BLOCK, NEAR_OCC);
+    grid.dilate(|f| f & NEAR_OCC == 0, REACH, NEAR_EMPTY);
+    grid.dilate(|f| f & CANDIDATE == CANDIDATE, REACH, BAND);
     let mut sites = Vec::new();
     let mut candidates = 0usize;
     for (index, p) in points.iter().enumerate() {
@@ -118,7 +132,7 @@ struct Grid {
 
 impl Grid {
     fn new(frame: &Frame, h: f64, n: usize) -> Option<Self> {
-        let limit = (4 * n + (1 << 20)) as f64;
+        let limit = (8 * n + (1 << 20)) as f64;
         let cells = |k: usize| ((frame.hi[k] - frame.lo[k]) / h).floor() + 1.0 + 2.0 * REACH as f64;
         let (nx, ny) = (cells(0), cells(1));
         if !(h > 0.0 && nx.is_finite() && ny.is_finite() && nx * ny <= limit) {
@@ -142,12 +156,11 @@ impl Grid {
         idx(1) * self.dims[0] + idx(0)
     }
 
-    /// Sets `bit` on every cell with a cell satisfying `src` within
-    /// [`REACH`] cells (Chebyshev distance): a sliding window count along
-    /// the rows, then along the columns.
-    fn dilate(&mut self, src: impl Fn(u8) -> bool, bit: u8) {
+    /// Sets `bit` on every cell with a cell satisfying `src` within `r`
+    /// cells (Chebyshev distance): a sliding window count along the rows,
+    /// then along the columns.
+    fn dilate(&mut self, src: impl Fn(u8) -> bool, r: usize, bit: u8) {
         let [nx, ny] = self.dims;
-        let r = REACH;
         let mut rows = vec![0u8; self.flags.len()];
         for (row, out) in self.flags.chunks_exact(nx).zip(rows.chunks_exact_mut(nx)) {
             let mut count: usize = row[..=r.min(nx - 1)].iter().filter(|&&f| src(f)).count();
