@@ -4,6 +4,9 @@
 //! * convex hull of 10^5 points on a sphere (all are vertices) and in a ball
 //! * hidden point removal of 10^5 points on a sphere
 //! * boundary loops + corners of a noisy 10^5-point rectangular patch
+//! * boundary loops of a noisy 10^6-point patch: the boundary band and
+//!   sampled spacing (the default above 200,000 points) and the
+//!   triangulation of every point
 //!
 //! Run: `cargo bench -p scanfit --bench cloud -- --sample-size 10`
 
@@ -99,6 +102,17 @@ fn bench(c: &mut Criterion) {
     });
     c.bench_function("boundary: 1e5-point noisy patch", |bch| {
         bch.iter(|| boundary_loops(black_box(&p), &BoundaryConfig::default()).unwrap())
+    });
+    let million = patch(1_000_000, 5);
+    c.bench_function("boundary: 1e6-point noisy patch (band)", |bch| {
+        bch.iter(|| boundary_loops(black_box(&million), &BoundaryConfig::default()).unwrap())
+    });
+    let every = BoundaryConfig {
+        sample_above: usize::MAX,
+        ..Default::default()
+    };
+    c.bench_function("boundary: 1e6-point noisy patch (every point)", |bch| {
+        bch.iter(|| boundary_loops(black_box(&million), &every).unwrap())
     });
     let bd = boundary_loops(&p, &BoundaryConfig::default()).unwrap();
     let lp: Vec<Point3> = bd.outer_loop().iter().map(|&i| p[i]).collect();

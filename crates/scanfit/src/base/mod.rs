@@ -13,6 +13,7 @@ pub use coons::{
 pub use coons_cloud::{coons_from_cloud, CoonsFromCloud, CoonsFromCloudConfig};
 pub use coons_param::{coons_parameters, CoonsParamConfig, CoonsParameters, CoonsProjection};
 pub use plane::{
-    plane_parameters, FlatHull, PlaneAxes, PlaneExtents, PlaneMap, PlaneParameterization,
+    plane_frame, plane_parameters, FlatHull, PlaneAxes, PlaneExtents, PlaneFrame, PlaneMap,
+    PlaneParameterization,
 };
 pub mod turntable;

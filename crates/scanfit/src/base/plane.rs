@@ -26,6 +26,50 @@ pub struct PlaneParameterization {
     pub uv: Vec<[f64; 2]>,
 }
 
+/// The best-fit plane's frame: the centroid, the in-plane axes along the
+/// minimum-area bounding rectangle and the normal, without the parameters
+/// (no per-point array is kept: the points are streamed).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlaneFrame {
+    /// Centroid of the points.
+    pub origin: Point3,
+    /// First in-plane axis (the long side of the minimum-area rectangle).
+    pub e1: Vector3,
+    /// Second in-plane axis (`normal x e1`).
+    pub e2: Vector3,
+    /// Normal (`e1 x e2`; the covariance's smallest principal direction).
+    pub normal: Vector3,
+}
+
+/// The frame of [`plane_parameters`] alone (the same steps: PCA normal, the
+/// axes of the minimum-area rectangle of the projections, Freeman & Shapira
+/// 1975, deterministic signs), without the per-point parameters: the hull
+/// keeps only the points outside the octagon of extreme projections
+/// (Akl & Toussaint 1978, in [`FlatHull::add`]), so the memory is that of the
+/// few points near the outline, not a copy of the cloud.
+///
+/// Errors: invalid coordinates, fewer than 3 points, collinear points.
+///
+/// ```
+/// use scanfit::base::plane_frame;
+/// use scanfit::Point3;
+/// let pts: Vec<Point3> = (0..60)
+///     .map(|k| Point3::new((k % 10) as f64 * 2.0, (k / 10) as f64, 5.0))
+///     .collect();
+/// let f = plane_frame(&pts).unwrap();
+/// assert!((f.normal.z - 1.0).abs() < 1e-12);
+/// assert!((f.e1.x - 1.0).abs() < 1e-12); // the long side is along x
+/// ```
+pub fn plane_frame(points: &[Point3]) -> Result<PlaneFrame> {
+    let map = plane_map(points)?;
+    Ok(PlaneFrame {
+        origin: map.origin,
+        e1: map.e1,
+        e2: map.e2,
+        normal: map.normal,
+    })
+}
+
 /// Parameters of `points` on their best-fit plane. Axis signs are made
 /// deterministic (largest component positive), so the result does not depend
 /// on the eigen solver.
@@ -34,6 +78,22 @@ pub struct PlaneParameterization {
 /// the covariance sums, [`FlatHull`], [`PlaneExtents`], [`PlaneMap`]), each
 /// fed all points at once here.
 pub fn plane_parameters(points: &[Point3]) -> Result<PlaneParameterization> {
+    let map = plane_map(points)?;
+    let uv = points.iter().map(|p| map.uv(p)).collect();
+    Ok(PlaneParameterization {
+        origin: map.origin,
+        e1: map.e1,
+        e2: map.e2,
+        normal: map.normal,
+        bounds: map.bounds,
+        uv,
+    })
+}
+
+/// The steps of a chunked or distributed run ([`PlaneAxes`] from the
+/// covariance sums, [`FlatHull`], [`PlaneExtents`]), each fed all points at
+/// once.
+fn plane_map(points: &[Point3]) -> Result<PlaneMap> {
     crate::validate_points(points)?;
     if points.len() < 3 {
         return Err(Error::TooFewPoints {
@@ -52,16 +112,7 @@ pub fn plane_parameters(points: &[Point3]) -> Result<PlaneParameterization> {
     hull.add(&axes, points);
     let mut extents = PlaneExtents::new(&axes, hull.rectangle_direction());
     extents.add(points);
-    let map = extents.finish()?;
-    let uv = points.iter().map(|p| map.uv(p)).collect();
-    Ok(PlaneParameterization {
-        origin: map.origin,
-        e1: map.e1,
-        e2: map.e2,
-        normal: map.normal,
-        bounds: map.bounds,
-        uv,
-    })
+    extents.finish()
 }
 
 /// `v` with its largest component made positive (deterministic signs).
@@ -131,8 +182,10 @@ const HULL_TAG: &[u8; 8] = b"SFHULL01";
 impl FlatHull {
     /// Adds points (in space; flattened by `axes`).
     pub fn add(&mut self, axes: &PlaneAxes, points: &[Point3]) {
+        // only points outside the octagon of extreme projections can be hull
+        // vertices (Akl & Toussaint 1978): no copy of the chunk
         let mut flat = std::mem::take(&mut self.hull);
-        flat.extend(points.iter().map(|p| axes.flat(p)));
+        flat.extend(hull_candidates(points.iter().map(|p| axes.flat(p))));
         self.hull = convex_hull(&flat);
     }
 
@@ -386,6 +439,48 @@ fn rectangle_direction(hull: &[[f64; 2]]) -> (f64, f64) {
         }
     }
     best.1
+}
+
+/// The points of `pts` that can be vertices of their convex hull: all but
+/// those strictly inside the octagon of the extreme points in the directions
+/// `x`, `y`, `x + y` and `x - y` (Akl & Toussaint 1978), with a margin of
+/// 1e-9 of the extent so that rounding never drops a hull vertex. The hull
+/// of the candidates is the hull of all points.
+fn hull_candidates(pts: impl Iterator<Item = [f64; 2]> + Clone) -> Vec<[f64; 2]> {
+    let dirs = [[1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [-1.0, 1.0]];
+    // extreme point per direction and sign, in counter-clockwise order of
+    // the outward directions (+x, +x+y, +y, -x+y, -x, -x-y, -y, x-y)
+    let mut ext = [[f64::NAN; 2]; 8];
+    let mut best = [f64::NEG_INFINITY; 8];
+    let mut scale = 0.0f64;
+    for p in pts.clone() {
+        scale = scale.max(p[0].abs()).max(p[1].abs());
+        for (k, d) in dirs.iter().enumerate() {
+            let s = p[0] * d[0] + p[1] * d[1];
+            if s > best[k] {
+                (best[k], ext[k]) = (s, p);
+            }
+            if -s > best[k + 4] {
+                (best[k + 4], ext[k + 4]) = (-s, p);
+            }
+        }
+    }
+    let mut octagon: Vec<[f64; 2]> = Vec::with_capacity(8);
+    for q in ext {
+        if octagon.last() != Some(&q) && octagon.first() != Some(&q) {
+            octagon.push(q);
+        }
+    }
+    let tol = 1e-9 * scale * scale;
+    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
+        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+    };
+    let inside = |p: [f64; 2]| {
+        octagon.len() >= 3
+            && (0..octagon.len())
+                .all(|k| cross(octagon[k], octagon[(k + 1) % octagon.len()], p) > tol)
+    };
+    pts.filter(|&p| !inside(p)).collect()
 }
 
 /// Convex hull (Andrew's monotone chain), counter-clockwise, no collinear points.
