@@ -240,8 +240,7 @@ impl Measured {
     /// Adds the block after this one's points (its box inside this one's).
     fn merge(&mut self, part: Self) {
         self.bad |= part.bad;
-        if part.cols > 0 {
-            let rows = part.den.len() / part.cols;
+        if let Some(rows) = part.den.len().checked_div(part.cols) {
             for a in 0..rows {
                 let at = (part.i0 - self.i0 + a) * self.cols + part.j0 - self.j0;
                 let (to, from) = (at..at + part.cols, a * part.cols..(a + 1) * part.cols);
