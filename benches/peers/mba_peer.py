@@ -3,18 +3,20 @@
 
 Purpose
     Fit alone and whole command, at the same final lattice (scanfit `--levels 8 --base 1x1`:
-    131 x 131 control values; the peer: grid 2 x 2, 8 levels), with the held-out RMSE and the
-    peak memory of each. Runs alternate (scanfit, peer, scanfit, peer, ...) so both meet the same
-    load; the table gives the best and the median of --repeats runs and the load average.
+    131 x 131 control values; the peer: grid 2 x 2, 8 levels), with the held-out RMSE, the CPU
+    time (user + system of all threads: what a shared machine's load does not inflate) and the
+    peak memory of each, for each of scanfit's starts (--starts). Runs alternate (scanfit start
+    1, scanfit start 2, ..., peer; again) so all meet the same load; the table gives the best and
+    the median of --repeats runs, and the load average. One command gives the whole table.
 
 What it runs (nothing is built here; build both first)
     fit alone, scanfit: target/release/examples/mba_timing POINTS HELDOUT LEVELS START
         (cargo build --release -p scanfit --example mba_timing); prints JSON with fit_s
-        (scanfit::mba::mba on the points in memory) and heldout_rmse.
+        (scanfit::mba::mba on the points in memory), fit_cpu_s and heldout_rmse.
     fit alone, peer:    --peer DRIVER POINTS HELDOUT LEVELS zero; your own C++ driver around
         ddemidov/mba's header (see BENCHMARKS.md for what it calls); it must print one JSON
-        line with fit_s and heldout_rmse. The peer's code and the driver stay out of this
-        repository.
+        line with fit_s, fit_cpu_s (std::clock() around the constructor) and heldout_rmse. The
+        peer's code and the driver stay out of this repository.
     whole command:      target/release/scanfit mba POINTS --levels 8 --base 1x1 --start START -o OUT.json --quiet
         against the driver's whole process (read, fit, held-out evaluation), both under
         /usr/bin/time for the wall time and the peak resident memory.
@@ -24,8 +26,9 @@ Data: benches/peers/mba_data.py (Franke's function on uniform random points, see
 Command (from the repository root):
     python3 benches/peers/mba_data.py --out /tmp/mbadata
     python3 benches/peers/mba_peer.py --peer /tmp/mbapeer/driver --data /tmp/mbadata
-    options: --sizes 1000000 10000000, --levels 8, --repeats 3, --start fitted|mean (scanfit's
-             start of level 0, default fitted), --scanfit PATH, --timing PATH, --json OUT
+    options: --sizes 1000000 10000000 (default both), --levels 8, --repeats 3 (--repeats-large 1
+             above 5 * 10^6 points), --starts fitted mean (scanfit's starts of level 0, default
+             both), --fit-only (skip the whole commands), --scanfit PATH, --timing PATH, --json OUT
 """
 
 from __future__ import annotations
@@ -42,17 +45,17 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def timed(cmd: list[str]) -> tuple[float, float, str]:
-    """Wall seconds, peak RSS in MB and stdout of cmd under /usr/bin/time."""
+def timed(cmd: list[str]) -> tuple[float, float, float, str]:
+    """Wall seconds, CPU seconds (user + system), peak RSS in MB and stdout of cmd under /usr/bin/time."""
     with tempfile.NamedTemporaryFile("r", suffix=".time") as t:
         out = subprocess.run(
-            ["/usr/bin/time", "-f", "%e %M", "-o", t.name, *cmd],
+            ["/usr/bin/time", "-f", "%e %U %S %M", "-o", t.name, *cmd],
             check=True,
             capture_output=True,
             text=True,
         )
-        wall, kb = t.read().split()[-2:]
-    return float(wall), int(kb) / 1024.0, out.stdout
+        wall, user, system, kb = t.read().split()[-4:]
+    return float(wall), float(user) + float(system), int(kb) / 1024.0, out.stdout
 
 
 def stats(xs: list[float]) -> dict:
@@ -60,37 +63,45 @@ def stats(xs: list[float]) -> dict:
 
 
 def row(a: argparse.Namespace, n: int) -> dict:
+    """All runs at n points: per start s_<start>_*, the peer p_*."""
     pts = str(a.data / f"points_{n}.ply")
     held = str(a.data / "heldout.ply")
     lv = str(a.levels)
-    r: dict = {k: [] for k in ("s_fit", "p_fit", "s_fit_mem", "s_whole", "p_whole", "s_mem", "p_mem")}
+    r: dict = {}
+    add = lambda k, v: r.setdefault(k, []).append(v)  # noqa: E731
+    rmse: dict = {}
     load = [os.getloadavg()[0]]
+    repeats = a.repeats if n <= 5_000_000 else a.repeats_large
     with tempfile.TemporaryDirectory() as d:
         out = str(Path(d) / "m.json")
-        for _ in range(a.repeats):
-            _, m, s = timed([str(a.timing), pts, held, lv, a.start])
-            s = json.loads(s)
-            r["s_fit"].append(s["fit_s"])
-            r["s_fit_mem"].append(m)
-            _, _, p = timed([str(a.peer), pts, held, lv, "zero"])
+        for _ in range(repeats):
+            for st in a.starts:
+                _, _, m, s = timed([str(a.timing), pts, held, lv, st])
+                s = json.loads(s)
+                add(f"s_{st}_fit", s["fit_s"])
+                add(f"s_{st}_fit_cpu", s["fit_cpu_s"])
+                add(f"s_{st}_fit_mem", m)
+                rmse[st] = s["heldout_rmse"]
+                r["control_points"] = s["control_points"]
+            w, c, m, p = timed([str(a.peer), pts, held, lv, "zero"])
             p = json.loads(p)
-            r["p_fit"].append(p["fit_s"])
-            w, m, _ = timed(
-                [str(a.scanfit), "mba", pts, "--levels", lv, "--base", "1x1", "--start", a.start, "-o", out, "--quiet"]
-            )
-            r["s_whole"].append(w)
-            r["s_mem"].append(m)
-            w, m, _ = timed([str(a.peer), pts, held, lv, "zero"])
-            r["p_whole"].append(w)
-            r["p_mem"].append(m)
+            add("p_fit", p["fit_s"])
+            add("p_fit_cpu", p["fit_cpu_s"])
+            add("p_whole", w)
+            add("p_whole_cpu", c)
+            add("p_mem", m)
+            rmse["peer"] = p["heldout_rmse"]
+            if not a.fit_only:
+                for st in a.starts:
+                    w, c, m, _ = timed(
+                        [str(a.scanfit), "mba", pts, "--levels", lv, "--base", "1x1", "--start", st, "-o", out, "--quiet"]
+                    )
+                    add(f"s_{st}_whole", w)
+                    add(f"s_{st}_whole_cpu", c)
+                    add(f"s_{st}_mem", m)
             load.append(os.getloadavg()[0])
-    res = {k: stats(v) for k, v in r.items()}
-    res["points"] = n
-    res["start"] = a.start
-    res["s_heldout_rmse"] = s["heldout_rmse"]
-    res["p_heldout_rmse"] = p["heldout_rmse"]
-    res["control_points"] = s["control_points"]
-    res["load_average_1min"] = load
+    res = {k: stats(v) if isinstance(v, list) and k != "control_points" else v for k, v in r.items()}
+    res.update(points=n, heldout_rmse=rmse, load_average_1min=load)
     return res
 
 
@@ -101,12 +112,14 @@ def main() -> None:
     ap.add_argument("--sizes", type=int, nargs="+", default=[1_000_000, 10_000_000])
     ap.add_argument("--levels", type=int, default=8)
     ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--start", choices=["fitted", "mean"], default="fitted")
+    ap.add_argument("--repeats-large", type=int, default=1, help="repeats above 5 * 10^6 points")
+    ap.add_argument("--starts", choices=["fitted", "mean"], nargs="+", default=["fitted", "mean"])
+    ap.add_argument("--fit-only", action="store_true", help="skip the whole commands")
     ap.add_argument("--scanfit", type=Path, default=ROOT / "target/release/scanfit")
     ap.add_argument("--timing", type=Path, default=ROOT / "target/release/examples/mba_timing")
     ap.add_argument("--json", type=Path, help="write the raw results here")
     a = ap.parse_args()
-    for exe in (a.peer, a.scanfit, a.timing):
+    for exe in (a.peer, a.timing) + (() if a.fit_only else (a.scanfit,)):
         if not exe.exists():
             sys.exit(f"{exe} does not exist; build it first (see this script's docstring)")
     rows = [row(a, n) for n in a.sizes]
@@ -116,18 +129,23 @@ def main() -> None:
     print("|---|---|---|---|---|")
     for r in rows:
         n = f"10^{len(str(r['points'])) - 1}"
-        for name, s, p, unit in (
-            ("fit alone", "s_fit", "p_fit", "s"),
-            ("whole command", "s_whole", "p_whole", "s"),
-            ("peak memory, whole command", "s_mem", "p_mem", "MB"),
-            ("peak memory, fit alone (scanfit: the timing example)", "s_fit_mem", "p_mem", "MB"),
-        ):
-            sb, sm, pb, pm = r[s]["best"], r[s]["median"], r[p]["best"], r[p]["median"]
-            print(f"| {n} | {name} | {sb:.3g} / {sm:.3g} {unit} | {pb:.3g} / {pm:.3g} {unit} | {pb / sb:.2f} |")
-        print(
-            f"| {n} | held-out RMSE (10^5 points) | {r['s_heldout_rmse']:.4e} | {r['p_heldout_rmse']:.4e} | "
-            f"{r['p_heldout_rmse'] / r['s_heldout_rmse']:.3f} |"
-        )
+        for st in a.starts:
+            runs = [
+                (f"fit alone, `{st}`", f"s_{st}_fit", "p_fit", "s"),
+                (f"fit alone, `{st}`, CPU time", f"s_{st}_fit_cpu", "p_fit_cpu", "s"),
+                (f"peak memory, fit alone, `{st}` (scanfit: the timing example)", f"s_{st}_fit_mem", "p_mem", "MB"),
+            ]
+            if not a.fit_only:
+                runs += [
+                    (f"whole command, `{st}`", f"s_{st}_whole", "p_whole", "s"),
+                    (f"whole command, `{st}`, CPU time", f"s_{st}_whole_cpu", "p_whole_cpu", "s"),
+                    (f"peak memory, whole command, `{st}`", f"s_{st}_mem", "p_mem", "MB"),
+                ]
+            for name, s, p, unit in runs:
+                sb, sm, pb, pm = r[s]["best"], r[s]["median"], r[p]["best"], r[p]["median"]
+                print(f"| {n} | {name} | {sb:.3g} / {sm:.3g} {unit} | {pb:.3g} / {pm:.3g} {unit} | {pb / sb:.2f} |")
+            h, ph = r["heldout_rmse"][st], r["heldout_rmse"]["peer"]
+            print(f"| {n} | held-out RMSE (10^5 points), `{st}` | {h:.4e} | {ph:.4e} | {ph / h:.3f} |")
         la = r["load_average_1min"]
         print(f"| {n} | load average (1 min) | {min(la):.1f}-{max(la):.1f} | | |")
 

@@ -93,8 +93,8 @@ pub struct MbaArgs {
     pub tolerance: Option<f64>,
     /// Start of level 0: mean (the mean height), or fitted (the constant
     /// that leaves the smallest final residual at the points: 21% lower
-    /// held-out error than the mean on Franke's function, about 1.25x the fit's
-    /// CPU time; not with --chunk-points or --adjust).
+    /// held-out error than the mean on Franke's function, at the same CPU
+    /// time; not with --chunk-points or --adjust).
     #[arg(long, default_value = "mean", value_name = "S", value_parser = choice::<StartArg>())]
     pub start: StartArg,
     /// Hjelle's control-value formula (turntable paper eq. 6) instead of eq. 4.

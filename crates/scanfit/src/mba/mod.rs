@@ -64,7 +64,7 @@ pub struct MbaConfig {
 pub enum Start {
     /// The mean height (the frame's `z0`): independent of the heights'
     /// origin, and the only start of the streamed and distributed level
-    /// loop ([`MbaLevels`]), whose sums it keeps exact.
+    /// loop ([`MbaLevels`]), whose sums carry the heights alone.
     #[default]
     Mean,
     /// The constant of least squares: the level loop also runs the constant
@@ -72,8 +72,8 @@ pub enum Start {
     /// start `z0 + delta` with `delta = sum r c / sum c^2` (`r`, `c` the
     /// final residuals of the heights and of the constant) leaves the
     /// smallest residual at the points among all constant starts. In memory
-    /// only ([`mba`]); about 1.25 times the CPU time of [`Start::Mean`]
-    /// (the points are also sorted by lattice cell once).
+    /// only ([`mba`]), at the CPU time of [`Start::Mean`] (the in-memory
+    /// loop carries the second value set for both starts).
     Fitted,
 }
 
@@ -166,11 +166,11 @@ fn to_cells(unit: &[[f64; 2]], m: usize, n: usize) -> Vec<[f64; 2]> {
 
 /// Multilevel B-spline approximation of `points` (see the module documentation).
 ///
-/// One pass over the points per level: the pass that sums a level's BA step
-/// first subtracts the level before from the residuals and measures them,
-/// with the arithmetic and the order of additions of [`MbaLevels`] fed one
-/// level at a time, so the result equals the streamed level loop's bit for
-/// bit (see [`MbaLevels`]'s example).
+/// The points are ordered once by lattice cell; then one pass over them per
+/// level: the pass that sums a level's BA step first subtracts the level
+/// before from the residuals and measures them. The result equals the
+/// streamed level loop's ([`MbaLevels`] fed in file order) up to the
+/// rounding of the order of the sums (see [`MbaLevels`]'s example).
 pub fn mba(points: &[Point3], config: &MbaConfig) -> Result<Mba> {
     fused::mba(points, config)
 }

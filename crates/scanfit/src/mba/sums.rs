@@ -227,16 +227,6 @@ impl BaAccumulator {
     pub(super) fn partials(&self) -> usize {
         (PARTIAL_BUDGET / self.bytes()).clamp(1, 16)
     }
-
-    /// Points per block of the sums.
-    pub(super) fn block(&self) -> usize {
-        BA_BLOCK.max((self.m + 3) * (self.n + 3))
-    }
-
-    /// The control formula.
-    pub(super) fn formula(&self) -> ControlFormula {
-        self.formula
-    }
 }
 
 /// The lattice of `m x n` cells from BA sums: each control value the ratio
@@ -321,7 +311,12 @@ impl BaFactors {
     /// The factors at local coordinates `(s, t)` of a cell.
     #[inline]
     pub(super) fn new(s: f64, t: f64, formula: ControlFormula) -> Self {
-        let (bs, bt) = (uniform_cubic_basis(s), uniform_cubic_basis(t));
+        Self::of_basis(uniform_cubic_basis(s), uniform_cubic_basis(t), formula)
+    }
+
+    /// The factors from the basis values `bs = B(s)`, `bt = B(t)`.
+    #[inline]
+    pub(super) fn of_basis(bs: [f64; 4], bt: [f64; 4], formula: ControlFormula) -> Self {
         let (s2, t2) = (bs.map(|b| b * b), bt.map(|b| b * b));
         let sum2 = s2.iter().sum::<f64>() * t2.iter().sum::<f64>();
         match formula {
@@ -734,8 +729,7 @@ mod tests {
             max_levels: 6,
             ..Default::default()
         };
-        let once = mba(&p, &config).unwrap();
-        for chunk in [1, 777, 16_384, 25_000, 40_000] {
+        let streamed = |chunk: usize| {
             let mut fs = FrameSums::default();
             for c in p.chunks(chunk) {
                 fs.add(c).unwrap();
@@ -749,10 +743,31 @@ mod tests {
                 }
                 run.push(a).unwrap();
             }
-            let streamed = run.finish();
-            assert_eq!(streamed.frame, once.frame, "chunk {chunk}");
-            assert_eq!(streamed.lattice, once.lattice, "chunk {chunk}");
+            run.finish()
+        };
+        let whole = streamed(p.len());
+        for chunk in [1, 777, 16_384, 25_000] {
+            let got = streamed(chunk);
+            assert_eq!(got.frame, whole.frame, "chunk {chunk}");
+            assert_eq!(got.lattice, whole.lattice, "chunk {chunk}");
         }
+        // the in-memory loop sums in cell order: the same lattice up to the
+        // rounding of the sums' order
+        let once = mba(&p, &config).unwrap();
+        let f = (once.frame, whole.frame);
+        assert_eq!(
+            (f.0.x0, f.0.y0, f.0.width, f.0.height),
+            (f.1.x0, f.1.y0, f.1.width, f.1.height)
+        );
+        assert!((f.0.z0 - f.1.z0).abs() <= 1e-14 * f.1.z0.abs().max(1.0));
+        let scale = whole.lattice.phi.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let worst = once
+            .lattice
+            .phi
+            .iter()
+            .zip(&whole.lattice.phi)
+            .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+        assert!(worst <= 1e-12 * scale, "{worst:e} of {scale}");
     }
 
     #[test]

@@ -6,7 +6,8 @@
 //! chunks, always in the same order. The fits go through the same
 //! accumulators as the in-memory pipelines ([`crate::mba::BaAccumulator`],
 //! [`crate::fit::surface::NormalEquations`]), fed chunk after chunk in file order, so the surface
-//! is the in-memory one **bit for bit**:
+//! is the in-memory one: `fit`'s **bit for bit**, `mba`'s to 1e-12 of the largest control value
+//! (the in-memory MBA sums the points in lattice-cell order, [`crate::mba::mba`]):
 //!
 //! * [`mba`]: one pass for the frame ([`FrameSums`]), one per level
 //!   (residuals after the levels so far, [LWS97] eqs. 3-4), one to measure.
@@ -183,7 +184,9 @@ pub struct StreamedMba {
 /// Multilevel B-spline approximation of the points of `source` by passes
 /// (see the module documentation); the surface equals
 /// [`crate::pipeline::mba::run`]'s with the same up axis (`up`; `None`:
-/// [`UpAxis::automatic`] on an evenly spaced sample). The projection adjustment needs the
+/// [`UpAxis::automatic`] on an evenly spaced sample) to 1e-12 of the largest
+/// control value (the in-memory loop sums in lattice-cell order). The
+/// projection adjustment needs the
 /// whole cloud and is not offered here.
 ///
 /// ```
@@ -203,7 +206,10 @@ pub struct StreamedMba {
 /// let mut source = SliceSource { points: &p, uv: None, chunk: 333 };
 /// let r = mba(&mut source, &config, &AssessConfig::default(), None, &NoProgress)?;
 /// let once = mba_in_memory(&p, &config)?;
-/// assert_eq!(r.surface, lattice_surface(&once.frame, &once.lattice)?);
+/// let want = lattice_surface(&once.frame, &once.lattice)?;
+/// let worst = r.surface.control_points().iter().zip(want.control_points())
+///     .map(|(a, b)| (a.z - b.z).abs()).fold(0.0, f64::max);
+/// assert!(worst < 1e-12);
 /// assert_eq!(r.passes, 7); // bounding box, frame, 4 levels, measures
 /// # Ok::<(), scanfit::Error>(())
 /// ```
@@ -646,22 +652,34 @@ mod tests {
                 chunk,
             };
             let r = mba(&mut s, &cfg.mba, &cfg.assess, None, &NoProgress).unwrap();
-            assert_eq!(r.surface, once.surface, "chunk {chunk}");
+            // the in-memory MBA sums in lattice-cell order: equal to rounding
+            let (cs, co) = (r.surface.control_points(), once.surface.control_points());
+            assert_eq!(cs.len(), co.len());
+            assert_eq!(r.surface.knots_u(), once.surface.knots_u());
+            assert_eq!(r.surface.knots_v(), once.surface.knots_v());
+            let scale = co.iter().fold(0.0f64, |m, q| m.max(q.z.abs()));
+            for (a, b) in cs.iter().zip(co) {
+                assert_eq!((a.x, a.y), (b.x, b.y), "chunk {chunk}");
+                assert!((a.z - b.z).abs() <= 1e-12 * scale, "chunk {chunk}");
+            }
             assert_eq!(r.passes, 8);
             let (a, b) = (r.quality, once.assessment.quality);
-            let close = |x: f64, y: f64| (x - y).abs() <= 1e-12 * y.abs().max(1e-300);
+            let close = |x: f64, y: f64| (x - y).abs() <= 1e-10 * y.abs().max(1e-300);
             assert!(
                 close(a.at_parameters.rmse, b.at_parameters.rmse),
                 "{a:?} {b:?}"
             );
-            assert_eq!(a.at_parameters.max, b.at_parameters.max);
+            assert!(close(a.at_parameters.max, b.at_parameters.max));
             assert!(close(a.orthogonal.rmse, b.orthogonal.rmse));
-            assert_eq!(a.grid_rmse, b.grid_rmse);
-            assert_eq!(a.samples_to_points.stats.max, b.samples_to_points.stats.max);
+            assert!(close(a.grid_rmse, b.grid_rmse));
+            assert!(close(
+                a.samples_to_points.stats.max,
+                b.samples_to_points.stats.max
+            ));
             for (x, y) in r.levels.iter().zip(&once.levels) {
                 assert_eq!((x.level, x.control_points), (y.level, y.control_points));
                 assert!(close(x.vertical.rmse, y.vertical.rmse), "{x:?} {y:?}");
-                assert_eq!(x.grid_rmse, y.grid_rmse);
+                assert!(close(x.grid_rmse, y.grid_rmse));
             }
         }
     }
@@ -709,7 +727,12 @@ mod tests {
         };
         let r = mba(&mut s, &cfg.mba, &cfg.assess, None, &NoProgress).unwrap();
         assert_eq!(r.up, UpAxis::Y);
-        assert_eq!(r.surface, turned.surface);
+        // (the in-memory loop sums in cell order: equal to rounding)
+        let (cs, co) = (r.surface.control_points(), turned.surface.control_points());
+        let scale = co.iter().fold(0.0f64, |m, q| m.max(q.coords.abs().max()));
+        for (a, b) in cs.iter().zip(co) {
+            assert!((a - b).norm() <= 1e-12 * scale, "{a} {b}");
+        }
     }
 
     #[test]
