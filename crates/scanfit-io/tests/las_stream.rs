@@ -175,10 +175,24 @@ fn streamed_mba_on_las_and_laz_gives_the_in_memory_surface() {
             &mut source,
             &config.mba,
             &AssessConfig::default(),
+            Some(config.up),
             &NoProgress,
         )
         .unwrap();
-        assert_eq!(streamed.surface, whole.surface, "{}", path.display());
+        // the in-memory loop sums in lattice-cell order: equal to rounding
+        let (a, b) = (
+            streamed.surface.control_points(),
+            whole.surface.control_points(),
+        );
+        assert_eq!(a.len(), b.len());
+        let scale = b.iter().fold(0.0f64, |m, q| m.max(q.coords.abs().max()));
+        for (p, q) in a.iter().zip(b) {
+            assert!(
+                (p - q).norm() <= 1e-12 * scale,
+                "{}: {p} {q}",
+                path.display()
+            );
+        }
         assert_eq!(streamed.passes, 8);
     }
 }

@@ -508,7 +508,7 @@ impl Bands {
     /// `v` range).
     fn at(&self, v: f64) -> &[u32] {
         let t = (v - self.v0) * self.scale;
-        if !(t >= 0.0) || t > self.edges.len() as f64 {
+        if t.is_nan() || t < 0.0 || t > self.edges.len() as f64 {
             return &[];
         }
         &self.edges[(t as usize).min(self.edges.len() - 1)]
