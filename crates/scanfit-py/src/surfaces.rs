@@ -17,6 +17,7 @@ use scanfit::pipeline::surface_fit::{run as run_fit, FitConfig, ParameterSource}
 use scanfit::pipeline::turntable::{run as run_turntable, TurntableConfig, WeightComparison};
 use scanfit::progress::NoProgress;
 use scanfit::project::{DirectedConfig, GridIterationConfig, InversionConfig, WeightFactor};
+use scanfit::up_axis::UpAxis;
 use scanfit::PointCloud;
 
 use crate::cloud::{cloud_arg, criterion_of, CloudArg};
@@ -224,8 +225,12 @@ pub fn fit_surface<'py>(
 ///         ``"mean"`` (the mean height, the default) or ``"fitted"`` (the
 ///         constant that leaves the smallest residual at the points after
 ///         all levels; about 1.25 times the time).
+///     up: the height axis, as ``scanfit mba --up``: ``"auto"`` (the
+///         default: the thin axis of a sheet, else z), ``"x"``, ``"y"`` or
+///         ``"z"``. A y-up scan is fitted as ``y = f(x, -z)`` (the z-up fit
+///         turned), not as a wall of spikes over x, y.
 ///
-/// Returns a dict: ``surface``, ``cells``, ``u``, ``v``, ``vertical``
+/// Returns a dict: ``surface``, ``cells``, ``up`` (the height axis used), ``u``, ``v``, ``vertical``
 /// (``|z - f(x, y)|`` per point), ``levels`` (one dict per level:
 /// ``level``, ``control_points``, ``vertical``, ``grid_rmse``,
 /// ``adjusted``, ``seconds``), ``seconds``, ``quality``, ``residuals``,
@@ -236,7 +241,7 @@ pub fn fit_surface<'py>(
 ///     >>> r = scanfit.mba(cloud, levels=5, adjust=True)
 ///     >>> [l["grid_rmse"] for l in r["levels"]]  # doctest: +SKIP
 #[pyfunction]
-#[pyo3(signature = (points, levels = 6, base = None, tolerance = None, hjelle = false, adjust = false, alpha = 1.49, weight = "moon", adjust_steps = 5, start = "mean"))]
+#[pyo3(signature = (points, levels = 6, base = None, tolerance = None, hjelle = false, adjust = false, alpha = 1.49, weight = "moon", adjust_steps = 5, start = "mean", up = "auto"))]
 #[allow(clippy::too_many_arguments)]
 pub fn mba<'py>(
     py: Python<'py>,
@@ -250,9 +255,17 @@ pub fn mba<'py>(
     weight: &str,
     adjust_steps: usize,
     start: &str,
+    up: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let cloud = cloud_arg(points, "points")?;
     let mut cfg = MbaRunConfig::default();
+    cfg.up = match up {
+        "auto" => UpAxis::automatic(cloud.get().points()),
+        "x" => UpAxis::X,
+        "y" => UpAxis::Y,
+        "z" => UpAxis::Z,
+        o => return Err(bad_choice("up", o, &["auto", "x", "y", "z"])),
+    };
     cfg.mba = mba_config(levels, base.as_ref(), tolerance, hjelle, start)?;
     let weight = weight_of(weight)?;
     cfg.adjust = adjust.then(|| AdjustConfig {
@@ -269,6 +282,7 @@ pub fn mba<'py>(
     let d = PyDict::new(py);
     d.set_item("surface", PySurface::new(r.surface.clone()))?;
     d.set_item("cells", r.cells)?;
+    d.set_item("up", r.up.name())?;
     put_uv(&d, &r.uv)?;
     d.set_item("vertical", vec1(py, r.vertical.clone()))?;
     let rows = PyList::empty(py);

@@ -173,3 +173,22 @@ def test_the_gil_is_released_while_the_library_computes(data):
     # the main thread kept running Python during the fit (about one tick
     # per millisecond); with the GIL held it would get a handful at most
     assert elapsed > 0.05 and ticks > 0.1 * elapsed * 1000, (ticks, elapsed)
+
+
+def test_mba_takes_the_thin_axis_of_a_y_up_sheet_as_height():
+    rng = np.random.default_rng(7)
+    x, y = rng.uniform(0, 40, 3000), rng.uniform(0, 30, 3000)
+    zup = np.c_[x, y, 2.0 * np.sin(x / 7.0) + np.cos(y / 5.0)]
+    # the same terrain stored y-up: (x, y, z) -> (x, z, -y)
+    yup = np.c_[zup[:, 0], zup[:, 2], -zup[:, 1]]
+    flat = scanfit.mba(zup, levels=4)
+    turned = scanfit.mba(yup, levels=4)
+    assert (flat["up"], turned["up"]) == ("z", "y")
+    cz = flat["surface"].control_points.reshape(-1, 3)
+    cy = turned["surface"].control_points.reshape(-1, 3)
+    # exactly the z-up net turned
+    assert np.array_equal(cy, np.c_[cz[:, 0], cz[:, 2], -cz[:, 1]])
+    wall = scanfit.mba(yup, levels=4, up="z")
+    assert wall["quality"]["rmse_distance"] > 5 * turned["quality"]["rmse_distance"]
+    with pytest.raises(scanfit.ScanfitError, match="up"):
+        scanfit.mba(yup, up="w")

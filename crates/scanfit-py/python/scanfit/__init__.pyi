@@ -198,6 +198,7 @@ def mba(
     weight: Literal["moon", "aza04", "as05", "axis4"] = "moon",
     adjust_steps: int = 5,
     start: Literal["mean", "fitted"] = "mean",
+    up: Literal["auto", "x", "y", "z"] = "auto",
 ) -> dict[str, Any]: ...
 def coons(
     points: Points,
