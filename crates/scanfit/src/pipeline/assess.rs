@@ -499,6 +499,44 @@ fn per_point<W>(
     workspace: impl Fn() -> W + Sync,
     value: impl Fn(usize, &mut W) -> (f64, Option<(f64, bool)>) + Sync,
 ) -> Measured {
+    let s = per_point_sums(n, keep, distances, workspace, value);
+    Measured {
+        at_parameters: s.at_parameters.stats(),
+        orthogonal: if distances {
+            s.orthogonal.stats()
+        } else {
+            ErrorStats::default()
+        },
+        residuals: s.residuals,
+        distances: s.distances,
+        unconverged: s.unconverged,
+        inversions: Vec::new(),
+    }
+}
+
+/// The sums of [`per_point`], before they become statistics: the streamed
+/// assessment ([`super::stream::StreamAssessor`]) merges them over chunks.
+pub(crate) struct PointSums {
+    /// The errors at the parameters.
+    pub at_parameters: ResidualSums,
+    /// The orthogonal distances (empty without them).
+    pub orthogonal: ResidualSums,
+    /// The errors, when kept.
+    pub residuals: Vec<f64>,
+    /// The distances, when kept.
+    pub distances: Vec<f64>,
+    /// Indices (in `0..n`) whose inversion did not converge.
+    pub unconverged: Vec<usize>,
+}
+
+/// [`per_point`]'s pass, returning the sums.
+pub(crate) fn per_point_sums<W>(
+    n: usize,
+    keep: (bool, bool),
+    distances: bool,
+    workspace: impl Fn() -> W + Sync,
+    value: impl Fn(usize, &mut W) -> (f64, Option<(f64, bool)>) + Sync,
+) -> PointSums {
     type Part = (ResidualSums, ResidualSums, Vec<usize>);
     let block = |b: usize, errors: &mut [f64], dist: &mut [f64]| -> Part {
         let mut ws = workspace();
@@ -548,17 +586,12 @@ fn per_point<W>(
         orth.merge(&o);
         unconverged.extend(bad);
     }
-    Measured {
-        at_parameters: at.stats(),
-        orthogonal: if distances {
-            orth.stats()
-        } else {
-            ErrorStats::default()
-        },
+    PointSums {
+        at_parameters: at,
+        orthogonal: orth,
         residuals,
         distances: kept,
         unconverged,
-        inversions: Vec::new(),
     }
 }
 

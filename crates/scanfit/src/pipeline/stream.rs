@@ -29,17 +29,22 @@
 
 use std::time::Instant;
 
+use rayon::prelude::*;
+
 use crate::bspline::Surface;
 use crate::centring::Centring;
 use crate::mba::{
     lattice_surface, sums::residual, FrameSums, Lattice, MbaConfig, MbaLevels, ResidualSums,
 };
 use crate::metrics::ParamQuality;
-use crate::pipeline::assess::{AssessConfig, Extent, SampleDistances, SurfaceQuality};
+use crate::pipeline::assess::{
+    per_point_sums, AssessConfig, Extent, Measure, SampleDistances, SurfaceQuality,
+};
 use crate::pipeline::mba::LevelRow;
 use crate::pipeline::surface_fit::{FitConfig, ParameterSource};
 use crate::progress::Progress;
-use crate::project::SurfaceInverter;
+use crate::project::power_form::PowerForm;
+use crate::project::{InversionWorkspace, SurfaceInverter};
 use crate::spatial::KdTree;
 use crate::up_axis::UpAxis;
 use crate::{Error, Point3, PointCloud, Result};
@@ -283,13 +288,13 @@ pub fn mba(
     let mut last = ResidualSums::default();
     let mut grid = NearestSums::new(crate::mba::adjust::knot_grid(&frame, &result.lattice));
     source.pass(&mut |c| {
-        let uv: Vec<[f64; 2]> = c.points.iter().map(|p| frame.unit(p)).collect();
-        for (p, t) in c.points.iter().zip(&uv) {
-            vertical.push((p.z - surface.point(t[0], t[1]).z).abs());
-            last.push(residual(&frame, &result.levels, p, *t).abs());
-        }
-        grid.add(c.points)?;
-        assessor.add(c.points, &uv)
+        let uv: Vec<[f64; 2]> = c.points.par_iter().map(|p| frame.unit(p)).collect();
+        let (v, l) = vertical_sums(&surface, &frame, &result.levels, c.points, &uv);
+        vertical.merge(&v);
+        last.merge(&l);
+        let tree = ChunkTree::new(c.points);
+        grid.add_tree(&tree)?;
+        assessor.add_tree(&tree, &uv)
     })?;
     passes += 1;
     let mut reports = result.reports;
@@ -471,6 +476,67 @@ fn chunk_uv<'a>(c: &Chunk<'a>) -> Result<&'a [[f64; 2]]> {
     })
 }
 
+/// The sums of the vertical errors of `surface` at the points of a chunk
+/// (at their parameters `uv`) and of the residuals after the last of
+/// `levels`, in parallel blocks merged in order.
+fn vertical_sums(
+    surface: &Surface,
+    frame: &crate::mba::Frame,
+    levels: &[Lattice],
+    points: &[Point3],
+    uv: &[[f64; 2]],
+) -> (ResidualSums, ResidualSums) {
+    const BLOCK: usize = 1 << 14;
+    let parts: Vec<(ResidualSums, ResidualSums)> = points
+        .par_chunks(BLOCK)
+        .zip(uv.par_chunks(BLOCK))
+        .map(|(p, t)| {
+            let (mut v, mut l) = (ResidualSums::default(), ResidualSums::default());
+            for (p, t) in p.iter().zip(t) {
+                v.push((p.z - surface.point(t[0], t[1]).z).abs());
+                l.push(residual(frame, levels, p, *t).abs());
+            }
+            (v, l)
+        })
+        .collect();
+    let (mut v, mut l) = (ResidualSums::default(), ResidualSums::default());
+    for (a, b) in &parts {
+        v.merge(a);
+        l.merge(b);
+    }
+    (v, l)
+}
+
+/// The KD-tree of one chunk's points, built at the first query and shared by
+/// every [`NearestSums`] of the pass (one tree per chunk, not one per
+/// measure).
+pub struct ChunkTree<'a> {
+    points: &'a [Point3],
+    tree: std::sync::OnceLock<KdTree>,
+}
+
+impl<'a> ChunkTree<'a> {
+    /// The (not yet built) tree of `points`.
+    pub fn new(points: &'a [Point3]) -> Self {
+        Self {
+            points,
+            tree: std::sync::OnceLock::new(),
+        }
+    }
+
+    /// The tree, built on first use; `None` for an empty chunk.
+    fn get(&self) -> Result<Option<&KdTree>> {
+        if self.points.is_empty() {
+            return Ok(None);
+        }
+        if self.tree.get().is_none() {
+            let t = KdTree::new(self.points, "the chunk's points")?;
+            let _ = self.tree.set(t);
+        }
+        Ok(self.tree.get())
+    }
+}
+
 /// The smallest distance from each of a fixed set of query points to the
 /// points of all chunks seen (exact: the minimum over chunks).
 #[derive(Debug, Clone)]
@@ -488,13 +554,21 @@ impl NearestSums {
 
     /// Takes the chunk's points into account.
     pub fn add(&mut self, points: &[Point3]) -> Result<()> {
-        if points.is_empty() || self.queries.is_empty() {
+        self.add_tree(&ChunkTree::new(points))
+    }
+
+    /// Takes the chunk of `tree` into account (queries in parallel).
+    pub fn add_tree(&mut self, tree: &ChunkTree<'_>) -> Result<()> {
+        if self.queries.is_empty() {
             return Ok(());
         }
-        let tree = KdTree::new(points, "the chunk's points")?;
-        for (b, q) in self.best.iter_mut().zip(&self.queries) {
-            *b = b.min(tree.nearest(q).distance);
-        }
+        let Some(tree) = tree.get()? else {
+            return Ok(());
+        };
+        self.best
+            .par_iter_mut()
+            .zip(self.queries.par_iter())
+            .for_each(|(b, q)| *b = b.min(tree.nearest(q).distance));
         Ok(())
     }
 
@@ -516,10 +590,14 @@ impl NearestSums {
 }
 
 /// The assessment of a surface against points that arrive in chunks (see
-/// the module documentation for what is exact and what is sampled).
+/// the module documentation for what is exact and what is sampled), with
+/// the in-memory assessment's per-point kernel (in parallel over each
+/// chunk) and its [`Measure`] levels: [`Measure::None`] measures the errors
+/// at the parameters and the extent only, as in memory.
 pub struct StreamAssessor<'s> {
     surface: &'s Surface,
     inverter: SurfaceInverter<'s>,
+    form: Option<PowerForm>,
     at_parameters: ResidualSums,
     orthogonal: ResidualSums,
     unconverged: usize,
@@ -536,13 +614,19 @@ impl<'s> StreamAssessor<'s> {
     /// An assessor of `surface` with the settings of `config`.
     pub fn new(surface: &'s Surface, config: &AssessConfig) -> Result<Self> {
         let (grid, samples) = crate::pipeline::assess::sample_grid(surface, config)?;
+        let measured = config.measure != Measure::None;
         Ok(Self {
             surface,
             inverter: SurfaceInverter::new(surface, config.inversion)?,
+            form: PowerForm::new(surface),
             at_parameters: ResidualSums::default(),
             orthogonal: ResidualSums::default(),
             unconverged: 0,
-            knots: NearestSums::new(crate::pipeline::assess::knot_line_points(surface)),
+            knots: NearestSums::new(if measured {
+                crate::pipeline::assess::knot_line_points(surface)
+            } else {
+                Vec::new()
+            }),
             samples: NearestSums::new(samples),
             grid,
             far_spacings: config.far_spacings,
@@ -554,6 +638,13 @@ impl<'s> StreamAssessor<'s> {
 
     /// Adds a chunk of points with their parameters.
     pub fn add(&mut self, points: &[Point3], uv: &[[f64; 2]]) -> Result<()> {
+        self.add_tree(&ChunkTree::new(points), uv)
+    }
+
+    /// [`Self::add`] with the chunk's shared tree (the chunk is the tree's
+    /// points).
+    pub fn add_tree(&mut self, chunk: &ChunkTree<'_>, uv: &[[f64; 2]]) -> Result<()> {
+        let points = chunk.points;
         if points.len() != uv.len() {
             return Err(Error::LengthMismatch {
                 what: "parameter pairs",
@@ -561,33 +652,67 @@ impl<'s> StreamAssessor<'s> {
                 got: uv.len(),
             });
         }
-        for (p, t) in points.iter().zip(uv) {
-            self.at_parameters
-                .push((p - self.surface.point(t[0], t[1])).norm());
+        let measured = self.config.measure != Measure::None;
+        let (surface, inverter, form) = (self.surface, &self.inverter, &self.form);
+        let sums = per_point_sums(
+            points.len(),
+            (false, false),
+            measured,
+            || InversionWorkspace::new(surface),
+            |i, ws| {
+                let (p, t) = (&points[i], uv[i]);
+                let error = (p - surface.point(t[0], t[1])).norm();
+                if !measured {
+                    return (error, None);
+                }
+                let r = match form {
+                    Some(f) => inverter
+                        .invert_near_with(p, t, ws, |u, v, o, out, _| f.derivatives(u, v, o, out)),
+                    None => inverter.invert_near(p, t, ws),
+                };
+                (error, Some((r.distance, r.converged)))
+            },
+        );
+        self.at_parameters.merge(&sums.at_parameters);
+        self.orthogonal.merge(&sums.orthogonal);
+        self.unconverged += sums.unconverged.len();
+        if measured {
+            self.knots.add_tree(chunk)?;
+            self.samples.add_tree(chunk)?;
+            if self.spacing.is_none() && points.len() >= 2 {
+                self.spacing = Some(PointCloud::new(points.to_vec())?.spacing()?.median);
+            }
         }
-        for r in self.inverter.invert_all(points) {
-            self.orthogonal.push(r.distance);
-            self.unconverged += usize::from(!r.converged);
-        }
-        self.knots.add(points)?;
-        self.samples.add(points)?;
         for p in points {
             let (lo, hi) = self.bounds.get_or_insert((*p, *p));
             *lo = lo.inf(p);
             *hi = hi.sup(p);
-        }
-        if self.spacing.is_none() && points.len() >= 2 {
-            self.spacing = Some(PointCloud::new(points.to_vec())?.spacing()?.median);
         }
         Ok(())
     }
 
     /// The measures.
     pub fn finish(self) -> SurfaceQuality {
+        let measured = self.config.measure != Measure::None;
         let spacing = self.spacing.unwrap_or(0.0);
-        let d = self.samples.distances();
-        let limit = self.far_spacings * spacing;
-        let far = d.iter().filter(|&&x| x > limit).count();
+        let samples_to_points = if measured {
+            let d = self.samples.distances();
+            let limit = self.far_spacings * spacing;
+            let far = d.iter().filter(|&&x| x > limit).count();
+            SampleDistances {
+                grid: self.grid,
+                stats: crate::metrics::ErrorStats::of(d),
+                spacing,
+                far_spacings: self.far_spacings,
+                far_share: far as f64 / d.len().max(1) as f64,
+            }
+        } else {
+            SampleDistances {
+                grid: self.grid,
+                far_spacings: self.far_spacings,
+                ..Default::default()
+            }
+        };
         let extent = match self.bounds {
             Some(b) => crate::pipeline::assess::extent_in_box(
                 self.surface,
@@ -601,16 +726,14 @@ impl<'s> StreamAssessor<'s> {
         SurfaceQuality {
             points: usize::try_from(self.at_parameters.count).unwrap_or(usize::MAX),
             at_parameters: self.at_parameters.stats(),
-            orthogonal: self.orthogonal.stats(),
-            unconverged: self.unconverged,
-            grid_rmse: self.knots.rmse(),
-            samples_to_points: SampleDistances {
-                grid: self.grid,
-                stats: crate::metrics::ErrorStats::of(d),
-                spacing,
-                far_spacings: self.far_spacings,
-                far_share: far as f64 / d.len().max(1) as f64,
+            orthogonal: if measured {
+                self.orthogonal.stats()
+            } else {
+                crate::metrics::ErrorStats::default()
             },
+            unconverged: self.unconverged,
+            grid_rmse: if measured { self.knots.rmse() } else { 0.0 },
+            samples_to_points,
             parameterization: ParamQuality::default(),
             extent,
         }
