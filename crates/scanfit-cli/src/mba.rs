@@ -10,6 +10,7 @@ use clap::{Args, ValueEnum};
 use scanfit::mba::adjust::AdjustConfig;
 use scanfit::mba::{ControlFormula, Start};
 use scanfit::pipeline::mba::{run as mba, LevelRow, MbaReport, MbaRunConfig};
+use scanfit::pipeline::trim::{Loops, TrimInput};
 use scanfit::project::{DirectedConfig, WeightFactor};
 use scanfit_io::json::SurfaceDoc;
 use scanfit_io::render::Up;
@@ -268,9 +269,16 @@ pub fn run(a: MbaArgs) -> Result<()> {
     let mut r = mba(&cloud, &config, &progress)
         .map_err(|e| anyhow::anyhow!("{}: {}", input.display(), cli_message(&e, &options)))?;
     let pts = cloud.points();
-    let trimmed = a.trim.apply(true, &r.surface, pts, &r.uv, None)?;
+    let trim = TrimInput {
+        surface: &r.surface,
+        cloud: &cloud,
+        uv: &r.uv,
+        loops: Loops::Parameters {
+            scale: [r.frame.width, r.frame.height],
+        },
+    };
     let q = &mut r.assessment.quality;
-    crate::cad::measure_trimmed(q, trimmed.as_ref(), &cloud, &config.assess)?;
+    let trimmed = a.trim.apply(true, &trim, q, &config.assess, &progress)?;
     a.out.guard(
         q,
         "remove stray points or use fewer levels (--levels) or a tolerance (--tolerance)",
