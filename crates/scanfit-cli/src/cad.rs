@@ -108,7 +108,7 @@ impl TrimArgs {
     pub fn apply(
         &self,
         default: bool,
-        input: &TrimInput,
+        input: TrimInput,
         quality: &mut SurfaceQuality,
         assess: &AssessConfig,
         progress: &dyn Progress,

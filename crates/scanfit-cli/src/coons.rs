@@ -308,7 +308,7 @@ pub fn run(a: CoonsArgs) -> Result<()> {
     let progress = Progress::spinner(a.quiet || a.json);
     let input = a.input.input.display().to_string();
     progress.stage(format!("reading {input}"));
-    let cloud = a.outliers.apply(a.input.load(a.json)?, a.json)?;
+    let mut cloud = a.outliers.apply(a.input.load(a.json)?, a.json)?;
     let mut r = coons(&cloud, &cfg, &progress)
         .map_err(|e| {
             let message = cli_message(
@@ -329,15 +329,15 @@ pub fn run(a: CoonsArgs) -> Result<()> {
         })
         .with_context(|| format!("Coons patch of {input} ({} sides)", a.sides.count()))?;
     let secs = t0.elapsed().as_secs_f64();
-    let pts = cloud.points();
     let trim = TrimInput {
         surface: &r.surface,
-        cloud: &cloud,
+        cloud: &mut cloud,
         uv: &r.parameters.uv,
         loops: Loops::Given(&r.base.boundary),
     };
     let q = &mut r.assessment.quality;
-    let trimmed = a.trim.apply(true, &trim, q, &cfg.assess, &progress)?;
+    let trimmed = a.trim.apply(true, trim, q, &cfg.assess, &progress)?;
+    let pts = cloud.points();
     a.out.guard(
         q,
         "check the corners (--corners), use fewer control points (--ctrl) or fewer PDE terms (--pde)",

@@ -252,7 +252,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
     }
     let progress = Progress::spinner(a.quiet || a.json);
     progress.stage(format!("reading {}", a.input.input.display()));
-    let cloud = a.outliers.apply(a.input.load(a.json)?, a.json)?;
+    let mut cloud = a.outliers.apply(a.input.load(a.json)?, a.json)?;
     let up = a.out.view.up(cloud.points());
     let (residual_name, parameters) = height_names(up);
     note_lattice(&a, cloud.points());
@@ -268,17 +268,17 @@ pub fn run(a: MbaArgs) -> Result<()> {
     config.up = up;
     let mut r = mba(&cloud, &config, &progress)
         .map_err(|e| anyhow::anyhow!("{}: {}", input.display(), cli_message(&e, &options)))?;
-    let pts = cloud.points();
     let trim = TrimInput {
         surface: &r.surface,
-        cloud: &cloud,
+        cloud: &mut cloud,
         uv: &r.uv,
         loops: Loops::Parameters {
             scale: [r.frame.width, r.frame.height],
         },
     };
     let q = &mut r.assessment.quality;
-    let trimmed = a.trim.apply(true, &trim, q, &config.assess, &progress)?;
+    let trimmed = a.trim.apply(true, trim, q, &config.assess, &progress)?;
+    let pts = cloud.points();
     a.out.guard(
         q,
         "remove stray points or use fewer levels (--levels) or a tolerance (--tolerance)",

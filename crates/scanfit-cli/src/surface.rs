@@ -233,19 +233,19 @@ pub fn run(a: FitArgs) -> Result<()> {
         return crate::stream::fit(&a, n);
     }
     let progress = Progress::spinner(a.quiet);
-    let (cloud, mut r) = read_and_fit(&a, &progress)?;
-    let pts = cloud.points();
+    let (mut cloud, mut r) = read_and_fit(&a, &progress)?;
     let plane = matches!(a.params, ParamsArg::Plane) && !a.periodic_u;
     let trim = TrimInput {
         surface: &r.surface,
-        cloud: &cloud,
+        cloud: &mut cloud,
         uv: &r.uv,
         loops: Loops::BestFitPlane,
     };
     let q = &mut r.assessment.quality;
     let trimmed = a
         .trim
-        .apply(plane, &trim, q, &a.config().assess, &progress)?;
+        .apply(plane, trim, q, &a.config().assess, &progress)?;
+    let pts = cloud.points();
     a.out.guard(
         q,
         "raise the smoothing (--smooth; by default it is scaled to the data) or use fewer control points (--ctrl)",

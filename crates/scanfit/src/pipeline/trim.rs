@@ -107,12 +107,17 @@ pub struct TrimReport {
 
 /// What [`run`] trims: the fitted surface, the points and their parameters
 /// (indexed alike), and where the loops come from.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug)]
 pub struct TrimInput<'a> {
     /// The fitted surface.
     pub surface: &'a Surface,
-    /// The points it was fitted to.
-    pub cloud: &'a PointCloud,
+    /// The points it was fitted to. When the loops are computed here, the
+    /// cloud's cached KD-tree is released first
+    /// ([`PointCloud::release_tree`]; about 37 bytes per point, idle while
+    /// the alpha shape allocates) and built again only if a face is
+    /// measured: `mba` on 10^7 points then peaks in its assessment, not in
+    /// its trim (BENCHMARKS.md).
+    pub cloud: &'a mut PointCloud,
     /// Each point's parameters on the surface.
     pub uv: &'a [[f64; 2]],
     /// The loops' source.
@@ -141,16 +146,16 @@ pub struct TrimInput<'a> {
 ///     .filter(|&(x, y)| !((25.0..35.0).contains(&x) && (25.0..35.0).contains(&y)))
 ///     .map(|(x, y)| Point3::new(x, y, 20.0 * (-((x - 30.0).powi(2) + (y - 30.0).powi(2)) / 400.0).exp()))
 ///     .collect();
-/// let cloud = PointCloud::new(pts)?;
+/// let mut cloud = PointCloud::new(pts)?;
 /// let r = mba(&cloud, &MbaRunConfig::default(), &NoProgress)?;
 /// let mut quality = r.assessment.quality.clone();
 /// let input = TrimInput {
 ///     surface: &r.surface,
-///     cloud: &cloud,
+///     cloud: &mut cloud,
 ///     uv: &r.uv,
 ///     loops: Loops::Parameters { scale: [r.frame.width, r.frame.height] },
 /// };
-/// let t = run(&input, &mut quality, &TrimRunConfig::default(), &NoProgress)?;
+/// let t = run(input, &mut quality, &TrimRunConfig::default(), &NoProgress)?;
 /// let face = t.trimmed.expect("the hole is trimmed");
 /// // the outline is the lattice's rectangle, the hole its one trim loop
 /// assert!(face.outer.is_none() && face.holes.len() == 1);
@@ -158,7 +163,7 @@ pub struct TrimInput<'a> {
 /// # Ok::<(), scanfit::Error>(())
 /// ```
 pub fn run(
-    input: &TrimInput,
+    mut input: TrimInput,
     quality: &mut SurfaceQuality,
     config: &TrimRunConfig,
     progress: &dyn Progress,
@@ -175,7 +180,10 @@ pub fn run(
         )));
     }
     progress.stage("trimming: boundary loops", None);
-    let trimmed = face(input, config);
+    if !matches!(input.loops, Loops::Given(_)) {
+        input.cloud.release_tree();
+    }
+    let trimmed = face(&input, config);
     let trimmed = match (trimmed, config.mode) {
         (Ok(t), _) => t,
         (Err(e), TrimMode::Default) => {
@@ -240,7 +248,7 @@ mod tests {
         // Franke's bumps tilt the best-fit plane; in the plane the loops
         // hold spurious holes, in the parameters there is one loop on the
         // domain's edges
-        let cloud = franke(100_000, 3);
+        let mut cloud = franke(100_000, 3);
         let r = mba(&cloud, &MbaRunConfig::default(), &NoProgress).unwrap();
         let scale = [r.frame.width, r.frame.height];
         let flat = boundary_loops_2d(&r.uv, scale, &BoundaryConfig::default()).unwrap();
@@ -252,11 +260,11 @@ mod tests {
         let mut q = r.assessment.quality.clone();
         let input = TrimInput {
             surface: &r.surface,
-            cloud: &cloud,
+            cloud: &mut cloud,
             uv: &r.uv,
             loops: Loops::Parameters { scale },
         };
-        let t = run(&input, &mut q, &TrimRunConfig::default(), &NoProgress).unwrap();
+        let t = run(input, &mut q, &TrimRunConfig::default(), &NoProgress).unwrap();
         assert!(t.trimmed.is_none() && t.kept_rectangle.is_none());
         assert_eq!(
             q, r.assessment.quality,
