@@ -1002,7 +1002,13 @@ mod tests {
             for (x, y) in b.areas.iter().zip(&flat.areas) {
                 assert!((x / y - 1.0).abs() < 1e-9, "{x} {y}");
             }
-            assert!((b.spacing / flat.spacing - 1.0).abs() < 1e-9);
+            // the same median edge, up to rounding; above sample_above
+            // the sample's cells are cut from unit coordinates of another
+            // origin and extent, so a point at a cell's edge may fall on
+            // the other side (the loops above are still the same)
+            let tol = if n > 200_000 { 0.01 } else { 1e-9 };
+            let rel = b.spacing / flat.spacing - 1.0;
+            assert!(rel.abs() < tol, "n = {n}: spacing {rel:e} off");
             // the strip's area less the holes': the loops run inside the
             // region, by less than a spacing along its 24.2 units of edges
             let area: f64 = b.areas.iter().sum();

@@ -163,7 +163,7 @@ pub struct TrimInput<'a> {
 /// # Ok::<(), scanfit::Error>(())
 /// ```
 pub fn run(
-    mut input: TrimInput,
+    input: TrimInput,
     quality: &mut SurfaceQuality,
     config: &TrimRunConfig,
     progress: &dyn Progress,
