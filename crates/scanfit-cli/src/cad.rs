@@ -115,7 +115,7 @@ impl TrimArgs {
     ) -> Result<Option<TrimmedSurface>> {
         let mut config = TrimRunConfig::default();
         config.mode = self.mode(default);
-        config.assess = assess.clone();
+        config.assess = *assess;
         let r = run(input, quality, &config, progress)
             .map_err(|e| anyhow::anyhow!("trimming the surface: {e} (or give --no-trim)"))?;
         if let Some(why) = &r.kept_rectangle {

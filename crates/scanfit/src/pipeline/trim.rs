@@ -148,7 +148,7 @@ pub struct TrimInput<'a> {
 ///     .collect();
 /// let mut cloud = PointCloud::new(pts)?;
 /// let r = mba(&cloud, &MbaRunConfig::default(), &NoProgress)?;
-/// let mut quality = r.assessment.quality.clone();
+/// let mut quality = r.assessment.quality;
 /// let input = TrimInput {
 ///     surface: &r.surface,
 ///     cloud: &mut cloud,
@@ -257,7 +257,7 @@ mod tests {
         assert!(area > 0.99 && area <= 1.0, "{area}");
         let tilted = boundary_loops(cloud.points(), &BoundaryConfig::default()).unwrap();
         assert!(tilted.loops.len() > 10, "{}", tilted.loops.len());
-        let mut q = r.assessment.quality.clone();
+        let mut q = r.assessment.quality;
         let input = TrimInput {
             surface: &r.surface,
             cloud: &mut cloud,
