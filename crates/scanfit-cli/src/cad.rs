@@ -6,12 +6,10 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use clap::{Args, ValueEnum};
-use scanfit::bspline::Surface;
-use scanfit::cloud::boundary::Boundary;
 use scanfit::pipeline::assess::{AssessConfig, SurfaceQuality};
-use scanfit::pipeline::assess_trimmed::assess_trimmed;
-use scanfit::trim::{trim_surface, trim_to_points, TrimConfig, TrimmedSurface};
-use scanfit::{Point3, PointCloud};
+use scanfit::pipeline::trim::{run, TrimInput, TrimMode, TrimRunConfig};
+use scanfit::progress::Progress;
+use scanfit::trim::{TrimConfig, TrimmedSurface};
 use scanfit_io::iges::iges_file_with;
 use scanfit_io::step::{step_file_with, CadItem};
 use scanfit_io::units::{CadOptions, LengthUnit};
@@ -91,53 +89,40 @@ impl TrimArgs {
         self.trim || (default && !self.no_trim)
     }
 
-    /// The trimmed surface when wanted: `surface` bounded by the boundary
-    /// loops of `points` (`boundary` when the pipeline computed them),
-    /// mapped by their parameters `uv`.
+    /// The library's trim mode for these flags, `default` when neither is
+    /// given.
+    pub fn mode(&self, default: bool) -> TrimMode {
+        if self.trim {
+            TrimMode::Required
+        } else if self.wanted(default) {
+            TrimMode::Default
+        } else {
+            TrimMode::Off
+        }
+    }
+
+    /// The trimmed face when wanted ([`scanfit::pipeline::trim::run`]), with
+    /// `quality` (the pipeline's assessment, taken with `assess`) measured
+    /// again on it; a default trim that cannot be made says why on stderr
+    /// and keeps the rectangle.
     pub fn apply(
         &self,
         default: bool,
-        surface: &Surface,
-        points: &[Point3],
-        uv: &[[f64; 2]],
-        boundary: Option<&Boundary>,
+        input: TrimInput,
+        quality: &mut SurfaceQuality,
+        assess: &AssessConfig,
+        progress: &dyn Progress,
     ) -> Result<Option<TrimmedSurface>> {
-        if !self.wanted(default) {
-            return Ok(None);
+        let mut config = TrimRunConfig::default();
+        config.mode = self.mode(default);
+        config.assess = *assess;
+        let r = run(input, quality, &config, progress)
+            .map_err(|e| anyhow::anyhow!("trimming the surface: {e} (or give --no-trim)"))?;
+        if let Some(why) = &r.kept_rectangle {
+            eprintln!("note: the surface is not trimmed: {why}");
         }
-        let cfg = TrimConfig::default();
-        let t = match boundary {
-            Some(b) => trim_surface(surface, uv, b, &cfg),
-            None => trim_to_points(surface, points, uv, &cfg),
-        };
-        let t = match t {
-            Ok(t) => t,
-            Err(e) if !self.trim => {
-                // the default: say why and keep the rectangle
-                eprintln!("note: the surface is not trimmed: {e}");
-                return Ok(None);
-            }
-            Err(e) => anyhow::bail!("trimming the surface: {e} (or give --no-trim)"),
-        };
-        // a boundary that is the rectangle's own, without holes, trims nothing
-        Ok((t.outer.is_some() || !t.holes.is_empty()).then_some(t))
+        Ok(r.trimmed)
     }
-}
-
-/// The surface-to-points measures and the extent check of `quality` (the
-/// pipeline's assessment with `config`) taken again over the trimmed face,
-/// when there is one: the parts of the rectangle outside the trim loops are
-/// in no output and do not count.
-pub fn measure_trimmed(
-    quality: &mut SurfaceQuality,
-    trimmed: Option<&TrimmedSurface>,
-    cloud: &PointCloud,
-    config: &AssessConfig,
-) -> Result<()> {
-    if let Some(t) = trimmed {
-        assess_trimmed(quality, t, cloud, config)?;
-    }
-    Ok(())
 }
 
 /// One line describing a trimmed face, for the command's report.

@@ -16,6 +16,7 @@ use scanfit::cloud::corners::CornerCriterion;
 use scanfit::fit::surface::SurfaceFitConfig;
 use scanfit::pde::PdeConfig;
 use scanfit::pipeline::coons::{run as coons, CoonsConfig, CoonsReport, CoonsRoute};
+use scanfit::pipeline::trim::{Loops, TrimInput};
 use scanfit::project::{GridIterationConfig, InversionConfig};
 use scanfit::Point3;
 use scanfit_io::json::SurfaceDoc;
@@ -307,7 +308,7 @@ pub fn run(a: CoonsArgs) -> Result<()> {
     let progress = Progress::spinner(a.quiet || a.json);
     let input = a.input.input.display().to_string();
     progress.stage(format!("reading {input}"));
-    let cloud = a.outliers.apply(a.input.load(a.json)?, a.json)?;
+    let mut cloud = a.outliers.apply(a.input.load(a.json)?, a.json)?;
     let mut r = coons(&cloud, &cfg, &progress)
         .map_err(|e| {
             let message = cli_message(
@@ -328,13 +329,15 @@ pub fn run(a: CoonsArgs) -> Result<()> {
         })
         .with_context(|| format!("Coons patch of {input} ({} sides)", a.sides.count()))?;
     let secs = t0.elapsed().as_secs_f64();
-    let pts = cloud.points();
-    let boundary = Some(&r.base.boundary);
-    let trimmed = a
-        .trim
-        .apply(true, &r.surface, pts, &r.parameters.uv, boundary)?;
+    let trim = TrimInput {
+        surface: &r.surface,
+        cloud: &mut cloud,
+        uv: &r.parameters.uv,
+        loops: Loops::Given(&r.base.boundary),
+    };
     let q = &mut r.assessment.quality;
-    crate::cad::measure_trimmed(q, trimmed.as_ref(), &cloud, &cfg.assess)?;
+    let trimmed = a.trim.apply(true, trim, q, &cfg.assess, &progress)?;
+    let pts = cloud.points();
     a.out.guard(
         q,
         "check the corners (--corners), use fewer control points (--ctrl) or fewer PDE terms (--pde)",

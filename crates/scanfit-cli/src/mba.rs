@@ -10,6 +10,7 @@ use clap::{Args, ValueEnum};
 use scanfit::mba::adjust::AdjustConfig;
 use scanfit::mba::{ControlFormula, Start};
 use scanfit::pipeline::mba::{run as mba, LevelRow, MbaReport, MbaRunConfig};
+use scanfit::pipeline::trim::{Loops, TrimInput};
 use scanfit::project::{DirectedConfig, WeightFactor};
 use scanfit_io::json::SurfaceDoc;
 use scanfit_io::render::Up;
@@ -251,7 +252,7 @@ pub fn run(a: MbaArgs) -> Result<()> {
     }
     let progress = Progress::spinner(a.quiet || a.json);
     progress.stage(format!("reading {}", a.input.input.display()));
-    let cloud = a.outliers.apply(a.input.load(a.json)?, a.json)?;
+    let mut cloud = a.outliers.apply(a.input.load(a.json)?, a.json)?;
     let up = a.out.view.up(cloud.points());
     let (residual_name, parameters) = height_names(up);
     note_lattice(&a, cloud.points());
@@ -267,10 +268,17 @@ pub fn run(a: MbaArgs) -> Result<()> {
     config.up = up;
     let mut r = mba(&cloud, &config, &progress)
         .map_err(|e| anyhow::anyhow!("{}: {}", input.display(), cli_message(&e, &options)))?;
-    let pts = cloud.points();
-    let trimmed = a.trim.apply(true, &r.surface, pts, &r.uv, None)?;
+    let trim = TrimInput {
+        surface: &r.surface,
+        cloud: &mut cloud,
+        uv: &r.uv,
+        loops: Loops::Parameters {
+            scale: [r.frame.width, r.frame.height],
+        },
+    };
     let q = &mut r.assessment.quality;
-    crate::cad::measure_trimmed(q, trimmed.as_ref(), &cloud, &config.assess)?;
+    let trimmed = a.trim.apply(true, trim, q, &config.assess, &progress)?;
+    let pts = cloud.points();
     a.out.guard(
         q,
         "remove stray points or use fewer levels (--levels) or a tolerance (--tolerance)",

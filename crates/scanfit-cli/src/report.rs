@@ -291,7 +291,9 @@ pub fn run(a: ReportArgs) -> Result<()> {
     // a trimmed face is measured as trimmed: the surface samples cover the
     // face, not its parameter rectangle
     let q = &mut r.assessment.quality;
-    crate::cad::measure_trimmed(q, trimmed.as_ref(), &cloud, &config.assess)?;
+    if let Some(t) = &trimmed {
+        scanfit::pipeline::assess_trimmed::assess_trimmed(q, t, &cloud, &config.assess)?;
+    }
     progress.stage("rendering");
     let pic = pictures(&a, &surface, trimmed.as_ref(), pts, &r)?;
     progress.finish();

@@ -10,6 +10,7 @@ use scanfit::bspline::Surface;
 use scanfit::fit::surface::KnotPlacement;
 use scanfit::pipeline::assess::SurfaceQuality;
 use scanfit::pipeline::surface_fit::{run as fit, FitConfig, FitReport, ParameterSource};
+use scanfit::pipeline::trim::{Loops, TrimInput};
 use scanfit::PointCloud;
 use scanfit_io::json::SurfaceDoc;
 use scanfit_io::{write_all_atomic, PointTable};
@@ -232,12 +233,19 @@ pub fn run(a: FitArgs) -> Result<()> {
         return crate::stream::fit(&a, n);
     }
     let progress = Progress::spinner(a.quiet);
-    let (cloud, mut r) = read_and_fit(&a, &progress)?;
-    let pts = cloud.points();
+    let (mut cloud, mut r) = read_and_fit(&a, &progress)?;
     let plane = matches!(a.params, ParamsArg::Plane) && !a.periodic_u;
-    let trimmed = a.trim.apply(plane, &r.surface, pts, &r.uv, None)?;
+    let trim = TrimInput {
+        surface: &r.surface,
+        cloud: &mut cloud,
+        uv: &r.uv,
+        loops: Loops::BestFitPlane,
+    };
     let q = &mut r.assessment.quality;
-    crate::cad::measure_trimmed(q, trimmed.as_ref(), &cloud, &a.config().assess)?;
+    let trimmed = a
+        .trim
+        .apply(plane, trim, q, &a.config().assess, &progress)?;
+    let pts = cloud.points();
     a.out.guard(
         q,
         "raise the smoothing (--smooth; by default it is scaled to the data) or use fewer control points (--ctrl)",

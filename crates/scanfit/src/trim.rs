@@ -3,7 +3,9 @@
 //!
 //! The boundary loops come from the alpha shape of the points
 //! ([`crate::cloud::boundary_loops`], [PDE23] §4.1): an outer loop and one
-//! loop per hole, as point indices. Every pipeline that fits a surface has
+//! loop per hole, as point indices, taken in the plane the pipeline made
+//! the parameters in ([`crate::pipeline::trim`] says which for each
+//! pipeline). Every pipeline that fits a surface has
 //! already given each point its parameters `(u, v)`, so each loop maps into
 //! the surface's parameter space through the parameters of its points. There
 //! it is approximated by a closed (periodic) cubic B-spline curve, the

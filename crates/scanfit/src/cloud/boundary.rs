@@ -146,11 +146,41 @@ impl Boundary {
     }
 }
 
+/// Where the 2D coordinates of the points come from.
+#[derive(Debug, Clone, Copy)]
+enum Source<'a> {
+    /// 3D points projected on a plane.
+    Plane(&'a [Point3], BoundaryPlane),
+    /// Given coordinates, each multiplied by its axis's scale (a metric
+    /// plane: one unit of the scaled coordinates is one unit of length
+    /// along either axis).
+    Scaled(&'a [[f64; 2]], [f64; 2]),
+}
+
+impl Source<'_> {
+    fn len(&self) -> usize {
+        match self {
+            Source::Plane(p, _) => p.len(),
+            Source::Scaled(c, _) => c.len(),
+        }
+    }
+
+    /// The metric plane coordinates of point `i`.
+    #[inline]
+    fn at(&self, i: usize) -> [f64; 2] {
+        match self {
+            Source::Plane(p, plane) => plane.project(&p[i]),
+            Source::Scaled(c, s) => [c[i][0] * s[0], c[i][1] * s[1]],
+        }
+    }
+}
+
 /// The projection of the points in units of their extent (spade rejects
 /// coordinates below ~1e-42 in magnitude; negligible values are set to
 /// zero), and what the passes over all points gather.
 #[derive(Debug, Clone, Copy)]
-struct Frame {
+struct Frame<'a> {
+    source: Source<'a>,
     plane: BoundaryPlane,
     /// Largest absolute plane coordinate.
     extent: f64,
@@ -162,41 +192,56 @@ struct Frame {
     centre: [f64; 2],
 }
 
-impl Frame {
-    fn new(points: &[Point3], plane: BoundaryPlane) -> Result<Self> {
-        let extent = points
-            .iter()
-            .flat_map(|p| plane.project(p).map(f64::abs))
+impl<'a> Frame<'a> {
+    fn new(source: Source<'a>, plane: BoundaryPlane) -> Result<Self> {
+        let n = source.len();
+        let extent = (0..n)
+            .flat_map(|i| source.at(i).map(f64::abs))
             .fold(0.0f64, f64::max);
         if extent == 0.0 {
             return Err(Error::InvalidInput(
                 "all points coincide in the plane: no boundary".into(),
             ));
         }
-        let mut f = Self {
+        if !extent.is_finite() {
+            return Err(Error::InvalidInput(
+                "a point's plane coordinate is not finite: no boundary".into(),
+            ));
+        }
+        let f = Self {
+            source,
             plane,
             extent,
             lo: [f64::INFINITY; 2],
             hi: [f64::NEG_INFINITY; 2],
             centre: [0.0; 2],
         };
-        let mut sum = [0.0; 2];
-        for p in points {
-            let q = f.unit(p);
+        let (mut sum, mut lo, mut hi) = ([0.0; 2], f.lo, f.hi);
+        for q in f.units() {
             for k in 0..2 {
                 sum[k] += q[k];
-                f.lo[k] = f.lo[k].min(q[k]);
-                f.hi[k] = f.hi[k].max(q[k]);
+                lo[k] = lo[k].min(q[k]);
+                hi[k] = hi[k].max(q[k]);
             }
         }
-        let inv = 1.0 / points.len() as f64;
-        f.centre = [sum[0] * inv, sum[1] * inv];
-        Ok(f)
+        let inv = 1.0 / n as f64;
+        Ok(Self {
+            lo,
+            hi,
+            centre: [sum[0] * inv, sum[1] * inv],
+            ..f
+        })
     }
 
-    /// Plane coordinates of `p` in units of the extent.
-    fn unit(&self, p: &Point3) -> [f64; 2] {
-        self.plane.project(p).map(|c| {
+    /// Number of points.
+    fn len(&self) -> usize {
+        self.source.len()
+    }
+
+    /// Plane coordinates of point `i` in units of the extent.
+    #[inline]
+    fn unit(&self, i: usize) -> [f64; 2] {
+        self.source.at(i).map(|c| {
             let v = c / self.extent;
             if v.abs() < 1e-30 {
                 0.0
@@ -204,6 +249,11 @@ impl Frame {
                 v
             }
         })
+    }
+
+    /// [`Frame::unit`] of every point, in input order.
+    fn units(&self) -> impl Iterator<Item = [f64; 2]> + '_ {
+        (0..self.len()).map(|i| self.unit(i))
     }
 }
 
@@ -255,9 +305,82 @@ impl HasPosition for Vertex {
 /// assert!((b.spacing - 1.0).abs() < 1e-12 && (b.alpha - 2.5).abs() < 1e-12);
 /// ```
 pub fn boundary_loops(points: &[Point3], config: &BoundaryConfig) -> Result<Boundary> {
-    if points.len() < 3 {
+    check_config(points.len(), config)?;
+    let pf = plane_frame(points)?;
+    let plane = BoundaryPlane {
+        origin: pf.origin,
+        e1: pf.e1,
+        e2: pf.e2,
+        normal: pf.normal,
+    };
+    loops_in(Frame::new(Source::Plane(points, plane), plane)?, config)
+}
+
+/// The boundary loops of points given by 2D coordinates in a plane: the
+/// alpha shape of the points `(coords[i][0] * scale[0], coords[i][1] *
+/// scale[1])` ([PDE23] §4.1, as [`boundary_loops`] after its projection).
+///
+/// For a pipeline that has already mapped its points into a plane by an
+/// affine map, such as the parameters of a height field scaled to the unit
+/// square (`scale` = the extents of the two axes, so that the scaled
+/// coordinates measure lengths alike in both directions: an alpha disc is
+/// a disc in the data, not an ellipse stretched by the aspect ratio). The
+/// loops are then those of the points as the surface sees them, with no
+/// best-fit plane between (a tilted plane under a bumpy height field folds
+/// the projection and opens spurious holes). `alpha`, `spacing` and the
+/// areas are in the units of the scaled coordinates; the returned
+/// [`Boundary::plane`] is the scaled coordinates' own (origin 0, `e1` = x,
+/// `e2` = y, normal z). No copy of the coordinates is made.
+///
+/// Errors: as [`boundary_loops`], and a `scale` or a coordinate that is not
+/// finite (`scale` must be > 0).
+///
+/// ```
+/// use scanfit::cloud::boundary::{boundary_loops_2d, BoundaryConfig};
+/// // a 20 x 10 grid stored in unit coordinates, 19 x 9 long
+/// let uv: Vec<[f64; 2]> = (0..200)
+///     .map(|k| [(k % 20) as f64 / 19.0, (k / 20) as f64 / 9.0])
+///     .collect();
+/// let b = boundary_loops_2d(&uv, [19.0, 9.0], &BoundaryConfig::default()).unwrap();
+/// assert_eq!(b.loops.len(), 1);
+/// assert_eq!(b.outer_loop().len(), 56);
+/// assert!((b.spacing - 1.0).abs() < 1e-12 && (b.areas[0] - 171.0).abs() < 1e-9);
+/// ```
+pub fn boundary_loops_2d(
+    coords: &[[f64; 2]],
+    scale: [f64; 2],
+    config: &BoundaryConfig,
+) -> Result<Boundary> {
+    check_config(coords.len(), config)?;
+    if !scale.iter().all(|s| s.is_finite() && *s > 0.0) {
+        return Err(Error::InvalidInput(format!(
+            "boundary scale [{}, {}] must be finite and > 0 (the lengths of the two coordinate axes)",
+            scale[0], scale[1]
+        )));
+    }
+    if let Some(i) = coords
+        .iter()
+        .position(|c| !(c[0].is_finite() && c[1].is_finite()))
+    {
+        return Err(Error::InvalidInput(format!(
+            "point {i} has a coordinate that is not finite ({}, {}): no boundary",
+            coords[i][0], coords[i][1]
+        )));
+    }
+    let plane = BoundaryPlane {
+        origin: Point3::origin(),
+        e1: Vector3::x(),
+        e2: Vector3::y(),
+        normal: Vector3::z(),
+    };
+    loops_in(Frame::new(Source::Scaled(coords, scale), plane)?, config)
+}
+
+/// The checks of the point count and the settings common to both entries.
+fn check_config(n: usize, config: &BoundaryConfig) -> Result<()> {
+    if n < 3 {
         return Err(Error::TooFewPoints {
-            got: points.len(),
+            got: n,
             needed: 3,
             what: "a boundary loop".into(),
         });
@@ -275,36 +398,35 @@ pub fn boundary_loops(points: &[Point3], config: &BoundaryConfig) -> Result<Boun
             )));
         }
     }
-    let pf = plane_frame(points)?;
-    let plane = BoundaryPlane {
-        origin: pf.origin,
-        e1: pf.e1,
-        e2: pf.e2,
-        normal: pf.normal,
-    };
-    let frame = Frame::new(points, plane)?;
-    let sampled = if points.len() > config.sample_above {
-        spacing::sampled_spacing(points, &frame)
+    Ok(())
+}
+
+/// The loops of the points of `frame`: from the band along the boundary
+/// above [`BoundaryConfig::sample_above`] points, else (or when the band's
+/// grid would be too large) from the triangulation of every point.
+fn loops_in(frame: Frame, config: &BoundaryConfig) -> Result<Boundary> {
+    let sampled = if frame.len() > config.sample_above {
+        spacing::sampled_spacing(&frame)
     } else {
         None
     };
     if let Some(spacing_unit) = sampled {
         let spacing = spacing_unit * frame.extent;
         let alpha = config.alpha.unwrap_or(config.alpha_factor * spacing);
-        if let Some(b) = band::band_loops(points, &frame, alpha, spacing)? {
+        if let Some(b) = band::band_loops(&frame, alpha, spacing)? {
             return Ok(b);
         }
     }
-    full_loops(points, &frame, config)
+    full_loops(&frame, config)
 }
 
 /// The loops from the triangulation of every point.
-fn full_loops(points: &[Point3], frame: &Frame, config: &BoundaryConfig) -> Result<Boundary> {
-    let sites = points
-        .iter()
+fn full_loops(frame: &Frame, config: &BoundaryConfig) -> Result<Boundary> {
+    let sites = frame
+        .units()
         .enumerate()
-        .map(|(index, p)| Site {
-            pos: frame.unit(p),
+        .map(|(index, pos)| Site {
+            pos,
             index,
             inner: true,
         })
@@ -737,8 +859,8 @@ mod tests {
             e2: pf.e2,
             normal: pf.normal,
         };
-        let frame = Frame::new(p, plane).unwrap();
-        band::band_loops(p, &frame, alpha, 1.0)
+        let frame = Frame::new(Source::Plane(p, plane), plane).unwrap();
+        band::band_loops(&frame, alpha, 1.0)
             .unwrap()
             .expect("the band's grid is built")
     }
@@ -852,6 +974,57 @@ mod tests {
         assert!((b.spacing - 1.0).abs() < 1e-9, "{}", b.spacing);
         assert_eq!(b.outer_loop().len(), 2 * (599 + 399));
         assert_eq!(b.triangles, 2 * 599 * 399);
+    }
+
+    #[test]
+    fn scaled_coordinates_give_the_loops_of_the_flat_points() {
+        // a flat 10 x 1 strip with holes, given as unit coordinates and the
+        // strip's extents: the same loops, areas and spacing as the points
+        // themselves (their best-fit plane is z = 0), through the full
+        // triangulation and through the band
+        let holes = [([2.0, 0.5], 0.2), ([7.0, 0.4], 0.15)];
+        for (n, seed) in [(20_000, 21), (260_000, 22)] {
+            let mut rng = Rng::new(seed);
+            let mut p = Vec::with_capacity(n);
+            while p.len() < n {
+                let (x, y) = (10.0 * rng.uniform(), rng.uniform());
+                if holes.iter().all(|(c, r)| (x - c[0]).hypot(y - c[1]) > *r) {
+                    p.push(Point3::new(x, y, 0.0));
+                }
+            }
+            let uv: Vec<[f64; 2]> = p.iter().map(|q| [q.x / 10.0, q.y]).collect();
+            let flat = boundary_loops(&p, &BoundaryConfig::default()).unwrap();
+            let b = boundary_loops_2d(&uv, [10.0, 1.0], &BoundaryConfig::default()).unwrap();
+            assert_eq!(b.loops.len(), 3, "n = {n}: {:?}", b.areas);
+            assert_eq!(b.loops, flat.loops, "n = {n}");
+            assert_eq!(b.outer, flat.outer);
+            assert_eq!(b.triangles, flat.triangles);
+            for (x, y) in b.areas.iter().zip(&flat.areas) {
+                assert!((x / y - 1.0).abs() < 1e-9, "{x} {y}");
+            }
+            // the same median edge, up to rounding; above sample_above
+            // the sample's cells are cut from unit coordinates of another
+            // origin and extent, so a point at a cell's edge may fall on
+            // the other side (the loops above are still the same)
+            let tol = if n > 200_000 { 0.01 } else { 1e-9 };
+            let rel = b.spacing / flat.spacing - 1.0;
+            assert!(rel.abs() < tol, "n = {n}: spacing {rel:e} off");
+            // the strip's area less the holes': the loops run inside the
+            // region, by less than a spacing along its 24.2 units of edges
+            let area: f64 = b.areas.iter().sum();
+            let pi = std::f64::consts::PI;
+            let exact = 10.0 - pi * (0.04 + 0.0225);
+            let edges = 22.0 + 2.0 * pi * 0.35;
+            let short = exact - area;
+            assert!(short > 0.0 && short < edges * b.spacing, "{area} {exact}");
+        }
+        // bad scales and coordinates are errors that say what is wrong
+        let uv = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+        let err = boundary_loops_2d(&uv, [0.0, 1.0], &BoundaryConfig::default()).unwrap_err();
+        assert!(format!("{err}").contains("scale"), "{err}");
+        let bad = [[0.0, 0.0], [1.0, f64::NAN], [0.0, 1.0]];
+        let err = boundary_loops_2d(&bad, [1.0, 1.0], &BoundaryConfig::default()).unwrap_err();
+        assert!(format!("{err}").contains("point 1"), "{err}");
     }
 
     #[test]

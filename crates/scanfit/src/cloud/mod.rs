@@ -141,6 +141,22 @@ impl PointCloud {
         self.tree.get().is_some()
     }
 
+    /// Frees the KD-tree of the neighbour queries (about 37 bytes per
+    /// point), which the next query builds again: for a caller about to
+    /// allocate much while the tree would sit idle.
+    ///
+    /// ```
+    /// use scanfit::{Point3, PointCloud};
+    /// let mut cloud = PointCloud::new(vec![Point3::origin(), Point3::new(1.0, 0.0, 0.0)])?;
+    /// cloud.tree()?;
+    /// cloud.release_tree();
+    /// assert!(!cloud.has_tree());
+    /// # Ok::<(), scanfit::Error>(())
+    /// ```
+    pub fn release_tree(&mut self) {
+        self.tree = OnceLock::new();
+    }
+
     /// Number of points.
     pub fn len(&self) -> usize {
         self.points.len()

@@ -48,6 +48,9 @@
 //! * [`surface_fit`]: least-squares surface through scattered points
 //!   (`scanfit fit`): parameters from the best-fit plane or given
 //!   attributes, optional Hoschek parameter correction.
+//! * [`trim`]: the trimmed face of a fitted surface: its boundary loops
+//!   (in the plane the parameters were made in), the fallback to the
+//!   rectangle, and the face measured again.
 //! * [`turntable`]: cylinder-like clouds by the virtual turntable.
 
 pub mod assess;
@@ -63,6 +66,7 @@ pub mod regularize;
 pub mod segment;
 pub mod stream;
 pub mod surface_fit;
+pub mod trim;
 pub mod turntable;
 
 pub use assess::{

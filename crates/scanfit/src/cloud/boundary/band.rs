@@ -45,7 +45,7 @@
 //! cloud is triangulated instead.
 
 use super::{Boundary, Frame, Site, SiteTriangulation};
-use crate::{Point3, Result};
+use crate::Result;
 
 /// Cells per alpha.
 const CELLS_PER_ALPHA: f64 = 6.0;
@@ -67,18 +67,14 @@ const BAND: u8 = 8;
 
 /// The loops of the alpha shape of radius `alpha` from the triangulation of
 /// the band; `None` when the grid would be too large.
-pub(super) fn band_loops(
-    points: &[Point3],
-    frame: &Frame,
-    alpha: f64,
-    spacing: f64,
-) -> Result<Option<Boundary>> {
+pub(super) fn band_loops(frame: &Frame, alpha: f64, spacing: f64) -> Result<Option<Boundary>> {
     let alpha_unit = alpha / frame.extent;
-    let Some(mut grid) = Grid::new(frame, alpha_unit / CELLS_PER_ALPHA, points.len()) else {
+    let n = frame.len();
+    let Some(mut grid) = Grid::new(frame, alpha_unit / CELLS_PER_ALPHA, n) else {
         return Ok(None);
     };
-    for p in points {
-        let c = grid.cell(frame.unit(p));
+    for q in frame.units() {
+        let c = grid.cell(q);
         grid.flags[c] |= OCC;
     }
     grid.dilate(|f| f & OCC != 0, HALF_BLOCK, NEAR_OCC);
@@ -86,8 +82,7 @@ pub(super) fn band_loops(
     grid.dilate(|f| f & CANDIDATE == CANDIDATE, REACH, BAND);
     let mut sites = Vec::new();
     let mut candidates = 0usize;
-    for (index, p) in points.iter().enumerate() {
-        let pos = frame.unit(p);
+    for (index, pos) in frame.units().enumerate() {
         let f = grid.flags[grid.cell(pos)];
         let inner = f & CANDIDATE == CANDIDATE;
         candidates += usize::from(inner);
@@ -114,7 +109,7 @@ pub(super) fn band_loops(
     let inner_candidates = (0..tri.sites.len())
         .filter(|&v| tri.sites[v].inner && a.on_kept[v] && !on_loop[v])
         .count();
-    let inner = (points.len() - candidates - tri.outer_repeats + inner_candidates) as i64;
+    let inner = (n - candidates - tri.outer_repeats + inner_candidates) as i64;
     let b = a.to_boundary(&tri, frame, alpha, spacing, 0)?;
     let chi: i64 = b.areas.iter().map(|&x| if x > 0.0 { 1 } else { -1 }).sum();
     let triangles = (2 * inner + loop_edges - 2 * chi).max(0) as usize;

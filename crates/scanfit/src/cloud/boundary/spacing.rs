@@ -28,7 +28,6 @@ use spade::{DelaunayTriangulation, Point2, Triangulation};
 
 use super::{median_edge, Frame, Vertex};
 use crate::sampling::{sample_indices, DEFAULT_SEED};
-use crate::Point3;
 
 /// Points per sampling cell on average over the occupied cells.
 const CELL_POINTS: f64 = 1024.0;
@@ -37,8 +36,8 @@ const SAMPLE_POINTS: f64 = 32_768.0;
 
 /// The sampled median Delaunay edge in unit coordinates; `None` when the
 /// projection spans no area or the sample has no edge.
-pub(super) fn sampled_spacing(points: &[Point3], frame: &Frame) -> Option<f64> {
-    let n = points.len();
+pub(super) fn sampled_spacing(frame: &Frame) -> Option<f64> {
+    let n = frame.len();
     let span = [frame.hi[0] - frame.lo[0], frame.hi[1] - frame.lo[1]];
     if !(span[0] > 0.0 && span[1] > 0.0) {
         return None;
@@ -51,8 +50,8 @@ pub(super) fn sampled_spacing(points: &[Point3], frame: &Frame) -> Option<f64> {
     loop {
         grid = Cells::new(frame, side.max(smallest));
         counts = vec![0u32; grid.dims[0] * grid.dims[1]];
-        for p in points {
-            let c = grid.cell(frame.unit(p));
+        for q in frame.units() {
+            let c = grid.cell(q);
             counts[c] = counts[c].saturating_add(1);
         }
         let occupied = counts.iter().filter(|&&c| c > 0).count().max(1);
@@ -80,9 +79,8 @@ pub(super) fn sampled_spacing(points: &[Point3], frame: &Frame) -> Option<f64> {
         span(j, fy, grid.dims[1])
             .any(|jj| span(i, fx, grid.dims[0]).any(|ii| taken[jj * grid.dims[0] + ii]))
     };
-    let verts: Vec<Vertex> = points
-        .iter()
-        .map(|p| frame.unit(p))
+    let verts: Vec<Vertex> = frame
+        .units()
         .filter(|&q| near_taken(q))
         .map(|q| Vertex {
             pos: Point2::new(q[0], q[1]),
