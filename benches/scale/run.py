@@ -7,7 +7,7 @@ make_franke.py.
     python3 benches/scale/make_franke.py 1000000 /tmp/franke_1000000.ply
     python3 benches/scale/make_franke.py 1000000 /tmp/franke_uv_1000000.ply --uv
     python3 benches/scale/make_franke.py 10000000 /tmp/franke_10000000.las
-    python3 benches/scale/run.py target/release/scanfit 1000000 [--repeat 3] [--only fit|mba|mba_las|mba_las_streamed] [--out-dir /tmp] [-- EXTRA...]
+    python3 benches/scale/run.py target/release/scanfit 1000000 [--repeat 3] [--only fit|fit_streamed|fit_plane|fit_plane_streamed|mba|mba_las|mba_las_streamed] [--out-dir /tmp] [-- EXTRA...]
 
 Each command runs `--repeat` times (default 3) under `/usr/bin/time -v`
 with SCANFIT_TIMINGS=1 (the CLI then prints each stage's wall time); the
@@ -16,7 +16,11 @@ split of the median run, the largest peak RSS and the bytes per point, and the l
 average before and after (the machine is shared). Arguments after `--` are
 added to every command (e.g. `--measure full`). When /tmp/franke_N.las
 exists, `mba` also runs on it in memory (`mba_las`) and streamed in chunks
-of 10^6 points (`mba_las_streamed`, `--chunk-points 1000000`).
+of 10^6 points (`mba_las_streamed`, `--chunk-points 1000000`). `fit_streamed`
+is `fit` read in chunks of 10^6 points; `fit_plane` is `fit` with its
+defaults (best-fit plane, distribution knots; untrimmed) on /tmp/franke_N.ply,
+`fit_plane_streamed` the same in chunks of 10^6 points (plane and knots as
+passes of sums).
 """
 import os
 import re
@@ -61,6 +65,10 @@ def main():
         "mba": [binary, "mba", f"/tmp/franke_{n}.ply", "--levels", "8", "--base", "1x1",
                 "-o", f"{out}/scale_mba.json", "--json", "-q"],
     }
+    commands["fit_streamed"] = commands["fit"] + ["--chunk-points", "1000000"]
+    commands["fit_plane"] = [binary, "fit", f"/tmp/franke_{n}.ply", "--ctrl", "64x64",
+                             "--no-trim", "-o", f"{out}/scale_fit_plane.json", "--json", "-q"]
+    commands["fit_plane_streamed"] = commands["fit_plane"] + ["--chunk-points", "1000000"]
     las = f"/tmp/franke_{n}.las"
     if os.path.exists(las):
         mba_las = [binary, "mba", las, "--levels", "8", "--base", "1x1",
