@@ -225,7 +225,7 @@ def test_tiles_are_read_by_the_workers_and_a_bad_tile_is_named(client, tmp_path)
     bad.write_bytes(b"ply\nformat binary_little_endian 1.0\nelement vertex 10\n")
     with pytest.raises(scanfit.ScanfitError, match="broken.ply"):
         sd.mba([*paths, bad], levels=3)
-    with pytest.raises(scanfit.ScanfitError, match="tile0.ply.*no columns named u and v"):
+    with pytest.raises(scanfit.ScanfitError, match=r"tile\d.ply.*no columns named u and v"):
         sd.fit_surface(paths, params="uv", knots="uniform")
 
 
