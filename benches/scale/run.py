@@ -20,7 +20,8 @@ of 10^6 points (`mba_las_streamed`, `--chunk-points 1000000`). `fit_streamed`
 is `fit` read in chunks of 10^6 points; `fit_plane` is `fit` with its
 defaults (best-fit plane, distribution knots; untrimmed) on /tmp/franke_N.ply,
 `fit_plane_streamed` the same in chunks of 10^6 points (plane and knots as
-passes of sums).
+passes of sums); their input is `make_franke.py N /tmp/franke_xy10_N.ply
+--xy-scale 10` (on the unit square the plane is not a height field's).
 """
 import os
 import re
@@ -66,7 +67,7 @@ def main():
                 "-o", f"{out}/scale_mba.json", "--json", "-q"],
     }
     commands["fit_streamed"] = commands["fit"] + ["--chunk-points", "1000000"]
-    commands["fit_plane"] = [binary, "fit", f"/tmp/franke_{n}.ply", "--ctrl", "64x64",
+    commands["fit_plane"] = [binary, "fit", f"/tmp/franke_xy10_{n}.ply", "--ctrl", "64x64",
                              "--no-trim", "-o", f"{out}/scale_fit_plane.json", "--json", "-q"]
     commands["fit_plane_streamed"] = commands["fit_plane"] + ["--chunk-points", "1000000"]
     las = f"/tmp/franke_{n}.las"
