@@ -6,7 +6,8 @@
 //! chunks, always in the same order. The fits go through the same
 //! accumulators as the in-memory pipelines ([`crate::mba::BaAccumulator`],
 //! [`crate::fit::surface::NormalEquations`]), fed chunk after chunk in file order, so the surface
-//! is the in-memory one: `fit`'s **bit for bit**, `mba`'s to 1e-12 of the largest control value
+//! is the in-memory one: `fit`'s **bit for bit** with given parameters and uniform knots (to 1e-12
+//! with the plane, distribution knots or correction), `mba`'s to 1e-12 of the largest control value
 //! (the in-memory MBA sums the points in lattice-cell order, [`crate::mba::mba`]):
 //!
 //! * [`mba`]: one pass for the frame ([`FrameSums`]), one per level
