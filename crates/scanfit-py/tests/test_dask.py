@@ -218,15 +218,105 @@ def test_tiles_are_read_by_the_workers_and_a_bad_tile_is_named(client, tmp_path)
     close(r["surface"].control_points, scanfit.mba(p, levels=5)["surface"].control_points, "tiles")
     # a given domain replaces the bounding-box pass
     lo, hi = p.min(axis=0), p.max(axis=0)
-    d = sd.mba(paths, levels=5, domain=(lo[0], lo[1], hi[0], hi[1]))
+    d = sd.mba(paths, levels=5, domain=(lo[0], lo[1], hi[0], hi[1]), up="z")
     assert d["passes"] == r["passes"] - 1
     close(d["surface"].control_points, r["surface"].control_points, "domain")
     bad = tmp_path / "broken.ply"
     bad.write_bytes(b"ply\nformat binary_little_endian 1.0\nelement vertex 10\n")
     with pytest.raises(scanfit.ScanfitError, match="broken.ply"):
         sd.mba([*paths, bad], levels=3)
-    with pytest.raises(scanfit.ScanfitError, match="no attributes u and v"):
+    with pytest.raises(scanfit.ScanfitError, match=r"tile\d.ply.*no columns named u and v"):
         sd.fit_surface(paths, params="uv", knots="uniform")
+
+
+def test_point_chunks_serve_the_rows_of_read_cloud_a_bounded_chunk_at_a_time(tmp_path):
+    p = terrain(25_000, seed=9)
+    uv = np.random.default_rng(1).random((len(p), 2))
+    path = tmp_path / "rows.ply"
+    scanfit.write_cloud(str(path), p, attributes={"u": uv[:, 0], "v": uv[:, 1]})
+    whole = scanfit.read_cloud(str(path)).positions
+    rows = scanfit.PointChunks(str(path), 4_000, uv=True, start=6_500, stop=19_000)
+    assert rows.bounded  # binary PLY: read a chunk of records at a time
+    got = list(rows)
+    # the chunks of the reader, cut to [start, stop): never more than chunk_points rows
+    assert [len(x) for x, _ in got] == [1_500, 4_000, 4_000, 3_000]
+    assert np.array_equal(np.concatenate([x for x, _ in got]), whole[6_500:19_000])
+    assert np.array_equal(np.concatenate([u for _, u in got]), uv[6_500:19_000])
+    assert rows.rows_read == 20_000  # reading stops at the chunk holding `stop`
+    assert [len(x) for x, u in scanfit.PointChunks(str(path), 10_000, start=24_000)] == [1_000]
+    with pytest.raises(scanfit.ScanfitError, match="chunk_points must be at least 1"):
+        scanfit.PointChunks(str(path), 0)
+    with pytest.raises(scanfit.ScanfitError, match="before start"):
+        scanfit.PointChunks(str(path), 10, start=5, stop=4)
+    with pytest.raises(scanfit.ScanfitError, match="none.ply"):
+        scanfit.PointChunks(str(tmp_path / "none.ply"), 100)
+
+
+def test_a_big_tile_is_split_into_tasks_that_read_it_a_chunk_at_a_time(client, tmp_path):
+    p = terrain(200_000, seed=11)
+    sizes = [30_000, 150_000, 20_000]  # one big tile between two small ones
+    paths = []
+    for k, part in enumerate(np.split(p, np.cumsum(sizes)[:-1])):
+        paths.append(tmp_path / f"t{k}.ply")
+        scanfit.write_cloud(str(paths[-1]), part)
+    once = scanfit.mba(p, levels=6)
+    r = sd.mba(paths, levels=6, chunk_points=12_000, task_points=40_000)
+    # the big tile in 4 tasks of at most 40 000 rows, the small ones whole
+    assert r["tasks"] == 1 + 4 + 1
+    close(r["surface"].control_points, once["surface"].control_points, "split tiles, mba")
+    assert r["points"] == len(p) and r["up"] == once["up"] == "z"
+    whole = sd.mba(paths, levels=6, chunk_points=12_000)
+    assert whole["tasks"] == 3
+    close(whole["surface"].control_points, once["surface"].control_points, "tiles, mba")
+    # the default fit (plane, distribution knots) over the split tiles
+    fit = scanfit.fit_surface(p, ctrl=(12, 10))
+    f = sd.fit_surface(paths, ctrl=(12, 10), chunk_points=12_000, task_points=40_000)
+    assert f["tasks"] == 6 and f["points"] == len(p)
+    close(f["surface"].control_points, fit["surface"].control_points, "split tiles, fit")
+    knots_close(f, fit, "split tiles, fit")
+    # a tile cut short is named, whichever of its tasks meets the cut
+    cut = tmp_path / "cut.ply"
+    cut.write_bytes(paths[1].read_bytes()[:-100_000])
+    with pytest.raises(scanfit.ScanfitError, match="tile .*cut.ply could not be read"):
+        sd.mba([paths[0], cut], levels=3, chunk_points=12_000, task_points=40_000)
+    with pytest.raises(scanfit.ScanfitError, match="task_points must be a positive"):
+        sd.mba(paths, task_points=0)
+    with pytest.raises(scanfit.ScanfitError, match="chunk_points must be a positive"):
+        sd.fit_surface(paths, chunk_points=2.5)
+
+
+def test_up_on_the_workers_is_the_single_process_up(client, tmp_path):
+    zup = terrain(120_000, seed=12)
+    # the same terrain stored y-up: world (x, z, -y) is the frame (x, -z, y) turned back
+    yup = np.column_stack([zup[:, 0], zup[:, 2], -zup[:, 1]])
+    arr = client.persist(da.from_array(yup, chunks=(40_000, 3)))
+    once = scanfit.mba(yup, levels=6, up="y")
+    r = sd.mba(arr, levels=6, up="y")
+    assert r["up"] == "y" and r["passes"] == 2 + 6 + 1
+    close(r["surface"].control_points, once["surface"].control_points, "up='y'")
+    for a, b in zip(r["levels"], once["levels"]):
+        assert a["vertical"]["rmse"] == pytest.approx(b["vertical"]["rmse"], rel=1e-12)
+    # auto finds y from the bounding-box pass's sample, as the single-process call does
+    auto = sd.mba(arr, levels=6)
+    assert auto["up"] == scanfit.mba(yup, levels=6)["up"] == "y"
+    assert np.array_equal(auto["surface"].control_points, r["surface"].control_points)
+    # z as height is the other surface (a wall of spikes), also as the single-process one
+    z = sd.mba(arr, levels=4, up="z")
+    close(z["surface"].control_points, scanfit.mba(yup, levels=4, up="z")["surface"].control_points, "z")
+    # tiles, x up, with the domain in the x-up frame's (y, z)
+    xup = np.column_stack([zup[:, 2], zup[:, 0], zup[:, 1]])
+    paths = []
+    for k, part in enumerate(np.array_split(xup, 2)):
+        paths.append(tmp_path / f"x{k}.ply")
+        scanfit.write_cloud(str(paths[-1]), part)
+    x = sd.mba(paths, levels=5, up="x", chunk_points=25_000)
+    close(x["surface"].control_points, scanfit.mba(xup, levels=5, up="x")["surface"].control_points, "x")
+    lo, hi = xup.min(axis=0), xup.max(axis=0)
+    d = sd.mba(paths, levels=5, up="x", domain=(lo[1], lo[2], hi[1], hi[2]))
+    assert d["passes"] == x["passes"] - 1
+    close(d["surface"].control_points, x["surface"].control_points, "x, domain")
+    with pytest.raises(scanfit.ScanfitError, match="up = 'w' is not one of"):
+        sd.mba(arr, up="w")
 
 
 def test_bad_points_are_refused_with_the_reason(client):

@@ -6,18 +6,18 @@
 //! chunks, always in the same order. The fits go through the same
 //! accumulators as the in-memory pipelines ([`crate::mba::BaAccumulator`],
 //! [`crate::fit::surface::NormalEquations`]), fed chunk after chunk in file order, so the surface
-//! is the in-memory one: `fit`'s **bit for bit**, `mba`'s to 1e-12 of the largest control value
+//! is the in-memory one: `fit`'s **bit for bit** with given parameters and uniform knots (to 1e-12
+//! with the plane, distribution knots or correction), `mba`'s to 1e-12 of the largest control value
 //! (the in-memory MBA sums the points in lattice-cell order, [`crate::mba::mba`]):
 //!
 //! * [`mba`]: one pass for the frame ([`FrameSums`]), one per level
 //!   (residuals after the levels so far, [LWS97] eqs. 3-4), one to measure.
-//! * [`fit`]: parameters per point from two attributes (`u`, `v`); one pass
-//!   for the normal equations ([NURBS97] eq. 9.63 with uniform knots), one to
-//!   measure. Settings that need all points at once are refused with the
-//!   reason: knots from the parameter distribution (eq. 9.69 sorts all
-//!   parameters), parameters from the best-fit plane (the plane's minimum-area
-//!   rectangle is not implemented as a streamed pass yet), parameter correction
-//!   (re-projects every point per round).
+//! * [`fit`] (in `stream/fit.rs`): every setting of the in-memory fit as
+//!   passes of mergeable sums: the best-fit plane (covariance, convex hull,
+//!   extents), the distribution knots (eq. 9.69, rounds of histograms), the
+//!   normal equations ([NURBS97] eq. 9.63), the parameter correction (each
+//!   round re-projects the points onto the accepted surfaces in turn), one
+//!   pass to measure; the surface equals the in-memory one to 1e-12.
 //!
 //! The report is measured by streaming too ([`StreamAssessor`]): errors at
 //! the parameters and orthogonal distances over every point; [MBA18] eq. 17
@@ -41,13 +41,15 @@ use crate::pipeline::assess::{
     per_point_sums, AssessConfig, Extent, Measure, SampleDistances, SurfaceQuality,
 };
 use crate::pipeline::mba::LevelRow;
-use crate::pipeline::surface_fit::{FitConfig, ParameterSource};
 use crate::progress::Progress;
 use crate::project::power_form::PowerForm;
 use crate::project::{InversionWorkspace, SurfaceInverter};
 use crate::spatial::KdTree;
 use crate::up_axis::UpAxis;
 use crate::{Error, Point3, PointCloud, Result};
+
+mod fit;
+pub use fit::{fit, StreamedFit};
 
 /// A chunk of points: positions and, when the source was asked for them,
 /// parameters.
@@ -354,119 +356,6 @@ fn level_grid(run: &MbaLevels) -> Vec<Point3> {
     total.map_or_else(Vec::new, |t| {
         crate::mba::adjust::knot_grid(&run.frame(), &t)
     })
-}
-
-/// What [`fit`] returns.
-#[derive(Debug, Clone, PartialEq)]
-#[non_exhaustive]
-pub struct StreamedFit {
-    /// The fitted surface (as the in-memory pipeline's).
-    pub surface: Surface,
-    /// Passes made over the points.
-    pub passes: usize,
-    /// The thin-plate weight used (after the pipeline's scaling rule).
-    pub smoothing: f64,
-    /// The streamed measures (see the module documentation).
-    pub quality: SurfaceQuality,
-}
-
-/// The least-squares surface of the points of `source` (parameters from
-/// attributes, uniform knots; see the module documentation for what is
-/// refused); the surface equals [`crate::pipeline::surface_fit::run`]'s.
-///
-/// ```
-/// use scanfit::fit::surface::KnotPlacement;
-/// use scanfit::pipeline::stream::{fit, SliceSource};
-/// use scanfit::pipeline::surface_fit::{FitConfig, ParameterSource};
-/// use scanfit::progress::NoProgress;
-/// use scanfit::Point3;
-///
-/// let (mut p, mut uv) = (Vec::new(), Vec::new());
-/// for k in 0..3000 {
-///     let (u, v) = ((k % 60) as f64 / 59.0, (k / 60) as f64 / 49.0);
-///     p.push(Point3::new(u, v, (2.0 * u).sin() * v));
-///     uv.push([u, v]);
-/// }
-/// let mut cfg = FitConfig::bare((8, 8));
-/// cfg.params = ParameterSource::uv_attributes();
-/// cfg.fit.knots = KnotPlacement::Uniform;
-/// let mut source = SliceSource { points: &p, uv: Some(&uv), chunk: 1000 };
-/// let r = fit(&mut source, &cfg, &NoProgress)?;
-/// let once = scanfit::fit::surface::fit_surface(&p, &uv, &cfg.fit)?;
-/// assert_eq!(r.surface, once);
-/// assert!(r.quality.at_parameters.max < 1e-3);
-/// # Ok::<(), scanfit::Error>(())
-/// ```
-pub fn fit(
-    source: &mut dyn PointSource,
-    config: &FitConfig,
-    progress: &dyn Progress,
-) -> Result<StreamedFit> {
-    check_fit(config)?;
-    let (centring, count) = centring_pass(source, None)?;
-    let source = &mut Centred {
-        source,
-        centring,
-        up: UpAxis::Z,
-    };
-    let fit_config = config.resolved_fit(count);
-    let mut eq = fit_config.uniform_equations()?;
-    let (cu, cv) = fit_config.ctrl;
-    progress.stage(
-        &format!("pass 1: normal equations of {cu} x {cv} control points"),
-        None,
-    );
-    source.pass(&mut |c| {
-        let uv = chunk_uv(&c)?;
-        eq.add(c.points, uv, None)
-    })?;
-    let surface = eq.finish(fit_config.smoothing)?;
-    progress.stage("pass 2: measuring", None);
-    let mut assessor = StreamAssessor::new(&surface, &config.assess)?;
-    source.pass(&mut |c| assessor.add(c.points, chunk_uv(&c)?))?;
-    Ok(StreamedFit {
-        quality: assessor.finish(),
-        surface: centring.restore(surface),
-        passes: 3,
-        smoothing: fit_config.smoothing,
-    })
-}
-
-/// Refuses the settings of `config` that need all points at once (with the
-/// reason): parameters from the best-fit plane and parameter correction.
-/// Knots from the parameter distribution are refused when the equations
-/// are made ([`crate::fit::surface::SurfaceFitConfig::uniform_equations`]).
-/// Drivers of their own (a cluster) call it before the first pass.
-///
-/// ```
-/// use scanfit::pipeline::stream::check_fit;
-/// use scanfit::pipeline::surface_fit::{FitConfig, ParameterSource};
-/// let mut cfg = FitConfig::default();
-/// assert!(check_fit(&cfg).is_err()); // the plane needs the whole cloud
-/// cfg.params = ParameterSource::uv_attributes();
-/// assert!(check_fit(&cfg).is_ok());
-/// ```
-pub fn check_fit(config: &FitConfig) -> Result<()> {
-    let refuse = |setting: &'static str, value: String, why: &str| Error::InvalidSetting {
-        setting,
-        value,
-        hint: format!("{why}; points read in chunks need settings computable per point"),
-    };
-    if config.params == ParameterSource::Plane {
-        return Err(refuse(
-            "params",
-            "plane".into(),
-            "parameters from the best-fit plane need the whole cloud (its minimum-area rectangle); give the parameters as u and v columns",
-        ));
-    }
-    if config.correction_rounds > 0 {
-        return Err(refuse(
-            "correction_rounds",
-            config.correction_rounds.to_string(),
-            "parameter correction re-projects every point in each round and keeps their parameters; leave it out",
-        ));
-    }
-    Ok(())
 }
 
 /// The parameters of a chunk, an error when the source gave none.
@@ -859,7 +748,8 @@ mod tests {
     }
 
     #[test]
-    fn streamed_fit_equals_the_in_memory_pipeline_and_refuses_what_needs_all_points() {
+    fn streamed_fit_equals_the_in_memory_pipeline_with_every_setting() {
+        use crate::pipeline::surface_fit::{FitConfig, ParameterSource};
         let p = terrain(12_000);
         let uv: Vec<[f64; 2]> = p
             .iter()
@@ -886,32 +776,74 @@ mod tests {
             chunk: 5000,
         };
         let r = fit(&mut s, &cfg, &NoProgress).unwrap();
+        // given parameters and uniform knots: the same sums in the same order
         assert_eq!(r.surface, once.surface);
+        assert_eq!(r.passes, 3);
         let (a, b) = (r.quality, once.assessment.quality);
         assert!(
             (a.at_parameters.rmse - b.at_parameters.rmse).abs() <= 1e-12 * b.at_parameters.rmse
         );
         assert_eq!(a.at_parameters.max, b.at_parameters.max);
         assert_eq!(a.grid_rmse, b.grid_rmse);
-        // refused, with the setting named
-        for bad in [
-            FitConfig {
-                params: ParameterSource::Plane,
-                ..cfg.clone()
-            },
-            FitConfig {
-                correction_rounds: 2,
-                ..cfg.clone()
-            },
+        // the plane, the distribution knots and the correction: more passes,
+        // the in-memory surface to the rounding of the sums
+        let close = |a: &Surface, b: &Surface| {
+            assert_eq!(a.knots_u().as_slice().len(), b.knots_u().as_slice().len());
+            for (x, y) in [(a.knots_u(), b.knots_u()), (a.knots_v(), b.knots_v())] {
+                for (s, t) in x.as_slice().iter().zip(y.as_slice()) {
+                    assert!((s - t).abs() <= 1e-12, "knots {s} {t}");
+                }
+            }
+            let scale = b
+                .control_points()
+                .iter()
+                .fold(0.0f64, |m, q| m.max(q.coords.abs().max()));
+            for (x, y) in a.control_points().iter().zip(b.control_points()) {
+                assert!((x - y).norm() <= 1e-12 * scale, "{x} {y}");
+            }
+        };
+        for (params, knots, rounds, passes) in [
+            // bounding box, plane x3, knots x2, equations, measure
+            (ParameterSource::Plane, KnotPlacement::Distribution, 0, 8),
+            (
+                ParameterSource::uv_attributes(),
+                KnotPlacement::Distribution,
+                0,
+                5,
+            ),
+            // plus the errors pass per fit, and a fit per round
+            (
+                ParameterSource::uv_attributes(),
+                KnotPlacement::Uniform,
+                2,
+                0,
+            ),
+            (ParameterSource::Plane, KnotPlacement::Distribution, 2, 0),
         ] {
-            assert!(matches!(
-                fit(&mut s, &bad, &NoProgress).unwrap_err(),
-                Error::InvalidSetting { .. }
-            ));
+            let mut c = cfg.clone();
+            c.params = params;
+            c.fit.knots = knots;
+            c.correction_rounds = rounds;
+            let once = surface_fit::run(&cloud, &c, &NoProgress).unwrap();
+            let r = fit(&mut s, &c, &NoProgress).unwrap();
+            close(&r.surface, &once.surface);
+            assert_eq!(r.rounds.len(), once.rounds.len());
+            for (x, y) in r.rounds.iter().zip(&once.rounds) {
+                assert!((x.errors.rmse - y.errors.rmse).abs() <= 1e-12 * y.errors.rmse);
+            }
+            if passes > 0 {
+                assert_eq!(r.passes, passes);
+            } else {
+                assert!(r.rounds.len() >= 2, "{:?}", r.rounds);
+            }
         }
+        // a plane cannot close around u
         let mut bad = cfg.clone();
-        bad.fit.knots = KnotPlacement::Distribution;
-        let e = fit(&mut s, &bad, &NoProgress).unwrap_err().to_string();
-        assert!(e.contains("9.69"), "{e}");
+        bad.params = ParameterSource::Plane;
+        bad.fit.periodic_u = true;
+        assert!(matches!(
+            fit(&mut s, &bad, &NoProgress).unwrap_err(),
+            Error::InvalidSetting { .. }
+        ));
     }
 }
