@@ -241,7 +241,7 @@ pub fn mba(a: &MbaArgs, chunk: usize) -> Result<()> {
     };
     let levels = format!(
         "{}(errors in data units)\n\n",
-        crate::mba::levels_table(&r.levels, false)
+        crate::mba::levels_table(&r.levels, false, true)
     );
     report.print(
         q,

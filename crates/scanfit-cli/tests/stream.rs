@@ -86,9 +86,39 @@ fn streamed_mba_writes_the_in_memory_surface() {
         let worst = relative(&sa[0], &sb[0]);
         assert!(worst <= 1e-12, "chunk {chunk}: {worst:e}");
         let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-        assert_eq!(report["streamed"]["passes"], 8);
+        // bounding box, frame, 5 levels, the last level's start (the default
+        // --start fitted), measures
+        assert_eq!(report["streamed"]["passes"], 9);
         assert_eq!(report["point_count"], 50_000);
     }
+    // the mean start: the same surface in memory and streamed, one pass fewer
+    let mean = [&base[..], &[a.to_str().unwrap(), "--start", "mean"]].concat();
+    ok(&scanfit(&mean));
+    let out = scanfit(
+        &[
+            &base[..],
+            &[
+                b.to_str().unwrap(),
+                "--start",
+                "mean",
+                "--chunk-points",
+                "7000",
+                "--json",
+            ],
+        ]
+        .concat(),
+    );
+    ok(&out);
+    let (sa, sb) = (surface(&a), surface(&b));
+    assert!(relative(&sa[0], &sb[0]) <= 1e-12);
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["streamed"]["passes"], 8);
+    // the adjustment starts from the mean; asking it for the fitted start is refused
+    let e = scanfit(&[
+        "mba", sample, "--adjust", "--start", "fitted", "--levels", "2",
+    ]);
+    assert!(!e.status.success());
+    assert!(String::from_utf8_lossy(&e.stderr).contains("starts from the mean"));
     let e = scanfit(&["mba", sample, "--adjust", "--chunk-points", "1000"]);
     assert!(!e.status.success());
     assert!(String::from_utf8_lossy(&e.stderr).contains("--adjust"));

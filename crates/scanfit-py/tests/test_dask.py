@@ -74,27 +74,46 @@ def close(a, b, what):
     assert worst <= 1e-12, f"{what}: relative difference {worst:.3e}"
 
 
+def broadcast(k, lattices, start):
+    """Bytes of an MBA level state: a header of 120 (tag, centring, frame, next
+    lattice), per lattice set a count of 8 and 24 + 8 per value for each lattice
+    (the constant's too for the fitted start), the start and the row (24)."""
+    sets = 2 if start == "fitted" else 1
+    return 120 + sets * (8 + 24 * k + lattices) + (8 if sets == 1 else 0) + 24
+
+
 def test_mba_on_two_workers_equals_the_single_process_mba(client, pts):
+    # the default start: fitted (the constant run through the levels beside the heights)
     once = scanfit.mba(pts, levels=7)
     # the points are sent to the workers once (persisted), not with every pass
     r = sd.mba(client.persist(da.from_array(pts, chunks=(CHUNKS, 3))), levels=7)
     close(r["surface"].control_points, once["surface"].control_points, "control points")
     assert r["cells"] == once["cells"]
-    assert r["points"] == N and r["passes"] == 2 + 7 + 1
+    # bounding box, frame, 7 levels, the last level's start, measures
+    assert r["points"] == N and r["passes"] == 2 + 7 + 1 + 1
     for a, b in zip(r["levels"], once["levels"]):
         assert a["control_points"] == b["control_points"]
         assert a["vertical"]["rmse"] == pytest.approx(b["vertical"]["rmse"], rel=1e-12)
         assert a["vertical"]["max"] == pytest.approx(b["vertical"]["max"], rel=1e-12)
     # the final residual statistics are those of the last level's report
     assert r["vertical"]["rmse"] == pytest.approx(once["levels"][-1]["vertical"]["rmse"], rel=1e-12)
-    # what is broadcast per level is the lattices so far, exactly: a header of 128 bytes
-    # (tag, centring, frame, next lattice, count), 24 per lattice, 8 per control value
+    # what is broadcast per level is the lattices so far, exactly
     lattices = 0
     for k, sent in enumerate(r["broadcast_bytes"]):
-        assert sent == 128 + 24 * k + lattices, (k, sent, lattices)
+        assert sent == broadcast(k, lattices, "fitted"), (k, sent, lattices)
         m, n = once["levels"][k]["control_points"]
         lattices += 8 * m * n
-    small = sd.mba(client.persist(da.from_array(pts[::10], chunks=(30_000, 3))), levels=7)
+    # the mean start: the heights' sums alone, one pass fewer
+    few = pts[::10]
+    mean = sd.mba(client.persist(da.from_array(few, chunks=(30_000, 3))), levels=7, start="mean")
+    close(mean["surface"].control_points, scanfit.mba(few, levels=7, start="mean")["surface"].control_points, "mean start")
+    assert mean["passes"] == 2 + 7 + 1
+    lattices = 0
+    for k, sent in enumerate(mean["broadcast_bytes"]):
+        assert sent == broadcast(k, lattices, "mean"), (k, sent, lattices)
+        m, n = once["levels"][k]["control_points"]
+        lattices += 8 * m * n
+    small = sd.mba(client.persist(da.from_array(few, chunks=(30_000, 3))), levels=7)
     assert small["broadcast_bytes"] == r["broadcast_bytes"]
 
 
@@ -116,8 +135,8 @@ def test_fit_surface_on_two_workers_equals_the_single_process_fit(client, pts):
     # what stays single-process is refused before any pass, with the reason
     with pytest.raises(scanfit.ScanfitError, match="whole cloud"):
         sd.mba(da.from_array(pts), adjust=True)
-    with pytest.raises(scanfit.ScanfitError, match="start from the mean|starts from the mean"):
-        sd.mba(da.from_array(pts), start="fitted")
+    with pytest.raises(scanfit.ScanfitError, match="'mean' or 'fitted'"):
+        sd.mba(da.from_array(pts), start="zero")
     with pytest.raises(scanfit.ScanfitError, match="a plane cannot close"):
         sd.fit_surface(da.from_array(pts), periodic_u=True)
 
@@ -337,22 +356,41 @@ def test_accumulators_pickle_exactly_and_merge_as_one_pass():
     assert pickle.loads(pickle.dumps(c)).centre == c.centre
     f = S.FrameSums()
     f.add(p, c)
-    run = S.MbaLevels(pickle.loads(pickle.dumps(f)), c, levels=4)
-    while not run.done:
-        state = pickle.loads(pickle.dumps(run.state()))
-        a, b = state.accumulator(), state.accumulator()
-        a.add(state, p[:15_000])
-        b.add(state, p[15_000:])
-        b2 = pickle.loads(pickle.dumps(b))
-        assert b2.to_bytes() == b.to_bytes() and b2.points == 25_000
-        a.merge(b2)
-        run.push(a)
-    got = run.finish()["surface"].control_points
-    close(got, scanfit.mba(p, levels=4)["surface"].control_points, "merged by hand")
+    for start in ("fitted", "mean"):
+        run = S.MbaLevels(pickle.loads(pickle.dumps(f)), c, levels=4, start=start)
+        while not run.done:
+            state = pickle.loads(pickle.dumps(run.state()))
+            a, b = state.accumulator(), state.accumulator()
+            sums = a.add(state, p[:15_000])
+            sums.merge(pickle.loads(pickle.dumps(b.add(state, p[15_000:]))))
+            b2 = pickle.loads(pickle.dumps(b))
+            assert b2.to_bytes() == b.to_bytes() and b2.points == 25_000
+            a.merge(b2)
+            assert not run.record(sums)
+            run.push(a)
+        # the fitted start of the last level: one more pass
+        assert run.needs_pass == (start == "fitted")
+        while run.needs_pass:
+            state = pickle.loads(pickle.dumps(run.state()))
+            sums = state.pass_sums(p[:15_000])
+            sums.merge(state.pass_sums(p[15_000:]))
+            run.record(sums)
+        run.record_last(run.state().residuals(p))
+        r = run.finish()
+        once = scanfit.mba(p, levels=4, start=start)
+        close(r["surface"].control_points, once["surface"].control_points, f"merged by hand, {start}")
+        for x, y in zip(r["levels"], once["levels"]):
+            assert x["vertical"]["rmse"] == pytest.approx(y["vertical"]["rmse"], rel=1e-12)
     with pytest.raises(scanfit.ScanfitError, match="BA sums"):
         S.BaSums.from_bytes(b"not sums at all")
     with pytest.raises(scanfit.ScanfitError, match="cut short"):
         S.BaSums.from_bytes(b2.to_bytes()[:-9])
+    # bytes of the format before the fitted start's second value set are refused as such
+    old = b"SFBASUM1" + b2.to_bytes()[8:]
+    with pytest.raises(scanfit.ScanfitError, match="version 1, but this scanfit reads version 2"):
+        S.BaSums.from_bytes(old)
+    with pytest.raises(scanfit.ScanfitError, match="version 1"):
+        S.MbaState.from_bytes(b"SFPYMBS1" + bytes(200))
     eq = S.FitSetup(100, c, ctrl=6, params="uv", knots="uniform").equations()
     assert pickle.loads(pickle.dumps(eq)).to_bytes() == eq.to_bytes()
 

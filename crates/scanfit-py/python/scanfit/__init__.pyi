@@ -220,7 +220,7 @@ def mba(
     alpha: float = 1.49,
     weight: Literal["moon", "aza04", "as05", "axis4"] = "moon",
     adjust_steps: int = 5,
-    start: Literal["mean", "fitted"] = "mean",
+    start: Optional[Literal["fitted", "mean"]] = None,
     up: Literal["auto", "x", "y", "z"] = "auto",
 ) -> dict[str, Any]: ...
 def coons(

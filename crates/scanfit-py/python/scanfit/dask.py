@@ -26,8 +26,8 @@ worker computes its points' parameters), ``knots="distribution"`` (the few order
 statistics eq. 9.69 needs, found exactly by rounds of histograms) and ``correct``
 (per round, the workers re-project their points onto the surfaces of the accepted
 rounds in turn, as the single-process correction does). MBA's ``adjust`` (the
-nearest points of the whole cloud per knot) and ``start="fitted"`` remain
-single-process and are a ``ScanfitError`` saying why. The surface equals the
+nearest points of the whole cloud per knot) remains
+single-process and is a ``ScanfitError`` saying why. The surface equals the
 single-process one up to the rounding of the merged additions (about 1e-15
 relative, tested at 1e-12 on 10^6 points).
 
@@ -52,6 +52,7 @@ from .sums import (
     FrameSums,
     MbaLevels,
     Parameterization,
+    PassSums,
     PlanePasses,
     ResidualSums,
 )
@@ -267,10 +268,10 @@ def _frame(part, centring, up="z"):
 
 
 def _level(part, state, up="z"):
-    acc, stats = state.accumulator(), ResidualSums()
+    acc, sums = state.accumulator(), PassSums()
     for pts, _ in _blocks(part, up):
-        stats.merge(acc.add(state, pts))
-    return acc, stats
+        sums.merge(acc.add(state, pts))
+    return acc, sums
 
 
 def _vertical(part, state, up="z"):
@@ -278,6 +279,14 @@ def _vertical(part, state, up="z"):
     for pts, _ in _blocks(part, up):
         stats.merge(state.residuals(pts))
     return stats
+
+
+def _start_pass(part, state, up="z"):
+    """The pass sums of a part without a level (the fitted start of the last)."""
+    sums = PassSums()
+    for pts, _ in _blocks(part, up):
+        sums.merge(state.pass_sums(pts))
+    return sums
 
 
 def _plane(part, stage):
@@ -410,6 +419,25 @@ def _mba_survey(client, parts, domain, up, task_points):
 # ---- the fits (run on the client) ----------------------------------------------
 
 
+def _mba_start(start):
+    """The distributed MBA's start of level 0 (``None``: ``"fitted"``)."""
+    if start is None:
+        return "fitted"
+    if start not in ("mean", "fitted"):
+        raise ScanfitError(f"start must be 'mean' or 'fitted'; got {start!r}")
+    return start
+
+
+def _last_start(client, parts, run, up="z"):
+    """The fitted start of the last level: one more pass while ``run`` needs it.
+    Returns the passes made (0 for the mean start)."""
+    passes = 0
+    while run.needs_pass:
+        run.record(_pass(client, parts, _start_pass, _shared(run.state()), up))
+        passes += 1
+    return passes
+
+
 def mba(
     points,
     levels=6,
@@ -420,7 +448,7 @@ def mba(
     alpha=1.49,
     weight="moon",
     adjust_steps=5,
-    start="mean",
+    start=None,
     up="auto",
     *,
     domain=None,
@@ -431,10 +459,10 @@ def mba(
     """Multilevel B-spline approximation ``z = f(x, y)`` on the current Dask client.
 
     The keywords are ``scanfit.mba``'s (``levels``, ``base``, ``tolerance``,
-    ``hjelle``, ``start``, ``up``); ``adjust=True`` is refused (the projection adjustment
-    finds the nearest points of the whole cloud per knot; ``alpha``, ``weight``
-    and ``adjust_steps`` belong to it), and so is ``start="fitted"`` (it runs the
-    constant through the levels beside the heights, in memory only).
+    ``hjelle``, ``start``: ``"fitted"``, the default, or ``"mean"``; ``up``);
+    ``adjust=True`` is refused (the projection adjustment finds the nearest points
+    of the whole cloud per knot; ``alpha``, ``weight`` and ``adjust_steps`` belong
+    to it).
 
     Parameters:
         points: a Dask array ``(N, 3)`` chunked by rows, or a list of point files.
@@ -461,8 +489,9 @@ def mba(
         client: a ``distributed.Client`` (default: the current one).
 
     Passes over the points: bounding box (unless ``domain`` with an ``up``
-    axis given and tiles not split), frame, one per level, one to measure the
-    final vertical residuals.
+    axis given and tiles not split), frame, one per level, with the fitted
+    start one for the last level's start, one to measure the final vertical
+    residuals.
 
     Returns a dict: ``surface`` (a ``Surface``), ``up`` (the axis used),
     ``tasks`` (tasks per pass), ``cells``, ``levels`` (per level:
@@ -481,13 +510,7 @@ def mba(
             "adjust=True projects the knot grid onto the whole cloud (nearest points along z) "
             "and needs all points at once; leave it out on Dask (scanfit.mba has it)"
         )
-    if start != "mean":
-        if start != "fitted":
-            raise ScanfitError(f"start must be 'mean' or 'fitted'; got {start!r}")
-        raise ScanfitError(
-            "start='fitted' runs the constant 1 through the levels beside the heights in memory "
-            "(scanfit.mba has it); on Dask the level loop starts from the mean: leave start out"
-        )
+    start = _mba_start(start)
     del alpha, weight, adjust_steps  # the adjustment's settings
     t0 = time.perf_counter()
     _check_up(up)
@@ -498,29 +521,32 @@ def mba(
     centring = _centring(box, domain, up)
     frame = _pass(client, parts, _frame, centring, up)
     run = MbaLevels(
-        frame, centring, levels=levels, base=base, tolerance=tolerance, hjelle=hjelle, domain=domain
+        frame,
+        centring,
+        levels=levels,
+        base=base,
+        tolerance=tolerance,
+        hjelle=hjelle,
+        domain=domain,
+        start=start,
     )
     passes += 1
     sent = []
-    recorded = True
     while not run.done:
         state = run.state()
         sent.append(len(state.to_bytes()))
         shared = _shared(state)
-        acc, stats = _pass(client, parts, _level, shared, up)
+        acc, sums = _pass(client, parts, _level, shared, up)
         passes += 1
-        if state.levels > 0:
-            recorded = True
-            if run.record_residual(stats):
-                break
+        if run.record(sums):
+            break
         run.push(acc)
-        recorded = False
+    passes += _last_start(client, parts, run, up)
     state = run.state()
     shared = _shared(state)
     vertical = _pass(client, parts, _vertical, shared, up)
     passes += 1
-    if not recorded:
-        run.record_residual(vertical)
+    run.record_last(vertical)
     r = run.finish()
     r["surface"] = _surface_from_frame(r["surface"], up)
     r["up"] = up

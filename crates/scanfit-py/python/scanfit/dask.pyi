@@ -20,7 +20,7 @@ def mba(
     alpha: float = 1.49,
     weight: Literal["moon", "aza04", "as05", "axis4"] = "moon",
     adjust_steps: int = 5,
-    start: Literal["mean", "fitted"] = "mean",
+    start: Optional[Literal["fitted", "mean"]] = None,
     up: Literal["auto", "x", "y", "z"] = "auto",
     *,
     domain: Optional[Tuple[float, float, float, float]] = None,

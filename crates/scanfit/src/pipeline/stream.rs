@@ -11,7 +11,9 @@
 //! (the in-memory MBA sums the points in lattice-cell order, [`crate::mba::mba`]):
 //!
 //! * [`mba`]: one pass for the frame ([`FrameSums`]), one per level
-//!   (residuals after the levels so far, [LWS97] eqs. 3-4), one to measure.
+//!   (residuals after the levels so far, [LWS97] eqs. 3-4), with the fitted
+//!   start ([`crate::mba::Start::Fitted`], the default) one for the last
+//!   level's start, one to measure (and eq. 17 of every level's surface).
 //! * [`fit`] (in `stream/fit.rs`): every setting of the in-memory fit as
 //!   passes of mergeable sums: the best-fit plane (covariance, convex hull,
 //!   extents), the distribution knots (eq. 9.69, rounds of histograms), the
@@ -33,8 +35,9 @@ use rayon::prelude::*;
 
 use crate::bspline::Surface;
 use crate::centring::Centring;
+use crate::mba::sums::{pass_sums, residual};
 use crate::mba::{
-    lattice_surface, sums::residual, FrameSums, Lattice, MbaConfig, MbaLevels, ResidualSums,
+    lattice_surface, FrameSums, Lattice, MbaConfig, MbaLevels, PassSums, ResidualSums,
 };
 use crate::metrics::ParamQuality;
 use crate::pipeline::assess::{
@@ -217,7 +220,8 @@ pub struct StreamedMba {
 /// let worst = r.surface.control_points().iter().zip(want.control_points())
 ///     .map(|(a, b)| (a.z - b.z).abs()).fold(0.0, f64::max);
 /// assert!(worst < 1e-12);
-/// assert_eq!(r.passes, 7); // bounding box, frame, 4 levels, measures
+/// // bounding box, frame, 4 levels, the fitted start of the last, measures
+/// assert_eq!(r.passes, 8);
 /// # Ok::<(), scanfit::Error>(())
 /// ```
 pub fn mba(
@@ -243,9 +247,6 @@ pub fn mba(
     let frame = frame_sums.finish()?;
     let mut run = MbaLevels::new(frame, config)?;
     let mut passes = 2;
-    let mut grid_rmse = Vec::new();
-    // the residual statistics of a level come from the pass after it
-    let mut recorded = true;
     while !run.done() {
         progress.stage(
             &format!(
@@ -258,28 +259,29 @@ pub fn mba(
             None,
         );
         let mut acc = run.accumulator()?;
-        let mut stats = ResidualSums::default();
-        let mut grid = run
-            .levels()
-            .last()
-            .map(|_| NearestSums::new(level_grid(&run)));
+        let mut sums = PassSums::default();
+        let inputs = run.inputs();
         source.pass(&mut |c| {
-            stats.merge(&acc.add_residuals(&frame, run.levels(), c.points)?);
-            if let Some(g) = grid.as_mut() {
-                g.add(c.points)?;
-            }
+            sums.merge(&acc.add_levels(&inputs, c.points)?);
             Ok(())
         })?;
         passes += 1;
-        if let Some(g) = grid {
-            grid_rmse.push(g.rmse());
-            recorded = true;
-            if run.record_residual(stats.stats()) {
-                break;
-            }
+        if run.record(&sums)? {
+            break;
         }
         run.push(acc)?;
-        recorded = false;
+    }
+    // the fitted start of the last level: one more pass
+    while run.needs_pass() {
+        progress.stage(&format!("pass {}: the start", passes + 1), None);
+        let mut sums = PassSums::default();
+        let inputs = run.inputs();
+        source.pass(&mut |c| {
+            sums.merge(&pass_sums(&inputs, c.points)?);
+            Ok(())
+        })?;
+        passes += 1;
+        run.record(&sums)?;
     }
     let result = run.finish();
     let surface = lattice_surface(&result.frame, &result.lattice)?;
@@ -288,7 +290,9 @@ pub fn mba(
     let mut assessor = StreamAssessor::new(&surface, assess)?;
     let mut vertical = ResidualSums::default();
     let mut last = ResidualSums::default();
-    let mut grid = NearestSums::new(crate::mba::adjust::knot_grid(&frame, &result.lattice));
+    // eq. 17 of every level's combined lattice (the last: the surface's)
+    let (queries, ends) = level_grids(&result)?;
+    let mut grid = NearestSums::new(queries);
     source.pass(&mut |c| {
         let uv: Vec<[f64; 2]> = c.points.par_iter().map(|p| frame.unit(p)).collect();
         let (v, l) = vertical_sums(&surface, &frame, &result.levels, c.points, &uv);
@@ -299,16 +303,21 @@ pub fn mba(
         assessor.add_tree(&tree, &uv)
     })?;
     passes += 1;
+    let grid_rmse: Vec<f64> = ends
+        .iter()
+        .scan(0, |start, &end| {
+            let d = &grid.distances()[*start..end];
+            *start = end;
+            Some((d.iter().map(|x| x * x).sum::<f64>() / d.len().max(1) as f64).sqrt())
+        })
+        .collect();
     let mut reports = result.reports;
-    if !recorded {
-        if let Some(r) = reports.last_mut() {
-            r.residual = last.stats();
-        }
-        grid_rmse.push(grid.rmse());
+    if let Some(r) = reports.last_mut().filter(|r| r.residual.count == 0) {
+        r.residual = last.stats();
     }
     let mut quality = assessor.finish();
     quality.at_parameters = vertical.stats();
-    quality.grid_rmse = grid.rmse();
+    quality.grid_rmse = grid_rmse.last().copied().unwrap_or(0.0);
     let levels = reports
         .iter()
         .zip(&grid_rmse)
@@ -338,24 +347,25 @@ pub fn mba(
     })
 }
 
-/// The knot grid of the combined lattice of the levels of `run` so far.
-fn level_grid(run: &MbaLevels) -> Vec<Point3> {
+/// The knot grids of the combined lattice of each level of `r` (the sum of
+/// its levels so far, refined), one after the other, and where each ends.
+fn level_grids(r: &crate::mba::Mba) -> Result<(Vec<Point3>, Vec<usize>)> {
+    let (mut queries, mut ends) = (Vec::new(), Vec::new());
     let mut total: Option<Lattice> = None;
-    for l in run.levels() {
-        total = Some(match total {
+    for l in &r.levels {
+        let t = match total.take() {
             None => l.clone(),
             Some(t) => {
-                let mut t = t.refine().unwrap_or_else(|_| l.clone());
-                if t.add(l).is_err() {
-                    t = l.clone();
-                }
+                let mut t = t.refine()?;
+                t.add(l)?;
                 t
             }
-        });
+        };
+        queries.extend(crate::mba::adjust::knot_grid(&r.frame, &t));
+        ends.push(queries.len());
+        total = Some(t);
     }
-    total.map_or_else(Vec::new, |t| {
-        crate::mba::adjust::knot_grid(&run.frame(), &t)
-    })
+    Ok((queries, ends))
 }
 
 /// The parameters of a chunk, an error when the source gave none.
@@ -674,7 +684,8 @@ mod tests {
                 assert_eq!((a.x, a.y), (b.x, b.y), "chunk {chunk}");
                 assert!((a.z - b.z).abs() <= 1e-12 * scale, "chunk {chunk}");
             }
-            assert_eq!(r.passes, 8);
+            // bounding box, frame, 5 levels, the last start (fitted), measures
+            assert_eq!(r.passes, 9);
             let (a, b) = (r.quality, once.assessment.quality);
             let close = |x: f64, y: f64| (x - y).abs() <= 1e-10 * y.abs().max(1e-300);
             assert!(
