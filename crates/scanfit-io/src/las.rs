@@ -541,6 +541,55 @@ fn column_names(gps_time: bool, color: bool, nir: bool) -> Vec<&'static str> {
     names
 }
 
+/// Decodes the chunks `spans` of a LAZ file held in `bytes` (chunk `c`
+/// has `size(c)` bytes, `declared` points in all) with `decode`, a few per
+/// thread at a time (chunks are independent), and hands each chunk's
+/// points to `append` in file order, with the coordinates and the columns
+/// `names` to append to; the first damaged chunk in file order is the
+/// error.
+#[allow(clippy::too_many_arguments)]
+fn decode_in_order<T: Send>(
+    path: &Path,
+    bytes: &[u8],
+    declared: u64,
+    names: Vec<&'static str>,
+    spans: &[crate::laz14::ChunkSpan],
+    size: impl Fn(usize) -> u64 + Sync,
+    decode: impl Fn(usize, &[u8], &mut Vec<T>) -> std::result::Result<(), crate::laz14::Laz14Error>
+        + Sync,
+    append: impl Fn(&[T], &mut Vec<Point3>, &mut [Vec<f64>]),
+) -> Result<Decoded> {
+    use rayon::prelude::*;
+    let cap = capacity(declared, bytes.len()).min(1 << 24);
+    let mut points = Vec::with_capacity(cap);
+    let mut columns = vec![Vec::with_capacity(cap); names.len()];
+    let group = 2 * rayon::current_num_threads().max(1);
+    let count = spans.len();
+    for first in (0..count).step_by(group) {
+        let decoded: Vec<_> = (first..(first + group).min(count))
+            .into_par_iter()
+            .map(|c| {
+                let at = spans[c].offset as usize;
+                let data = bytes
+                    .get(at..at.saturating_add(size(c) as usize))
+                    .unwrap_or(&[]);
+                let mut chunk = Vec::new();
+                decode(c, data, &mut chunk).map(|()| chunk)
+            })
+            .collect();
+        for chunk in decoded {
+            let chunk = chunk.map_err(|e| layered::binary(path, e))?;
+            append(&chunk, &mut points, &mut columns);
+        }
+    }
+    Ok(Decoded {
+        points,
+        names,
+        columns,
+        declared,
+    })
+}
+
 /// Columns read from the crate.
 #[derive(Default)]
 struct Decoded {

@@ -91,6 +91,22 @@ fn pointwise_laz_streams_one_laz_chunk_at_a_time() {
     assert_eq!(same_streamed(&path, 1000).iter().sum::<usize>(), 1500);
 }
 
+/// Compressor 1 (pointwise, the whole point stream one LAZ chunk) is read
+/// a requested chunk at a time, not one LAZ chunk (all points) at a time:
+/// the points, columns, locations and warnings are the one-piece reader's.
+#[test]
+fn a_compressor_1_laz_file_streams_in_requested_chunks() {
+    for (format, extra) in [(1u8, 0usize), (5, 2)] {
+        let n = 4000;
+        let raw = laz10_gen::records(format, extra, n, 17 + u64::from(format));
+        let f = laz10_gen::compress_single(format, extra, &raw);
+        let path = dir().join(format!("single{format}.laz"));
+        std::fs::write(&path, &f.bytes).unwrap();
+        assert_eq!(same_streamed(&path, 1500), [1500, 1500, 1000]);
+        assert_eq!(same_streamed(&path, 1).len(), n);
+    }
+}
+
 #[test]
 fn layered_laz_streams_one_laz_chunk_at_a_time() {
     use laz10_gen::laz_gen;
