@@ -7,7 +7,7 @@ make_franke.py.
     python3 benches/scale/make_franke.py 1000000 /tmp/franke_1000000.ply
     python3 benches/scale/make_franke.py 1000000 /tmp/franke_uv_1000000.ply --uv
     python3 benches/scale/make_franke.py 10000000 /tmp/franke_10000000.las
-    python3 benches/scale/run.py target/release/scanfit 1000000 [--repeat 3] [--only fit|mba|mba_las|mba_las_streamed] [--out-dir /tmp] [-- EXTRA...]
+    python3 benches/scale/run.py target/release/scanfit 1000000 [--repeat 3] [--only fit|mba|mba_las|mba_las_streamed|mba_laz1|mba_laz1_streamed] [--out-dir /tmp] [-- EXTRA...]
 
 Each command runs `--repeat` times (default 3) under `/usr/bin/time -v`
 with SCANFIT_TIMINGS=1 (the CLI then prints each stage's wall time); the
@@ -16,7 +16,12 @@ split of the median run, the largest peak RSS and the bytes per point, and the l
 average before and after (the machine is shared). Arguments after `--` are
 added to every command (e.g. `--measure full`). When /tmp/franke_N.las
 exists, `mba` also runs on it in memory (`mba_las`) and streamed in chunks
-of 10^6 points (`mba_las_streamed`, `--chunk-points 1000000`).
+of 10^6 points (`mba_las_streamed`, `--chunk-points 1000000`). When
+/tmp/franke_N_c1.laz exists (the LAS as a compressor-1 LAZ: `cargo run
+--release -p scanfit-io --example laz_pointwise -- /tmp/franke_N.las
+/tmp/franke_N_c1.laz`), the same two runs on it (`mba_laz1`,
+`mba_laz1_streamed`): streamed, its one LAZ chunk of all points is decoded
+a requested chunk at a time.
 """
 import os
 import re
@@ -67,6 +72,12 @@ def main():
                    "-o", f"{out}/scale_mba_las.json", "--json", "-q"]
         commands["mba_las"] = mba_las
         commands["mba_las_streamed"] = mba_las + ["--chunk-points", "1000000"]
+    laz1 = f"/tmp/franke_{n}_c1.laz"
+    if os.path.exists(laz1):
+        mba_laz1 = [binary, "mba", laz1, "--levels", "8", "--base", "1x1",
+                    "-o", f"{out}/scale_mba_laz1.json", "--json", "-q"]
+        commands["mba_laz1"] = mba_laz1
+        commands["mba_laz1_streamed"] = mba_laz1 + ["--chunk-points", "1000000"]
     for name, cmd in commands.items():
         if only and name != only:
             continue

@@ -36,7 +36,10 @@ fn main() {
     src.seek(SeekFrom::Start(0)).unwrap();
     src.read_exact(&mut head).unwrap();
     let format = head[104];
-    assert!(format <= 5, "point format {format}: this writes formats 0-5");
+    assert!(
+        format <= 5,
+        "point format {format}: this writes formats 0-5"
+    );
     let len = usize::from(u16_at(&head, 105));
     let standard = [20, 28, 26, 34, 57, 63][usize::from(format)];
     let items =

@@ -148,6 +148,43 @@ fn a_truncated_laz_file_fails_streamed_as_whole() {
     );
 }
 
+/// A LAZ header that declares fewer points than its chunk table's chunks
+/// hold: the chunks beyond the count are not read, with a warning, read
+/// whole and streamed alike (pointwise and layered).
+#[test]
+fn a_laz_count_below_the_chunk_table_is_a_warning() {
+    use laz10_gen::{laz_gen, Chunks};
+    let path = laz_file("fewer.laz", 1, 0, Chunks::Fixed(500), 1500);
+    let mut bytes = std::fs::read(&path).unwrap();
+    bytes[107..111].copy_from_slice(&900u32.to_le_bytes());
+    std::fs::write(&path, &bytes).unwrap();
+    assert_eq!(same_streamed(&path, 700), [500, 400]);
+    let w = read_cloud(&path, &ReadOptions::default()).unwrap().warnings;
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].ends_with("the LAZ chunk table lists 3 chunks, but the header's 900 points fill only 2; the points of the other 1 were not read (the header's point count may be too small)"),
+        "{w:?}"
+    );
+    let raw = laz_gen::records(6, 3000, 5);
+    let f = laz_gen::compress(6, false, laz_gen::Chunks::Fixed(1000), &raw);
+    let mut bytes = f.bytes.clone();
+    bytes[247..255].copy_from_slice(&1000u64.to_le_bytes());
+    let path = dir().join("fewer6.laz");
+    std::fs::write(&path, &bytes).unwrap();
+    assert_eq!(same_streamed(&path, 600), [600, 400]);
+    let w = read_cloud(&path, &ReadOptions::default()).unwrap().warnings;
+    assert!(
+        w.len() == 1 && w[0].contains("lists 3 chunks, but the header's 1000 points fill only 1"),
+        "{w:?}"
+    );
+    // the intact files: no warning
+    let path = laz_file("intact.laz", 1, 0, Chunks::Fixed(500), 1500);
+    assert!(read_cloud(&path, &ReadOptions::default())
+        .unwrap()
+        .warnings
+        .is_empty());
+}
+
 /// Offset of the point data of a LAS 1.2 file.
 fn laz_start(bytes: &[u8]) -> usize {
     u32::from_le_bytes(bytes[96..100].try_into().unwrap()) as usize

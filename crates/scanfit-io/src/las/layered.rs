@@ -8,7 +8,9 @@ use std::path::Path;
 
 use scanfit::Point3;
 
-use super::{column_names, decode_in_order, transforms, vlr_bytes, Decoded, Layered, Raw};
+use super::{
+    column_names, decode_in_order, transforms, unread_chunks, vlr_bytes, Decoded, Layered, Raw,
+};
 use crate::laz14::{LayeredLaz, Laz14Error, Point14, ReadAt};
 use crate::{Error, Result};
 
@@ -113,7 +115,7 @@ pub(super) fn read_layered(
     let file = open(path, &read, vlr, format, raw, layered)?;
     let transform = transforms(path, bytes)?;
     let names = names(&file);
-    decode_in_order(
+    let mut decoded = decode_in_order(
         path,
         bytes,
         layered.count,
@@ -122,5 +124,12 @@ pub(super) fn read_layered(
         |c| file.chunk_bytes(c),
         |c, data, out| file.decode_chunk(c, data, out),
         |chunk, points, columns| append(&file, &transform, chunk, points, columns),
-    )
+    )?;
+    decoded.warnings = unread_chunks(
+        path,
+        layered.table_chunks,
+        file.chunks().len(),
+        layered.count,
+    );
+    Ok(decoded)
 }

@@ -9,7 +9,7 @@ use std::path::Path;
 use scanfit::Point3;
 
 use super::layered::binary;
-use super::{column_names, decode_in_order, transforms, Decoded, Pointwise};
+use super::{column_names, decode_in_order, transforms, unread_chunks, Decoded, Pointwise};
 use crate::laz14::{PointwiseLaz, PointwiseRecord};
 use crate::{Error, Result};
 
@@ -83,7 +83,7 @@ pub(super) fn read_pointwise(path: &Path, bytes: &[u8], pw: &Pointwise) -> Resul
     )?;
     let transform = transforms(path, bytes)?;
     let names = names(&file);
-    decode_in_order(
+    let mut decoded = decode_in_order(
         path,
         bytes,
         pw.count,
@@ -92,7 +92,9 @@ pub(super) fn read_pointwise(path: &Path, bytes: &[u8], pw: &Pointwise) -> Resul
         |c| file.chunk_bytes(c),
         |c, data, out| file.decode_chunk(c, data, out),
         |chunk, points, columns| append(&file, &transform, chunk, points, columns),
-    )
+    )?;
+    decoded.warnings = unread_chunks(path, pw.table_chunks, file.chunks().len(), pw.count);
+    Ok(decoded)
 }
 
 /// The header's point format must be the one the LASzip items describe.

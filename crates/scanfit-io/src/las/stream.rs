@@ -29,7 +29,7 @@ use scanfit::Point3;
 use super::view::{u8_at, FileView, View};
 use super::{
     crate_failed, header_warnings, layered, laz_check, pointwise, precheck, quietly, transforms,
-    Compressed, CrateReader, Raw,
+    unread_chunks, Compressed, CrateReader, Raw,
 };
 use crate::laz14::{LayeredLaz, PointwiseCursor, PointwiseLaz, PointwiseRecord};
 use crate::table::{Format, Origin, PointTable};
@@ -105,6 +105,8 @@ pub(crate) struct LasChunks {
     extra: Vec<Vec<f64>>,
     at: usize,
     warnings: Vec<String>,
+    /// the decoder's warnings, known when the file is opened
+    laz_warnings: Vec<String>,
 }
 
 impl LasChunks {
@@ -126,12 +128,13 @@ impl LasChunks {
         };
         let format = u8_at(&view, 104).unwrap_or(0) & 0x3f;
         let read = |at: u64, n: usize| view.read(at, n).map(|b| b.into_owned());
-        let (decoder, names, declared) = match compressed {
+        let (decoder, names, declared, laz_warnings) = match compressed {
             Compressed::Layered(l) => {
                 let vlr = view.read(l.vlr_at, l.vlr_len as usize).unwrap_or_default();
                 let file = layered::open(path, &read, &vlr, format, &raw, &l)?;
                 let names = layered::names(&file);
-                (Decoder::Layered(file, 0), names, l.count)
+                let w = unread_chunks(path, l.table_chunks, file.chunks().len(), l.count);
+                (Decoder::Layered(file, 0), names, l.count, w)
             }
             Compressed::Pointwise(pw) => {
                 let vlr = view
@@ -140,20 +143,21 @@ impl LasChunks {
                 let file = pointwise::open(path, len, &pw, &vlr)?;
                 pointwise::check_format(path, format, &file, pw.vlr_at)?;
                 let names = pointwise::names(&file);
+                let w = unread_chunks(path, pw.table_chunks, file.chunks().len(), pw.count);
                 let stream = PointwiseStream {
                     file,
                     next: 0,
                     cursor: None,
                     records: Vec::new(),
                 };
-                (Decoder::Pointwise(Box::new(stream)), names, pw.count)
+                (Decoder::Pointwise(Box::new(stream)), names, pw.count, w)
             }
             Compressed::Crate => {
                 let source = BufReader::with_capacity(1 << 20, File::open(path).map_err(io)?);
                 let r = quietly(|| CrateReader::new(path, source, len, &raw))
                     .ok_or_else(|| crate_failed(path))??;
                 let (names, declared) = (r.names.clone(), r.declared);
-                (Decoder::Crate(Box::new(r)), names, declared)
+                (Decoder::Crate(Box::new(r)), names, declared, Vec::new())
             }
         };
         let transform = transforms(path, &view)?;
@@ -173,6 +177,7 @@ impl LasChunks {
             extra,
             at: 0,
             warnings: Vec::new(),
+            laz_warnings,
         })
     }
 
@@ -278,6 +283,7 @@ impl LasChunks {
             }
             if self.warnings.is_empty() {
                 self.warnings = header_warnings(&self.path, &self.raw, self.served);
+                self.warnings.extend(self.laz_warnings.iter().cloned());
             }
             return Ok(None);
         }
