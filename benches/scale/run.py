@@ -66,18 +66,13 @@ def main():
         "mba": [binary, "mba", f"/tmp/franke_{n}.ply", "--levels", "8", "--base", "1x1",
                 "-o", f"{out}/scale_mba.json", "--json", "-q"],
     }
-    las = f"/tmp/franke_{n}.las"
-    if os.path.exists(las):
-        mba_las = [binary, "mba", las, "--levels", "8", "--base", "1x1",
-                   "-o", f"{out}/scale_mba_las.json", "--json", "-q"]
-        commands["mba_las"] = mba_las
-        commands["mba_las_streamed"] = mba_las + ["--chunk-points", "1000000"]
-    laz1 = f"/tmp/franke_{n}_c1.laz"
-    if os.path.exists(laz1):
-        mba_laz1 = [binary, "mba", laz1, "--levels", "8", "--base", "1x1",
-                    "-o", f"{out}/scale_mba_laz1.json", "--json", "-q"]
-        commands["mba_laz1"] = mba_laz1
-        commands["mba_laz1_streamed"] = mba_laz1 + ["--chunk-points", "1000000"]
+    # the LAS and its compressor-1 LAZ, in memory and streamed
+    for key, path in (("las", f"/tmp/franke_{n}.las"), ("laz1", f"/tmp/franke_{n}_c1.laz")):
+        if os.path.exists(path):
+            cmd = [binary, "mba", path, "--levels", "8", "--base", "1x1",
+                   "-o", f"{out}/scale_mba_{key}.json", "--json", "-q"]
+            commands[f"mba_{key}"] = cmd
+            commands[f"mba_{key}_streamed"] = cmd + ["--chunk-points", "1000000"]
     for name, cmd in commands.items():
         if only and name != only:
             continue
