@@ -80,11 +80,33 @@ fn dist2(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     x * x + y * y + z * z
 }
 
-/// One candidate: squared distance, index in the input, tree position (16
-/// bytes, as the pair without the position would be after padding).
-type Candidate = (f64, u32, u32);
+/// One candidate packed in 16 bytes so that the integers order as
+/// (squared distance, index): the squared distance's bits (a non-negative
+/// f64, never NaN for finite points, orders like its bit pattern), the
+/// point's index in the input, its tree position. One integer comparison
+/// replaces two floating-point ones and a branch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+struct Candidate(u128);
 
-/// The `k` best candidates so far, sorted by (squared distance, index).
+impl Candidate {
+    fn new(d2: f64, id: u32, pos: u32) -> Self {
+        Self(((d2.to_bits() as u128) << 64) | ((id as u128) << 32) | pos as u128)
+    }
+
+    fn d2(self) -> f64 {
+        f64::from_bits((self.0 >> 64) as u64)
+    }
+
+    fn id(self) -> u32 {
+        (self.0 >> 32) as u32
+    }
+
+    fn pos(self) -> u32 {
+        self.0 as u32
+    }
+}
+
+/// The `k` best candidates so far, in increasing order.
 struct Best {
     k: usize,
     items: Vec<Candidate>,
@@ -105,23 +127,23 @@ impl Best {
     }
 
     fn offer(&mut self, d2: f64, id: u32, pos: u32) {
-        let before = |c: &Candidate| d2 < c.0 || (d2 == c.0 && id < c.1);
+        let c = Candidate::new(d2, id, pos);
         let n = self.items.len();
         if n == self.k {
-            if !before(&self.items[n - 1]) {
+            if c >= self.items[n - 1] {
                 return;
             }
-            self.items[n - 1] = (d2, id, pos);
+            self.items[n - 1] = c;
         } else {
-            self.items.push((d2, id, pos));
+            self.items.push(c);
         }
         // one insertion-sort step (k is small: no binary search, no memmove)
         let mut at = self.items.len() - 1;
-        while at > 0 && before(&self.items[at - 1]) {
+        while at > 0 && c < self.items[at - 1] {
             self.items[at] = self.items[at - 1];
             at -= 1;
         }
-        self.items[at] = (d2, id, pos);
+        self.items[at] = c;
     }
 }
 
@@ -139,7 +161,7 @@ impl Visit for Best {
         if self.items.len() < self.k {
             f64::INFINITY
         } else {
-            self.items[self.k - 1].0
+            self.items[self.k - 1].d2()
         }
     }
 
@@ -147,10 +169,11 @@ impl Visit for Best {
         // most points of a bucket are farther than the k-th: the test here
         // spares them the call (`<=`: an equal distance may win by index)
         let mut worst = self.bound();
-        for j in lo..hi {
-            let d2 = dist2(&tree.pts[j], q);
+        let (pts, ids) = (&tree.pts[lo..hi], &tree.ids[lo..hi]);
+        for (j, (p, &id)) in (lo as u32..).zip(pts.iter().zip(ids)) {
+            let d2 = dist2(p, q);
             if d2 <= worst {
-                self.offer(d2, tree.ids[j], j as u32);
+                self.offer(d2, id, j);
                 worst = self.bound();
             }
         }
@@ -341,9 +364,9 @@ impl KdTree {
         let positions: Vec<u32> = (0..n as u32).collect();
         let rows = |pos: usize, idx: &mut [u32], d: &mut [B]| {
             let mut best = Best::new(k + 1);
-            for (j, &(d2, id, _)) in self.own_row(pos, k, &mut best).enumerate() {
-                idx[j] = id;
-                d[j] = dist(d2);
+            for (j, c) in self.own_row(pos, k, &mut best).enumerate() {
+                idx[j] = c.id();
+                d[j] = dist(c.d2());
             }
         };
         // rows land at the input index of the tree position
@@ -359,20 +382,20 @@ impl KdTree {
         pos: usize,
         k: usize,
         best: &'b mut Best,
-    ) -> impl Iterator<Item = &'b Candidate> {
+    ) -> impl Iterator<Item = Candidate> + 'b {
         best.restart((k + 1).min(self.len()));
         self.descend(0, self.len(), &self.pts[pos], &mut [0.0; 3], best);
         let found = &best.items;
         let me = self.ids[pos];
         let skip = found
             .iter()
-            .position(|c| c.1 == me)
+            .position(|c| c.id() == me)
             .unwrap_or(found.len() - 1);
         found
             .iter()
             .enumerate()
             .filter(move |&(j, _)| j != skip)
-            .map(|(_, c)| c)
+            .map(|(_, c)| *c)
             .take(k)
     }
 
@@ -404,7 +427,7 @@ impl KdTree {
                 for (r, (row, o)) in rows.chunks_mut(k).zip(out).enumerate() {
                     let t = c * CHUNK + r;
                     for (x, c) in row.iter_mut().zip(self.own_row(t, k, &mut best)) {
-                        *x = c.2;
+                        *x = c.pos();
                     }
                     *o = f(t, row);
                 }
@@ -416,7 +439,14 @@ impl KdTree {
     /// collects, the nearer child first; `off` holds the cell's offset from
     /// `q` per axis, and a cell whose sum of squared offsets exceeds
     /// `visit.bound()` is skipped.
-    fn descend<V: Visit>(&self, lo: usize, hi: usize, q: &[f64; 3], off: &mut [f64; 3], visit: &mut V) {
+    fn descend<V: Visit>(
+        &self,
+        lo: usize,
+        hi: usize,
+        q: &[f64; 3],
+        off: &mut [f64; 3],
+        visit: &mut V,
+    ) {
         if hi - lo <= BUCKET {
             visit.bucket(self, lo, hi, q);
             return;
@@ -450,10 +480,10 @@ impl KdTree {
     /// smallest index among equally near ones).
     pub fn nearest(&self, query: &Point3) -> Neighbour {
         let b = self.best(&coords(query), 1);
-        let (d2, id, _) = b.items[0];
+        let c = b.items[0];
         Neighbour {
-            index: id as usize,
-            distance: d2.sqrt(),
+            index: c.id() as usize,
+            distance: c.d2().sqrt(),
         }
     }
 
@@ -475,9 +505,9 @@ impl KdTree {
         self.best(&coords(query), k)
             .items
             .into_iter()
-            .map(|(d2, id, _)| Neighbour {
-                index: id as usize,
-                distance: d2.sqrt(),
+            .map(|c| Neighbour {
+                index: c.id() as usize,
+                distance: c.d2().sqrt(),
             })
             .collect()
     }
@@ -668,6 +698,27 @@ mod tests {
         assert_eq!(all.len(), 500);
     }
 
+    /// Point sets that test ties: `n` random points in a unit square
+    /// (heights scaled by `z`), a `side x side x layers` grid (equal
+    /// distances everywhere) and random points with duplicates (the first
+    /// 15% and then the first 2.5% again).
+    fn hard_sets(seed: u64, n: usize, side: usize, layers: usize, z: f64) -> [Vec<Point3>; 3] {
+        let mut rng = crate::testdata::Lcg::new(seed);
+        let mut rnd = || rng.next_f64();
+        let random: Vec<Point3> = (0..n)
+            .map(|_| Point3::new(rnd(), rnd(), z * rnd()))
+            .collect();
+        let grid = (0..side * side * layers)
+            .map(|i| {
+                let (x, y, h) = (i % side, i / side % side, i / (side * side));
+                Point3::new(x as f64, y as f64, h as f64)
+            })
+            .collect();
+        let mut dups = random[..n * 3 / 20].to_vec();
+        dups.extend_from_slice(&random[..n / 40]);
+        [random, grid, dups]
+    }
+
     /// The tree against kiddo 6's `ImmutableKdTree` (the index it replaced,
     /// an independent implementation): on random points, a grid (ties
     /// everywhere) and duplicates, the k nearest have the same distances,
@@ -676,17 +727,7 @@ mod tests {
     #[test]
     fn answers_agree_with_kiddo() {
         use kiddo::{ImmutableKdTree, SquaredEuclidean};
-        let mut rng = crate::testdata::Lcg::new(17);
-        let mut rnd = || rng.next_f64();
-        let random: Vec<Point3> = (0..20_000)
-            .map(|_| Point3::new(rnd(), rnd(), 0.2 * rnd()))
-            .collect();
-        let grid: Vec<Point3> = (0..4000)
-            .map(|i| Point3::new((i % 20) as f64, (i / 20 % 20) as f64, (i / 400) as f64))
-            .collect();
-        let mut dups = random[..3000].to_vec();
-        dups.extend_from_slice(&random[..500]);
-        for pts in [random, grid, dups] {
+        for pts in hard_sets(17, 20_000, 20, 10, 0.2) {
             let ours = KdTree::new(&pts, "points").unwrap();
             let c: Vec<[f64; 3]> = pts.iter().map(coords).collect();
             let theirs: ImmutableKdTree<f64, 3> = ImmutableKdTree::new_from_slice(&c).unwrap();
@@ -733,16 +774,7 @@ mod tests {
     /// row of `graph_rows` at that point's input index.
     #[test]
     fn rows_in_tree_order_are_the_brute_force_neighbours() {
-        let mut rng = crate::testdata::Lcg::new(23);
-        let mut rnd = || rng.next_f64();
-        let random: Vec<Point3> = (0..1500)
-            .map(|_| Point3::new(rnd(), rnd(), 0.1 * rnd()))
-            .collect();
-        let grid: Vec<Point3> = (0..1000)
-            .map(|i| Point3::new((i % 10) as f64, (i / 10 % 10) as f64, (i / 100) as f64))
-            .collect();
-        let mut dups = random[..700].to_vec();
-        dups.extend_from_slice(&random[..300]);
+        let [random, grid, dups] = hard_sets(23, 1500, 10, 10, 0.1);
         for (pts, k) in [(random, 20), (grid, 9), (dups, 12), (grid_of(5), 4)] {
             let tree = KdTree::new(&pts, "points").unwrap();
             let order = tree.spatial_order();
