@@ -286,11 +286,8 @@ fn finish(
     let tree = cloud.tree()?;
     let order = tree.spatial_order();
     let pts = tree.points_in_order();
-    let n = cloud.len();
-    let mut components = 0;
-    let built: Neighbourhoods;
-    let rows = match config.orientation {
-        Orientation::None => rows,
+    match config.orientation {
+        Orientation::None => {}
         Orientation::Viewpoint(v) => {
             // the tree's copy of the points is the input's, bit for bit
             per_point.par_iter_mut().zip(pts).for_each(|(r, p)| {
@@ -298,59 +295,29 @@ fn finish(
                     r.normal = -r.normal;
                 }
             });
-            rows
         }
         Orientation::SpanningTree { hint } => {
-            // Prim's tree runs in input order (its ties by input index)
-            let (graph, at) = match rows {
-                Rows::Input { graph, at } => (graph, at),
-                Rows::Tree { rows, k } => {
-                    built = input_graph(&rows, k, order);
-                    drop(rows);
-                    (&built, positions(order))
-                }
-            };
-            let mut normals: Vec<Vector3> =
-                at.iter().map(|&t| per_point[t as usize].normal).collect();
-            let adj = Adjacency::of(graph);
-            components = orient_by_spanning_tree(cloud.points(), &adj, &mut normals, &hint);
-            drop(adj);
-            for (&i, r) in order.iter().zip(per_point.iter_mut()) {
-                r.normal = normals[i as usize];
-            }
-            Rows::Input { graph, at }
+            return finish_spanning_tree(cloud, per_point, rows, &hint);
         }
-    };
+    }
     let (flat_rows, k) = match &rows {
         Rows::Tree { rows, k } => (&rows[..], *k),
         Rows::Input { graph, .. } => (&graph.indices[..], graph.k),
     };
-    if components == 0 {
-        components = count_components(flat_rows, k, n);
-    }
+    let components = count_components(flat_rows, k, cloud.len());
+    let normal = |t: usize| per_point[t].normal;
     let disagreement = match (config.orientation, &rows) {
         (Orientation::None, _) => None,
-        (_, Rows::Tree { rows, k }) => disagreement(pts, &per_point, |t| {
+        (_, Rows::Tree { rows, k }) => disagreement(pts, normal, |t| {
             rows[t * k..(t + 1) * k].iter().map(|&s| s as usize)
         }),
-        (_, Rows::Input { graph, at }) => disagreement(pts, &per_point, |t| {
+        (_, Rows::Input { graph, at }) => disagreement(pts, normal, |t| {
             let nb = graph.indices_of(order[t] as usize);
             nb.iter().map(|&j| at[j as usize] as usize)
         }),
     };
     drop(rows);
-    // back to the input order
-    let mut normals = vec![Vector3::zeros(); n];
-    let mut variation = vec![0.0; n];
-    let mut degenerate = Vec::new();
-    for (&i, r) in order.iter().zip(&per_point) {
-        normals[i as usize] = r.normal;
-        variation[i as usize] = r.variation;
-        if r.flat {
-            degenerate.push(i as usize);
-        }
-    }
-    degenerate.sort_unstable();
+    let (normals, variation, degenerate) = into_input_order(&per_point, order);
     Ok(Normals {
         normals,
         variation,
@@ -358,6 +325,64 @@ fn finish(
         components,
         disagreement,
     })
+}
+
+/// [`finish`] with the spanning-tree orientation: Prim's tree runs in input
+/// order (its ties by input index) over the graph in input order, on the
+/// normals already in input order (the tree-order results are dropped
+/// before the adjacency, the largest thing the normals hold, is built).
+fn finish_spanning_tree(
+    cloud: &PointCloud,
+    per_point: Vec<PerPoint>,
+    rows: Rows<'_>,
+    hint: &Vector3,
+) -> Result<Normals> {
+    let tree = cloud.tree()?;
+    let order = tree.spatial_order();
+    let built: Neighbourhoods;
+    let (graph, at) = match rows {
+        Rows::Input { graph, at } => (graph, at),
+        Rows::Tree { rows, k } => {
+            built = input_graph(&rows, k, order);
+            drop(rows);
+            (&built, positions(order))
+        }
+    };
+    let (mut normals, variation, degenerate) = into_input_order(&per_point, order);
+    drop(per_point);
+    let adj = Adjacency::of(graph);
+    let components = orient_by_spanning_tree(cloud.points(), &adj, &mut normals, hint);
+    drop(adj);
+    let normal = |t: usize| normals[order[t] as usize];
+    let disagreement = disagreement(tree.points_in_order(), normal, |t| {
+        let nb = graph.indices_of(order[t] as usize);
+        nb.iter().map(|&j| at[j as usize] as usize)
+    });
+    Ok(Normals {
+        normals,
+        variation,
+        degenerate,
+        components,
+        disagreement,
+    })
+}
+
+/// The normals, variations and degenerate points (ascending) in input
+/// order, from the results in the tree's order.
+fn into_input_order(per_point: &[PerPoint], order: &[u32]) -> (Vec<Vector3>, Vec<f64>, Vec<usize>) {
+    let n = per_point.len();
+    let mut normals = vec![Vector3::zeros(); n];
+    let mut variation = vec![0.0; n];
+    let mut degenerate = Vec::new();
+    for (&i, r) in order.iter().zip(per_point) {
+        normals[i as usize] = r.normal;
+        variation[i as usize] = r.variation;
+        if r.flat {
+            degenerate.push(i as usize);
+        }
+    }
+    degenerate.sort_unstable();
+    (normals, variation, degenerate)
 }
 
 /// The tree position of each input index (`order` inverted).
@@ -387,12 +412,13 @@ fn input_graph(rows: &[u32], k: usize, order: &[u32]) -> Neighbourhoods {
 }
 
 /// The share of same-sheet neighbour pairs whose normals disagree (see
-/// [`Normals::disagreement`]), over the points and normals in the tree's
-/// order (`pts[t]`, `per_point[t]`), `neighbours(t)` giving the tree
-/// positions of the neighbours of `t`.
-fn disagreement<I, F>(pts: &[[f64; 3]], per_point: &[PerPoint], neighbours: F) -> Option<f64>
+/// [`Normals::disagreement`]), over the points in the tree's order
+/// (`pts[t]`), `normal(t)` the normal of the point at tree position `t` and
+/// `neighbours(t)` the tree positions of its neighbours.
+fn disagreement<I, N, F>(pts: &[[f64; 3]], normal: N, neighbours: F) -> Option<f64>
 where
     I: Iterator<Item = usize>,
+    N: Fn(usize) -> Vector3 + Sync,
     F: Fn(usize) -> I + Sync,
 {
     let (pairs, bad) = (0..pts.len())
@@ -408,7 +434,7 @@ where
                     continue;
                 }
                 let d = d / len;
-                let (a, b) = (per_point[t].normal, per_point[s].normal);
+                let (a, b) = (normal(t), normal(s));
                 if a.dot(&d).abs() < 0.5 && b.dot(&d).abs() < 0.5 && a.dot(&b).abs() > 0.5 {
                     pairs += 1;
                     bad += usize::from(a.dot(&b) < 0.0);
