@@ -317,14 +317,8 @@ fn finish(
         }),
     };
     drop(rows);
-    let (normals, variation, degenerate) = into_input_order(&per_point, order);
-    Ok(Normals {
-        normals,
-        variation,
-        degenerate,
-        components,
-        disagreement,
-    })
+    let parts = into_input_order(&per_point, order);
+    Ok(Normals::from_parts(parts, components, disagreement))
 }
 
 /// [`finish`] with the spanning-tree orientation: Prim's tree runs in input
@@ -358,18 +352,28 @@ fn finish_spanning_tree(
         let nb = graph.indices_of(order[t] as usize);
         nb.iter().map(|&j| at[j as usize] as usize)
     });
-    Ok(Normals {
-        normals,
-        variation,
-        degenerate,
-        components,
-        disagreement,
-    })
+    let parts = (normals, variation, degenerate);
+    Ok(Normals::from_parts(parts, components, disagreement))
 }
 
-/// The normals, variations and degenerate points (ascending) in input
-/// order, from the results in the tree's order.
-fn into_input_order(per_point: &[PerPoint], order: &[u32]) -> (Vec<Vector3>, Vec<f64>, Vec<usize>) {
+/// Normals, variations and degenerate points (ascending), in input order.
+type Parts = (Vec<Vector3>, Vec<f64>, Vec<usize>);
+
+impl Normals {
+    fn from_parts(parts: Parts, components: usize, disagreement: Option<f64>) -> Self {
+        let (normals, variation, degenerate) = parts;
+        Self {
+            normals,
+            variation,
+            degenerate,
+            components,
+            disagreement,
+        }
+    }
+}
+
+/// The [`Parts`] of the results in the tree's order.
+fn into_input_order(per_point: &[PerPoint], order: &[u32]) -> Parts {
     let n = per_point.len();
     let mut normals = vec![Vector3::zeros(); n];
     let mut variation = vec![0.0; n];
