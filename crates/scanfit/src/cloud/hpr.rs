@@ -10,6 +10,9 @@
 //!    `p' = p + 2 (R - |p|) p / |p|` (Katz et al. eq. 1).
 //! 2. *Convex hull*: a point is marked visible when its flipped image is a
 //!    vertex of the convex hull of the flipped points together with `C`.
+//!    From 50 000 points on, the flipped points certainly inside the hull of
+//!    a sample are dropped first (exact predicates, `hpr_filter`): the hull
+//!    of the rest has the same vertices, at a fraction of the cost.
 //!
 //! The radius follows the authors' reference implementation,
 //! `R = max|p - C| * 10^gamma`: the larger `gamma`, the more points near

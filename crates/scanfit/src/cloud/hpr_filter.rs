@@ -32,7 +32,7 @@
 use rayon::prelude::*;
 use robust::{orient3d, Coord3D};
 
-use super::hull::hull_of_coordinates;
+use super::hull::{c3, cross, dot, hull_of_coordinates};
 
 /// Clouds smaller than this go to the hull whole (the filter's sample hull
 /// and grid would not pay for themselves).
@@ -44,14 +44,6 @@ const SAMPLE_STRIDE: usize = 16;
 /// Smallest cosine between a direction and the mean direction for which
 /// the gnomonic projection is used (cos 78 degrees).
 const MIN_COS: f64 = 0.2;
-
-fn c3(p: &[f64; 3]) -> Coord3D<f64> {
-    Coord3D {
-        x: p[0],
-        y: p[1],
-        z: p[2],
-    }
-}
 
 const ORIGIN: Coord3D<f64> = Coord3D {
     x: 0.0,
@@ -105,18 +97,6 @@ struct Gnomonic {
     m: [f64; 3],
     e1: [f64; 3],
     e2: [f64; 3],
-}
-
-fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 fn unit(a: [f64; 3]) -> Option<[f64; 3]> {
