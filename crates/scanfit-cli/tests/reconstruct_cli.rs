@@ -119,20 +119,20 @@ fn can_report_pictures_and_mesh() {
     assert!(out.contains("largest gap along an edge"), "{out}");
 }
 
-#[test]
-fn ignored_cap_leaves_an_open_can() {
-    let d = tmpdir("reconstruct", "ignore");
+/// The JSON report of `reconstruct` with `extra` options on the can of
+/// [`write_can`] with its own labels (in the temporary directory `name`).
+fn can_json(name: &str, extra: &[&str]) -> serde_json::Value {
+    let d = tmpdir("reconstruct", name);
     let input = d.join("can.xyz");
     write_can(&input, |_, l| l.to_string());
-    let out = ok(&run(&[
-        "reconstruct",
-        s(&input),
-        "--ignore",
-        "11",
-        "--json",
-        "-q",
-    ]));
-    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let mut args = vec!["reconstruct", s(&input), "--json", "-q"];
+    args.extend_from_slice(extra);
+    serde_json::from_str(&ok(&run(&args))).unwrap()
+}
+
+#[test]
+fn ignored_cap_leaves_an_open_can() {
+    let j = can_json("ignore", &["--ignore", "11"]);
     assert_eq!(j["totals"]["faces"], 5);
     assert_eq!(j["totals"]["closed"], false);
     let free = j["edges"]
@@ -147,20 +147,7 @@ fn ignored_cap_leaves_an_open_can() {
 
 #[test]
 fn bspline_route() {
-    let d = tmpdir("reconstruct", "bspline");
-    let input = d.join("can.xyz");
-    write_can(&input, |_, l| l.to_string());
-    let out = ok(&run(&[
-        "reconstruct",
-        s(&input),
-        "--fit",
-        "bspline",
-        "--ctrl",
-        "6x6",
-        "--json",
-        "-q",
-    ]));
-    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let j = can_json("bspline", &["--fit", "bspline", "--ctrl", "6x6"]);
     let t = &j["totals"];
     assert!(t["max_gap"].as_f64().unwrap() <= 1e-9 * t["diagonal"].as_f64().unwrap());
     assert!(t["orthogonal"]["rmse"].as_f64().unwrap() < 0.006, "{t}");
@@ -474,20 +461,7 @@ fn umbrella_is_one_open_shell_of_three_sided_panels() {
 fn can_as_revolve_layout() {
     // the file's labels are replaced by 4 sectors x 2 bands and 4 three-sided
     // patches on each flat cap (closed ends, decided from the data)
-    let d = tmpdir("reconstruct", "revolve");
-    let input = d.join("can.xyz");
-    write_can(&input, |_, l| l.to_string());
-    let out = ok(&run(&[
-        "reconstruct",
-        s(&input),
-        "--layout",
-        "revolve:4x2",
-        "--axis",
-        "z",
-        "--json",
-        "-q",
-    ]));
-    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let j = can_json("revolve", &["--layout", "revolve:4x2", "--axis", "z"]);
     let t = &j["totals"];
     assert_eq!(t["faces"], 16, "{t}");
     let layout = j["layout"].as_str().unwrap();
@@ -542,4 +516,77 @@ fn layout_values_are_checked() {
         &["--layout", "grid:2x2"],
     );
     assert!(e.contains("grid layout needs a sheet"), "{e}");
+}
+
+/// A square sheet `[0, 2]^2` on a gentle dome as `x y z label` (quarters
+/// 0-3), uniform noise 0.02 wide; quarter 3 thinned to every third row and
+/// column over `[1.1, 1.9]^2`, where a 12 x 12 least-squares net flies off.
+fn write_sheet_with_a_sparse_quarter(path: &Path) {
+    let mut seed = 5u64;
+    let mut noise = || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        0.02 * ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5)
+    };
+    let n = 60;
+    let mut out = String::from("x y z label\n");
+    for i in 0..n {
+        for j in 0..n {
+            let (x, y) = ((i as f64 + 0.5) / 30.0, (j as f64 + 0.5) / 30.0);
+            let l = u8::from(x > 1.0) + 2 * u8::from(y > 1.0);
+            let inner = (x - 1.5).abs() < 0.4 && (y - 1.5).abs() < 0.4;
+            if l == 3 && inner && (i % 3 != 0 || j % 3 != 0) {
+                continue;
+            }
+            let z = 0.1 * (x * (2.0 - x) + y * (2.0 - y)) + noise();
+            writeln!(out, "{x:.6} {y:.6} {z:.6} {l}").unwrap();
+        }
+    }
+    std::fs::write(path, out).unwrap();
+}
+
+/// A patch that leaves its data is refused in one line naming it and the
+/// fixes (as fit, mba, coons and turntable refuse theirs), nothing written;
+/// `--allow-extrapolation` writes it and reports how far it left.
+#[test]
+fn a_patch_that_leaves_its_data_is_refused_by_name() {
+    let d = tmpdir("reconstruct", "leaves");
+    let input = d.join("sheet.xyz");
+    write_sheet_with_a_sparse_quarter(&input);
+    let model = d.join("m.json");
+    let args = [
+        "reconstruct",
+        s(&input),
+        "--fit",
+        "bspline",
+        "--ctrl",
+        "12x12",
+        "-o",
+        s(&model),
+        "-q",
+    ];
+    let o = run(&args);
+    assert!(!o.status.success());
+    assert!(!model.exists(), "a model was written");
+    let e = String::from_utf8_lossy(&o.stderr);
+    let line = e.lines().find(|l| l.contains("leaves the data")).unwrap();
+    assert!(
+        line.contains("patch 3: the surface leaves the data")
+            && line.contains("--ctrl, now 12x12")
+            && line.contains("--allow-extrapolation"),
+        "{e}"
+    );
+    let mut allowed = args.to_vec();
+    allowed.extend(["--allow-extrapolation", "--json"]);
+    let j: serde_json::Value = serde_json::from_str(&ok(&run(&allowed))).unwrap();
+    assert!(model.exists());
+    for p in j["patches"].as_array().unwrap() {
+        let (out, limit) = (
+            p["outside_box"].as_f64().unwrap(),
+            p["outside_box_limit"].as_f64().unwrap(),
+        );
+        assert_eq!(p["leaves_data"], p["id"] == 3, "{p}");
+        assert_eq!(out > limit, p["id"] == 3, "{p}");
+    }
 }
