@@ -10,10 +10,21 @@ use common::{ok, run, tmpdir};
 
 use std::f64::consts::{PI, TAU};
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
+}
+
+/// Deterministic noise uniform in `[-width / 2, width / 2)` (a 64-bit
+/// linear congruential generator from `seed`).
+fn uniform_noise(mut seed: u64, width: f64) -> impl FnMut() -> f64 {
+    move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        width * ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5)
+    }
 }
 
 /// A closed can (radius 1, height 2) as a text file `x y z label`: side
@@ -26,13 +37,7 @@ fn write_can(path: &Path, label: impl Fn(usize, i64) -> String) {
 /// [`write_can`] with `sectors` side sectors (labels `0..sectors`): with 6,
 /// each cap has 6 corners and two of its sides run over two edges.
 fn write_can_sectors(path: &Path, sectors: usize, label: impl Fn(usize, i64) -> String) {
-    let mut seed = 17u64;
-    let mut noise = || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        0.004 * ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5)
-    };
+    let mut noise = uniform_noise(17, 0.004);
     let h = 0.035;
     let mut out = String::from("x y z label\n");
     let mut k = 0;
@@ -212,6 +217,25 @@ fn missing_label_attribute_is_named() {
     assert!(e.contains("'segment'") && e.contains("label"), "{e}");
 }
 
+/// `reconstruct INPUT -o m.json --step m.stp --iges m.igs --json` in `dir`:
+/// the JSON report and the three paths.
+fn model_outputs(input: &Path, dir: &Path) -> (serde_json::Value, [PathBuf; 3]) {
+    let files = ["m.json", "m.stp", "m.igs"].map(|f| dir.join(f));
+    let out = ok(&run(&[
+        "reconstruct",
+        s(input),
+        "-o",
+        s(&files[0]),
+        "--step",
+        s(&files[1]),
+        "--iges",
+        s(&files[2]),
+        "--json",
+        "-q",
+    ]));
+    (serde_json::from_str(&out).unwrap(), files)
+}
+
 fn occ_available() -> bool {
     std::process::Command::new("python3")
         .args(["-c", "import OCP"])
@@ -260,20 +284,7 @@ fn vessel_is_one_valid_solid_of_the_true_volume() {
         &std::fs::read_to_string(common::examples().join("vessel_30k.json")).unwrap(),
     )
     .unwrap();
-    let (json, step, iges) = (d.join("v.json"), d.join("v.stp"), d.join("v.igs"));
-    let out = ok(&run(&[
-        "reconstruct",
-        s(&input),
-        "-o",
-        s(&json),
-        "--step",
-        s(&step),
-        "--iges",
-        s(&iges),
-        "--json",
-        "-q",
-    ]));
-    let r: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let (r, [json, step, iges]) = model_outputs(&input, &d);
     let t = &r["totals"];
     assert_eq!(t["faces"], 14);
     assert_eq!(t["closed"], true);
@@ -324,20 +335,7 @@ fn caps_with_six_corners_are_written_as_one_solid() {
     let d = tmpdir("reconstruct", "six");
     let input = d.join("can6.xyz");
     write_can_sectors(&input, 6, |_, l| l.to_string());
-    let (json, step, iges) = (d.join("c.json"), d.join("c.stp"), d.join("c.igs"));
-    let out = ok(&run(&[
-        "reconstruct",
-        s(&input),
-        "-o",
-        s(&json),
-        "--step",
-        s(&step),
-        "--iges",
-        s(&iges),
-        "--json",
-        "-q",
-    ]));
-    let r: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let (r, [json, step, iges]) = model_outputs(&input, &d);
     let t = &r["totals"];
     assert_eq!(
         (t["faces"].as_u64(), t["edges"].as_u64()),
@@ -419,18 +417,7 @@ fn caps_with_six_corners_are_written_as_one_solid() {
 fn umbrella_is_one_open_shell_of_three_sided_panels() {
     let d = tmpdir("reconstruct", "umbrella");
     let input = common::examples().join("umbrella_20k.ply");
-    let (json, step) = (d.join("u.json"), d.join("u.stp"));
-    let out = ok(&run(&[
-        "reconstruct",
-        s(&input),
-        "-o",
-        s(&json),
-        "--step",
-        s(&step),
-        "--json",
-        "-q",
-    ]));
-    let r: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let (r, [json, step, _]) = model_outputs(&input, &d);
     assert_eq!(r["totals"]["faces"], 8);
     assert_eq!(r["totals"]["corners"], 9);
     assert_eq!(r["totals"]["edges"], 16);
@@ -522,13 +509,7 @@ fn layout_values_are_checked() {
 /// 0-3), uniform noise 0.02 wide; quarter 3 thinned to every third row and
 /// column over `[1.1, 1.9]^2`, where a 12 x 12 least-squares net flies off.
 fn write_sheet_with_a_sparse_quarter(path: &Path) {
-    let mut seed = 5u64;
-    let mut noise = || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        0.02 * ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5)
-    };
+    let mut noise = uniform_noise(5, 0.02);
     let n = 60;
     let mut out = String::from("x y z label\n");
     for i in 0..n {

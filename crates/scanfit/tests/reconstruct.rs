@@ -249,6 +249,21 @@ fn closed_can_with_bspline_fit() {
     }
 }
 
+/// No gap along any edge beyond round-off, and the orthogonal RMSE over
+/// every point within 3 `sigma` of the noise.
+fn gapless_within_noise(r: &scanfit::pipeline::reconstruct::ReconstructReport, sigma: f64) {
+    assert!(
+        r.totals.max_gap <= 1e-9 * r.totals.diagonal,
+        "{:e}",
+        r.totals.max_gap
+    );
+    assert!(
+        r.totals.orthogonal.rmse < 3.0 * sigma,
+        "{:?}",
+        r.totals.orthogonal
+    );
+}
+
 #[test]
 fn sheet_in_four_quarters() {
     let sigma = 0.001;
@@ -260,16 +275,7 @@ fn sheet_in_four_quarters() {
     assert!(!r.totals.closed);
     assert_eq!(r.edges.iter().filter(|e| e.patches[1].is_none()).count(), 8);
     assert!(r.patches.iter().all(|p| p.sides == 4));
-    assert!(
-        r.totals.max_gap <= 1e-9 * r.totals.diagonal,
-        "{:e}",
-        r.totals.max_gap
-    );
-    assert!(
-        r.totals.orthogonal.rmse < 3.0 * sigma,
-        "{:?}",
-        r.totals.orthogonal
-    );
+    gapless_within_noise(&r, sigma);
     // the centre vertex near (1, 1)
     let c = r
         .network
@@ -291,16 +297,7 @@ fn umbrella_of_three_sided_panels() {
     let model = &r.complex;
     model.validate_with(1e-9).unwrap();
     assert_eq!(model.border_edges().len(), 8);
-    assert!(
-        r.totals.max_gap <= 1e-9 * r.totals.diagonal,
-        "{:e}",
-        r.totals.max_gap
-    );
-    assert!(
-        r.totals.orthogonal.rmse < 3.0 * sigma,
-        "{:?}",
-        r.totals.orthogonal
-    );
+    gapless_within_noise(&r, sigma);
     // the apex: the vertex all 8 radial edges share, on top of the cap
     let top = r
         .network
