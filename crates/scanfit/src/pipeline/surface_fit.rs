@@ -250,6 +250,26 @@ mod tests {
     use crate::progress::NoProgress;
     use crate::Point3;
 
+    #[test]
+    fn the_default_fit_of_a_height_field_of_large_relief_does_not_fold() {
+        // Franke's function (relief 1.2 over the unit square): the best-fit
+        // plane folded the bumps over; the default fit projects along z
+        let pts =
+            crate::testdata::scattered(20_000, 29, [0.0, 0.0, 1.0, 1.0], crate::testdata::franke);
+        let r = run(
+            &PointCloud::new(pts).unwrap(),
+            &FitConfig::default(),
+            &NoProgress,
+        )
+        .unwrap();
+        let p = r.projection.unwrap();
+        assert_eq!(p.axis, crate::base::ProjectionAxis::Z);
+        let q = &r.assessment.quality;
+        assert_eq!(q.parameterization.fold_overs, 0);
+        assert!(!q.extent.leaves, "{:?}", q.extent);
+        assert!(q.orthogonal.rmse < 1.2e-3, "{:?}", q.orthogonal);
+    }
+
     fn wave(n: usize) -> Vec<Point3> {
         (0..n * n)
             .map(|k| {
