@@ -291,19 +291,21 @@ pub fn run(a: FitArgs) -> Result<()> {
     write_all_atomic(&files)?;
     progress.finish();
     if a.json {
-        let report = serde_json::json!({
+        let mut report = serde_json::json!({
             "input": a.input.input.display().to_string(),
             "point_count": pts.len(),
             "degree": [a.degree.0, a.degree.1],
             "control_points": [r.surface.counts().0, r.surface.counts().1],
             "parameters": name(&a.params),
-            "projection": r.projection.as_ref().map(projection_json),
             "quality": quality,
             "samples_to_points": samples_json(q),
             "measure": crate::measure::json(&r.assessment),
             "trim": crate::cad::trim_json(trimmed.as_ref()),
             "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
         });
+        if let Some(p) = &r.projection {
+            report["projection"] = projection_json(p);
+        }
         out!(
             "{}",
             scanfit_io::json::finite_json(&report, "the JSON report")?
