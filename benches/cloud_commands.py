@@ -12,7 +12,8 @@ Data (numpy, fixed seeds; written once to --dir, not committed):
                      (the segmentation bench's cloud: six faces, twelve creases), float64.
     patch_1e6.ply    10^6 points of examples/data/make_clouds.py's bent panel with a hole (same
                      formula, noise 0.05% of the diagonal), float64: `cloud normals`, `coons --pde`.
-    blob_1e6.ply     10^6 points of make_clouds.py's egg-shaped bumpy blob, float64: `turntable`.
+    blob_1e6.ply     10^6 points of make_clouds.py's egg-shaped bumpy blob, float64: `turntable`,
+                     `cloud hpr`.
     sheet_1e7.ply    10^7 points of a jittered terrain-like sheet over [0, 100]^2, float32 x, y, z
                      (a 120 MB binary PLY, as issue 18's `cloud info` row): `cloud info`.
 
@@ -21,6 +22,7 @@ Commands timed (outputs go to --dir):
     scanfit cloud info sheet_1e7.ply
     scanfit cloud normals patch_1e6.ply --k 20 --orient view:50,35,1000 -o normals.ply --quiet
     scanfit turntable blob_1e6.ply -o blob.json --quiet
+    scanfit cloud hpr blob_1e6.ply --view 0,0,150 -o hpr.ply --quiet   (6 half-depths above the blob)
     scanfit coons patch_1e6.ply --pde 5x5 -o patch.json --quiet
 
 Run (from the repository root, after `cargo build --release -p scanfit-cli`):
@@ -114,6 +116,7 @@ COMMANDS = {
         "-o", "normals.ply", "--quiet",
     ],
     "turntable": ["turntable", "blob_1e6.ply", "-o", "blob.json", "--quiet"],
+    "hpr": ["cloud", "hpr", "blob_1e6.ply", "--view", "0,0,150", "-o", "hpr.ply", "--quiet"],
     "coons_pde": ["coons", "patch_1e6.ply", "--pde", "5x5", "-o", "patch.json", "--quiet"],
 }
 

@@ -18,8 +18,11 @@ What it runs (nothing is built here; build both first)
         line with fit_s, fit_cpu_s (std::clock() around the constructor) and heldout_rmse. The
         peer's code and the driver stay out of this repository.
     whole command:      target/release/scanfit mba POINTS --levels 8 --base 1x1 --start START -o OUT.json --quiet
-        against the driver's whole process (read, fit, held-out evaluation), both under
-        /usr/bin/time for the wall time and the peak resident memory.
+        (the default: it also measures the surface and trims it to the cloud's outline), and
+        the same with --measure none --no-trim (the peer's work: read, fit, write), against the
+        driver's whole process (read, fit, held-out evaluation), all under /usr/bin/time for
+        the wall time, the CPU time and the peak resident memory. Run the script as
+        `nice -n -15 python3 ...` (as root) on a shared machine: the children inherit it.
 
 Data: benches/peers/mba_data.py (Franke's function on uniform random points, seed 18).
 
@@ -93,12 +96,13 @@ def row(a: argparse.Namespace, n: int) -> dict:
             rmse["peer"] = p["heldout_rmse"]
             if not a.fit_only:
                 for st in a.starts:
-                    w, c, m, _ = timed(
-                        [str(a.scanfit), "mba", pts, "--levels", lv, "--base", "1x1", "--start", st, "-o", out, "--quiet"]
-                    )
-                    add(f"s_{st}_whole", w)
-                    add(f"s_{st}_whole_cpu", c)
-                    add(f"s_{st}_mem", m)
+                    cmd = [str(a.scanfit), "mba", pts, "--levels", lv, "--base", "1x1", "--start", st, "-o", out, "--quiet"]
+                    # the default (measures and trims), then the peer's work: read, fit, write
+                    for tag, extra in (("whole", []), ("equal", ["--measure", "none", "--no-trim"])):
+                        w, c, m, _ = timed(cmd + extra)
+                        add(f"s_{st}_{tag}", w)
+                        add(f"s_{st}_{tag}_cpu", c)
+                        add(f"s_{st}_{tag}_mem", m)
             load.append(os.getloadavg()[0])
     res = {k: stats(v) if isinstance(v, list) and k != "control_points" else v for k, v in r.items()}
     res.update(points=n, heldout_rmse=rmse, load_average_1min=load)
@@ -139,7 +143,10 @@ def main() -> None:
                 runs += [
                     (f"whole command, `{st}`", f"s_{st}_whole", "p_whole", "s"),
                     (f"whole command, `{st}`, CPU time", f"s_{st}_whole_cpu", "p_whole_cpu", "s"),
-                    (f"peak memory, whole command, `{st}`", f"s_{st}_mem", "p_mem", "MB"),
+                    (f"peak memory, whole command, `{st}`", f"s_{st}_whole_mem", "p_mem", "MB"),
+                    (f"whole command, the peer's work (`--measure none --no-trim`), `{st}`", f"s_{st}_equal", "p_whole", "s"),
+                    (f"the peer's work, `{st}`, CPU time", f"s_{st}_equal_cpu", "p_whole_cpu", "s"),
+                    (f"peak memory, the peer's work, `{st}`", f"s_{st}_equal_mem", "p_mem", "MB"),
                 ]
             for name, s, p, unit in runs:
                 sb, sm, pb, pm = r[s]["best"], r[s]["median"], r[p]["best"], r[p]["median"]

@@ -2,13 +2,17 @@
 process, bytes per worker per level (issue 17; BENCHMARKS.md, docs/scale-out.md).
 
     python benches/scale/dask_mba.py N [--chunk 1000000] [--levels 10] [--workers 2] [--single]
-        [--base MxN] [--ply FILE] [--compare JSON] [--save JSON]
+        [--base MxN] [--ply FILE] [--tiles FILE ...] [--task-points M] [--up auto|x|y|z]
+        [--compare JSON] [--save JSON]
 
 The points are generated on the workers (a deterministic terrain per chunk, seeded
 by the chunk's index), so nothing is read or sent by the client; with --ply FILE
 (a binary little-endian PLY of x, y, z float64 only, e.g. make_franke.py's) each
 worker reads its chunks' rows of that file itself instead (the input the CLI
-reads). --single also runs scanfit.mba in this process on the same points (they
+reads). With --tiles FILE ... the workers read the point files themselves with
+scanfit.PointChunks, --chunk rows at a time (the tiles' rows must add up to N), and
+--task-points M splits tiles of more than M rows into tasks of row ranges (the
+report's `dask_tasks`). --single also runs scanfit.mba in this process on the same points (they
 must fit in memory) and compares the surfaces; --compare JSON compares with the
 surface of a `scanfit mba -o JSON` run (e.g. the streaming CLI's, run.py); --save
 JSON writes the Dask surface (scanfit/1 JSON) to compare later. Prints one JSON line.
@@ -72,6 +76,9 @@ def main():
     ap.add_argument("--single", action="store_true")
     ap.add_argument("--base", help="cells of the first lattice, MxN (as the CLI's --base)")
     ap.add_argument("--ply")
+    ap.add_argument("--tiles", nargs="+")
+    ap.add_argument("--task-points", type=int)
+    ap.add_argument("--up", default="auto")
     ap.add_argument("--compare")
     ap.add_argument("--save")
     a = ap.parse_args()
@@ -83,6 +90,8 @@ def main():
     import scanfit
     import scanfit.dask as sd
 
+    if a.tiles and (a.single or a.ply):
+        raise SystemExit("--tiles reads its own files: compare with --compare JSON, not --single or --ply")
     sizes = [a.chunk] * (a.n // a.chunk) + ([a.n % a.chunk] if a.n % a.chunk else [])
     if a.ply:
         offset, rows = ply_layout(a.ply)
@@ -100,17 +109,21 @@ def main():
             da.from_delayed(delayed(terrain_block)(k, r, a.n), shape=(r, 3), dtype=np.float64)
             for k, r in enumerate(sizes)
         ]
-    points = da.concatenate(blocks)
+    points = a.tiles or da.concatenate(blocks)
     out = {"points": a.n, "chunk": a.chunk, "levels": a.levels, "workers": a.workers,
-           "input": a.ply or "generated on the workers", "load_before": os.getloadavg()}
+           "input": a.tiles or a.ply or "generated on the workers",
+           "task_points": a.task_points, "load_before": os.getloadavg()}
     with LocalCluster(
         n_workers=a.workers, threads_per_worker=1, processes=True, dashboard_address=None
     ) as cluster, Client(cluster) as client:
         sent0 = client.run(lambda dask_worker: dask_worker.transfer_outgoing_bytes_total)
         t0 = time.perf_counter()
         base = tuple(int(v) for v in a.base.split("x")) if a.base else None
-        r = sd.mba(points, levels=a.levels, base=base)
+        tiles = {"chunk_points": a.chunk, "task_points": a.task_points} if a.tiles else {}
+        r = sd.mba(points, levels=a.levels, base=base, up=a.up, **tiles)
         out["dask_seconds"] = time.perf_counter() - t0
+        out["dask_tasks"] = r["tasks"]
+        out["up"] = r["up"]
         sent1 = client.run(lambda dask_worker: dask_worker.transfer_outgoing_bytes_total)
         out["dask_passes"] = r["passes"]
         out["broadcast_bytes_per_level"] = r["broadcast_bytes"]

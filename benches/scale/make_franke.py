@@ -15,6 +15,12 @@ point with --uv): write them under /tmp, never commit them.
 writes the same points as a LAS 1.2 file of point format 0 (20-byte
 records, coordinates stored as integers at a scale of 1e-7, one return of
 one, class 2), for the LAS rows of "Peak memory of fit and mba".
+
+    python3 benches/scale/make_franke.py N OUT.ply --xy-scale 10
+
+stretches x and y to [0, 10] (z unchanged): a height field flat enough for
+the best-fit plane of `scanfit fit`'s default parameters (on the unit square
+Franke's heights spread as much as x and y, so the plane's normal is not z).
 """
 import sys
 
@@ -33,13 +39,14 @@ def main():
         sys.exit(__doc__)
     n, out = int(sys.argv[1]), sys.argv[2]
     uv = "--uv" in sys.argv[3:]
+    scale = float(sys.argv[sys.argv.index("--xy-scale") + 1]) if "--xy-scale" in sys.argv else 1.0
     rng = np.random.default_rng(18)
     x = rng.random(n)
     y = rng.random(n)
     if out.endswith(".las"):
         write_las(out, x, y, franke(x, y))
         return
-    cols = [x, y, franke(x, y)] + ([x, y] if uv else [])
+    cols = [scale * x, scale * y, franke(x, y)] + ([x, y] if uv else [])
     names = ["x", "y", "z"] + (["u", "v"] if uv else [])
     header = "ply\nformat binary_little_endian 1.0\n"
     header += f"element vertex {n}\n"

@@ -7,7 +7,7 @@ make_franke.py.
     python3 benches/scale/make_franke.py 1000000 /tmp/franke_1000000.ply
     python3 benches/scale/make_franke.py 1000000 /tmp/franke_uv_1000000.ply --uv
     python3 benches/scale/make_franke.py 10000000 /tmp/franke_10000000.las
-    python3 benches/scale/run.py target/release/scanfit 1000000 [--repeat 3] [--only fit|mba|mba_notrim|mba_las|mba_las_streamed] [--out-dir /tmp] [-- EXTRA...]
+    python3 benches/scale/run.py target/release/scanfit 1000000 [--repeat 3] [--only fit|fit_streamed|fit_plane|fit_plane_streamed|mba|mba_notrim|mba_las|mba_las_streamed|mba_laz1|mba_laz1_streamed] [--out-dir /tmp] [-- EXTRA...]
 
 Each command runs `--repeat` times (default 3) under `/usr/bin/time -v`
 with SCANFIT_TIMINGS=1 (the CLI then prints each stage's wall time); the
@@ -17,7 +17,18 @@ average before and after (the machine is shared). Arguments after `--` are
 added to every command (e.g. `--measure full`). When /tmp/franke_N.las
 exists, `mba` also runs on it in memory (`mba_las`) and streamed in chunks
 of 10^6 points (`mba_las_streamed`, `--chunk-points 1000000`); `mba_notrim` is
-`mba` with `--no-trim` (the trim's cost is the difference).
+`mba` with `--no-trim` (the trim's cost is the difference). `fit_streamed`
+is `fit` read in chunks of 10^6 points; `fit_plane` is `fit` with its
+defaults (best-fit plane, distribution knots; untrimmed) on /tmp/franke_N.ply,
+`fit_plane_streamed` the same in chunks of 10^6 points (plane and knots as
+passes of sums); their input is `make_franke.py N /tmp/franke_xy10_N.ply
+--xy-scale 10` (on the unit square the plane is not a height field's).
+When
+/tmp/franke_N_c1.laz exists (the LAS as a compressor-1 LAZ: `cargo run
+--release -p scanfit-io --example laz_pointwise -- /tmp/franke_N.las
+/tmp/franke_N_c1.laz`), the same two runs on it (`mba_laz1`,
+`mba_laz1_streamed`): streamed, its one LAZ chunk of all points is decoded
+a requested chunk at a time.
 """
 import os
 import re
@@ -64,12 +75,17 @@ def main():
     }
     # the same without the trim's alpha shape: its cost is the difference
     commands["mba_notrim"] = commands["mba"] + ["--no-trim"]
-    las = f"/tmp/franke_{n}.las"
-    if os.path.exists(las):
-        mba_las = [binary, "mba", las, "--levels", "8", "--base", "1x1",
-                   "-o", f"{out}/scale_mba_las.json", "--json", "-q"]
-        commands["mba_las"] = mba_las
-        commands["mba_las_streamed"] = mba_las + ["--chunk-points", "1000000"]
+    commands["fit_streamed"] = commands["fit"] + ["--chunk-points", "1000000"]
+    commands["fit_plane"] = [binary, "fit", f"/tmp/franke_xy10_{n}.ply", "--ctrl", "64x64",
+                             "--no-trim", "-o", f"{out}/scale_fit_plane.json", "--json", "-q"]
+    commands["fit_plane_streamed"] = commands["fit_plane"] + ["--chunk-points", "1000000"]
+    # the LAS and its compressor-1 LAZ, in memory and streamed
+    for key, path in (("las", f"/tmp/franke_{n}.las"), ("laz1", f"/tmp/franke_{n}_c1.laz")):
+        if os.path.exists(path):
+            cmd = [binary, "mba", path, "--levels", "8", "--base", "1x1",
+                   "-o", f"{out}/scale_mba_{key}.json", "--json", "-q"]
+            commands[f"mba_{key}"] = cmd
+            commands[f"mba_{key}_streamed"] = cmd + ["--chunk-points", "1000000"]
     for name, cmd in commands.items():
         if only and name != only:
             continue

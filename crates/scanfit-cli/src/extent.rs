@@ -13,7 +13,12 @@ pub fn check(e: &Extent, allow: bool, fix: &str) -> Result<()> {
     if !e.leaves || allow {
         return Ok(());
     }
-    bail!(
+    bail!("{}", message(e, fix))
+}
+
+/// The refusal's line for `e` (see [`check`]).
+pub fn message(e: &Extent, fix: &str) -> String {
+    format!(
         "the surface leaves the data: samples reach {} ({:.0} point spacings, {:.1}% of the diagonal) outside the points' bounding box and control points {} (limit {}); {fix}, or pass --allow-extrapolation to write it anyway",
         num(e.samples_outside),
         e.samples_outside_spacings,

@@ -59,7 +59,7 @@ pub enum WeightArg {
 pub enum StartArg {
     /// The mean height.
     Mean,
-    /// The constant of least squares (in memory only).
+    /// The constant of least squares.
     Fitted,
 }
 
@@ -92,12 +92,13 @@ pub struct MbaArgs {
     /// Stop once the vertical RMSE (or, with --adjust, the eq. 17 RMSE) is at most E [data units].
     #[arg(long, value_name = "E", allow_negative_numbers = true)]
     pub tolerance: Option<f64>,
-    /// Start of level 0: mean (the mean height), or fitted (the constant
-    /// that leaves the smallest final residual at the points: 21% lower
-    /// held-out error than the mean on Franke's function, at the same CPU
-    /// time; not with --chunk-points or --adjust).
-    #[arg(long, default_value = "mean", value_name = "S", value_parser = choice::<StartArg>())]
-    pub start: StartArg,
+    /// Start of level 0: fitted (the constant that leaves the smallest
+    /// final residual at the points: 21% lower held-out error than the mean
+    /// on Franke's function, at the same CPU time in memory; streamed, one
+    /// more pass) or mean (the mean height) [default: fitted; mean with
+    /// --adjust, which refuses fitted].
+    #[arg(long, value_name = "S", value_parser = choice::<StartArg>())]
+    pub start: Option<StartArg>,
     /// Hjelle's control-value formula (turntable paper eq. 6) instead of eq. 4.
     #[arg(long)]
     pub hjelle: bool,
@@ -147,7 +148,7 @@ impl MbaArgs {
         } else {
             ControlFormula::LeeWolbergShin
         };
-        c.mba.start = match self.start {
+        c.mba.start = match self.start() {
             StartArg::Mean => Start::Mean,
             StartArg::Fitted => Start::Fitted,
         };
@@ -164,6 +165,16 @@ impl MbaArgs {
         // anyway: the assessment keeps no per-point values
         c.assess = self.out.measure.config(c.assess, false);
         c
+    }
+
+    /// The start of level 0: the one given, else fitted (mean with
+    /// `--adjust`, which starts from the mean).
+    pub(crate) fn start(&self) -> StartArg {
+        self.start.unwrap_or(if self.adjust {
+            StartArg::Mean
+        } else {
+            StartArg::Fitted
+        })
     }
 
     /// The settings recorded in the surface document.
@@ -184,9 +195,11 @@ impl MbaArgs {
             "lee-wolberg-shin"
         };
         s.insert("formula".into(), formula.into());
-        if self.start == StartArg::Fitted {
-            s.insert("start".into(), "fitted".into());
-        }
+        let start = match self.start() {
+            StartArg::Fitted => "fitted",
+            StartArg::Mean => "mean",
+        };
+        s.insert("start".into(), start.into());
         if self.adjust {
             s.insert("adjust_alpha".into(), self.alpha.into());
             s.insert(
@@ -240,6 +253,11 @@ pub fn run(a: MbaArgs) -> Result<()> {
     a.out.check(&a.input.input, &[])?;
     if a.levels == 0 {
         anyhow::bail!("--levels must be at least 1");
+    }
+    if a.adjust && a.start == Some(StartArg::Fitted) {
+        anyhow::bail!(
+            "--start fitted cannot be used with --adjust: the adjustment changes the lattices between levels, so the constant's levels no longer give the start; it starts from the mean (leave --start out)"
+        );
     }
     if let Some(n) = a.chunk_points {
         if a.trim.trim {
@@ -365,7 +383,10 @@ fn note_lattice(a: &MbaArgs, points: &[scanfit::Point3]) {
 }
 
 /// The per-level table (in memory and streamed).
-pub(crate) fn levels_table(levels: &[LevelRow], adjust: bool) -> String {
+///
+/// `eq17`: whether the rows' eq. 17 was measured (not with `--measure none`
+/// in memory: it needs a KD-tree of all points; "-" then).
+pub(crate) fn levels_table(levels: &[LevelRow], adjust: bool, eq17: bool) -> String {
     let mut head = vec![
         "level",
         "control net",
@@ -386,7 +407,11 @@ pub(crate) fn levels_table(levels: &[LevelRow], adjust: bool) -> String {
             num(l.vertical.mean),
             num(l.vertical.max),
             num(l.vertical.rmse),
-            num(l.grid_rmse),
+            if eq17 || adjust {
+                num(l.grid_rmse)
+            } else {
+                "-".into()
+            },
         ];
         if adjust {
             cells.push(l.adjusted.map_or("-".into(), |x| num(x.vertical_rmse)));
@@ -430,7 +455,8 @@ fn print_report(a: &MbaArgs, r: &MbaReport) -> Result<()> {
         if a.adjust { ", adjusted" } else { "" },
         r.seconds
     );
-    out!("{}", levels_table(&r.levels, a.adjust));
+    let eq17 = !matches!(a.out.measure.measure, crate::measure::MeasureArg::None);
+    out!("{}", levels_table(&r.levels, a.adjust, eq17));
     outln!("(errors in data units)\n");
     out!(
         "{}",

@@ -176,6 +176,11 @@ pub struct ReconstructArgs {
     pub deviation_png: Option<PathBuf>,
     #[command(flatten)]
     pub view: crate::view::ViewArgs,
+    /// Write the model even when a patch leaves its data (samples farther
+    /// outside the bounding box of the patch's points than 10 point spacings
+    /// and a quarter of its diagonal).
+    #[arg(long)]
+    pub allow_extrapolation: bool,
     /// Print the report as JSON on stdout instead of tables.
     #[arg(long)]
     pub json: bool,
@@ -203,7 +208,7 @@ pub fn run(a: ReconstructArgs) -> Result<()> {
     let progress = Progress::spinner(a.quiet);
     let settings = crate::segment::SegmentOptions::SETTINGS;
     let r = reconstruct::run(&cloud, &cfg, &progress)
-        .map_err(|e| anyhow::anyhow!("{}", crate::args::cli_message(&e, &settings)))
+        .map_err(|e| anyhow::anyhow!("{}", error_message(&e, &cfg, &settings)))
         .with_context(|| format!("reconstructing {}", a.input.input.display()))?;
     progress.finish();
     let seconds = t0.elapsed().as_secs_f64();
@@ -232,6 +237,7 @@ fn config(a: &ReconstructArgs) -> Result<ReconstructConfig> {
     }
     cfg.network.contact_factor = a.contact;
     cfg.tolerance = a.export_tolerance;
+    cfg.allow_extrapolation = a.allow_extrapolation;
     cfg.fit = match (a.fit, a.pde) {
         (Some(FitRoute::Bspline), Some(_)) => {
             bail!("--fit bspline and --pde exclude each other; choose one route")
@@ -247,6 +253,33 @@ fn config(a: &ReconstructArgs) -> Result<ReconstructConfig> {
         }
     };
     Ok(cfg)
+}
+
+/// The one line for a failed run: a patch that left its data names the
+/// option that makes its surface stiffer (the route's own) and
+/// `--allow-extrapolation`.
+fn error_message(e: &scanfit::Error, cfg: &ReconstructConfig, settings: &[(&str, &str)]) -> String {
+    match e {
+        scanfit::Error::LeavesData {
+            patch: Some(id),
+            extent,
+        } => {
+            let fix = match cfg.fit {
+                FaceFit::Bspline { ctrl: (m, n) } => {
+                    format!("fit its patches with a coarser net (--ctrl, now {m}x{n})")
+                }
+                FaceFit::Pde(p) => {
+                    format!(
+                        "fit its patches with fewer sine terms (--pde, now {}x{})",
+                        p.m, p.n
+                    )
+                }
+                _ => "fit its patches with fewer control points".to_string(),
+            };
+            format!("patch {id}: {}", crate::extent::message(extent, &fix))
+        }
+        _ => crate::args::cli_message(e, settings),
+    }
 }
 
 /// Where the patch ids come from: the file, `--segment` or `--layout`.
@@ -549,6 +582,9 @@ fn json_report(
             "id": p.id, "sides": p.sides, "edges": p.edges, "points": p.points,
             "coons": stats(&p.coons_errors), "errors": stats(&p.errors), "orthogonal": stats(&p.orthogonal),
             "bspline_deviation": p.conversion_deviation, "fold_overs": p.fold_overs,
+            "outside_box": p.extent.samples_outside, "outside_box_spacings": p.extent.samples_outside_spacings,
+            "control_net_outside_box": p.extent.control_outside, "outside_box_limit": p.extent.limit,
+            "leaves_data": p.extent.leaves,
         })).collect::<Vec<_>>(),
         "edges": r.edges.iter().map(|e| serde_json::json!({
             "vertices": e.vertices, "patches": e.patches.iter().flatten().collect::<Vec<_>>(), "max_gap": e.max_gap,

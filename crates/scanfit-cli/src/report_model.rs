@@ -58,7 +58,10 @@ pub fn run(a: ReportArgs) -> Result<()> {
 fn assignment(r: &ModelMeasureReport) -> String {
     match &r.assignment {
         Assignment::Labels(n) => format!("by the label attribute '{n}'"),
-        Assignment::Nearest => "to the nearest patch (the cloud has no label attribute)".into(),
+        Assignment::Nearest => {
+            "to the patch at the smallest orthogonal distance (the cloud has no label attribute)"
+                .into()
+        }
     }
 }
 

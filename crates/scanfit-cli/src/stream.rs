@@ -75,8 +75,9 @@ pub fn fit(a: &FitArgs, chunk: usize) -> Result<()> {
     if a.points_out.is_some() {
         bail!("--points-out writes every point's parameters and errors and needs all points at once; leave it out with --chunk-points");
     }
-    let progress = Progress::spinner(a.quiet || a.json);
     let uv = a.params == ParamsArg::UvColumns;
+    trim_note(a, !uv)?;
+    let progress = Progress::spinner(a.quiet || a.json);
     let mut s = source(&a.input, chunk, uv, a.quiet || a.json)?;
     let options = [
         ("knots", "--knots"),
@@ -102,7 +103,10 @@ pub fn fit(a: &FitArgs, chunk: usize) -> Result<()> {
         q.points,
         a.settings(r.surface.counts(), r.smoothing),
     ));
-    doc.quality = Some(quality_doc(q, Vec::new()));
+    doc.quality = Some(quality_doc(
+        q,
+        r.rounds.iter().map(|r| r.errors.rmse).collect(),
+    ));
     let deviation = Deviation {
         per_point: &[],
         stats: q.orthogonal,
@@ -140,6 +144,20 @@ pub fn fit(a: &FitArgs, chunk: usize) -> Result<()> {
         "|P - S(u,v)| at the parameters (eq. 15)",
         "",
     )
+}
+
+/// The streamed fit keeps the parameter rectangle: `--trim` is refused with
+/// the reason, and the plane's default (trimmed) gets a note.
+fn trim_note(a: &FitArgs, plane: bool) -> Result<()> {
+    if a.trim.trim {
+        bail!("--trim cannot be used with --chunk-points: the face's outline and holes (an alpha shape) need all points at once; leave --trim out, or run without --chunk-points");
+    }
+    if plane && !a.trim.no_trim && !(a.quiet || a.json) {
+        crate::print_stderr(format_args!(
+            "note: the surface is NOT trimmed: --chunk-points fits the whole parameter rectangle, since the outline needs all points at once; --no-trim silences this note"
+        ));
+    }
+    Ok(())
 }
 
 /// Why a streamed `mba` gives the untrimmed rectangle, and how to get a
@@ -223,7 +241,7 @@ pub fn mba(a: &MbaArgs, chunk: usize) -> Result<()> {
     };
     let levels = format!(
         "{}(errors in data units)\n\n",
-        crate::mba::levels_table(&r.levels, false)
+        crate::mba::levels_table(&r.levels, false, true)
     );
     report.print(
         q,

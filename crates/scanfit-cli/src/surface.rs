@@ -102,8 +102,8 @@ pub struct FitArgs {
     #[arg(long, value_name = "POINTS")]
     pub points_out: Option<PathBuf>,
     /// Read the input in chunks of N points, in passes, so memory depends on
-    /// the control net, not the point count (needs --params uv-columns and
-    /// --knots uniform; text inputs are read in chunks, others whole).
+    /// the control net, not the point count (every --params, --knots and
+    /// --correct, as more passes; the face is not trimmed).
     #[arg(long, value_name = "N")]
     pub chunk_points: Option<usize>,
     /// Print the report as JSON on stdout instead of tables.

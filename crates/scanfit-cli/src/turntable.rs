@@ -319,6 +319,7 @@ fn print_json(
         "quality": quality,
         "fold_overs_inside_layers": t.quality_inside.fold_overs,
         "fold_overs_corrected": t.quality_fitted.fold_overs,
+        "measure": crate::measure::json(&r.assessment),
         "seconds": seconds,
         "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
     });
@@ -469,6 +470,9 @@ fn print_report(
         "fold-overs after projecting the points onto the fitted surface (parameter correction): {} of {}",
         t.quality_fitted.fold_overs, t.quality_fitted.triangles
     );
+    if let Some(note) = crate::measure::note(&r.assessment) {
+        outln!("{note}");
+    }
     if let Some(cmp) = &r.weight_comparison {
         outln!("\nRMSE of the layer samples' nearest-point distances by projection round:");
         let names: Vec<String> = cmp

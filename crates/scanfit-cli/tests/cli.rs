@@ -29,20 +29,33 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// The stdout of `scanfit COMMAND.. INPUT OPTIONS..`, which must succeed.
+fn succeeds(command: &[&str], input: &Path, options: &[&str]) -> String {
+    let mut args = command.to_vec();
+    args.push(s(input));
+    args.extend_from_slice(options);
+    let o = run(&args);
+    assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// The JSON report of [`succeeds`] with `--json`.
+fn json(command: &[&str], input: &Path, options: &[&str]) -> serde_json::Value {
+    let mut options = options.to_vec();
+    options.push("--json");
+    serde_json::from_str(&succeeds(command, input, &options)).unwrap()
+}
+
 #[test]
 fn fit_writes_json_that_reads_back_and_interpolates() {
     let d = tmpdir("fit");
     let out = d.join("c.json");
     let input = examples().join("dataset1.csv");
-    let o = run(&[
-        "curve",
-        "fit",
-        input.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let stdout = String::from_utf8_lossy(&o.stdout);
+    let stdout = succeeds(&["curve", "fit"], &input, &["-o", s(&out)]);
     assert!(
         stdout.contains("max deviation") && stdout.contains("data units"),
         "{stdout}"
@@ -63,18 +76,11 @@ fn fit_writes_json_that_reads_back_and_interpolates() {
 fn fit_json_report_and_least_squares() {
     let input = examples().join("dataset6.csv");
     let report = |smooth: &str| {
-        let o = run(&[
-            "curve",
-            "fit",
-            input.to_str().unwrap(),
-            "--ctrl",
-            "15",
-            "--smooth",
-            smooth,
-            "--json",
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
-        serde_json::from_slice::<serde_json::Value>(&o.stdout).unwrap()
+        json(
+            &["curve", "fit"],
+            &input,
+            &["--ctrl", "15", "--smooth", smooth],
+        )
     };
     let (plain, smooth) = (report("0"), report("1e-3"));
     assert_eq!(smooth["control_points"], 15);
@@ -99,17 +105,11 @@ fn closed_fit_gives_periodic_curve() {
         .collect();
     std::fs::write(&input, pts).unwrap();
     let out = d.join("loop.json");
-    let o = run(&[
-        "curve",
-        "fit",
-        input.to_str().unwrap(),
-        "--closed",
-        "--param",
-        "centripetal",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    succeeds(
+        &["curve", "fit"],
+        &input,
+        &["--closed", "--param", "centripetal", "-o", s(&out)],
+    );
     let (doc, curve) = scanfit_io::json::read_curve(&out).unwrap();
     assert!(doc.periodic && curve.is_periodic());
     assert!((curve.point(0.0) - curve.point(1.0)).norm() < 1e-12);
@@ -120,15 +120,7 @@ fn compare_prints_every_method_and_writes_svg() {
     let d = tmpdir("compare");
     let svg = d.join("ds3.svg");
     let input = examples().join("dataset3.csv");
-    let o = run(&[
-        "curve",
-        "compare",
-        input.to_str().unwrap(),
-        "-o",
-        svg.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let stdout = String::from_utf8_lossy(&o.stdout);
+    let stdout = succeeds(&["curve", "compare"], &input, &["-o", s(&svg)]);
     for m in [
         "centripetal",
         "exponential",
@@ -143,15 +135,7 @@ fn compare_prints_every_method_and_writes_svg() {
     assert!(stdout.contains("dataset3.csv:5 and"), "{stdout}");
     let text = std::fs::read_to_string(&svg).unwrap();
     assert_eq!(text.matches("font-weight=\"bold\">").count(), 8); // title + 7 panels
-    let o = run(&[
-        "curve",
-        "compare",
-        input.to_str().unwrap(),
-        "-o",
-        svg.to_str().unwrap(),
-        "--json",
-    ]);
-    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let v = json(&["curve", "compare"], &input, &["-o", s(&svg)]);
     let hybrid = v["methods"]
         .as_array()
         .unwrap()
@@ -319,16 +303,8 @@ fn review_regressions() {
     // --closed works with the default method (centripetal then)
     let sq = d.join("sq.csv");
     std::fs::write(&sq, "0,0,0\n1,0,0\n1,1,0\n0,1,0\n").unwrap();
-    let o = run(&[
-        "curve",
-        "fit",
-        sq.to_str().unwrap(),
-        "--closed",
-        "--degree",
-        "1",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    assert!(String::from_utf8_lossy(&o.stdout).contains("centripetal"));
+    let stdout = succeeds(&["curve", "fit"], &sq, &["--closed", "--degree", "1"]);
+    assert!(stdout.contains("centripetal"));
 }
 
 /// Writes `n` points of a smooth sheet, with a header, optionally with u, v columns.
@@ -412,31 +388,14 @@ fn surface_fit_from_uv_columns_is_exact_for_representable_data() {
         s += &format!("{},{},{},{u},{v}\n", 3.0 * u + v, 2.0 * v, 0.5 * u * v - u);
     }
     std::fs::write(&input, s).unwrap();
-    let o = run(&[
-        "fit",
-        input.to_str().unwrap(),
-        "--params",
-        "uv-columns",
-        "--ctrl",
-        "6",
-        "--smooth",
-        "0",
-        "--json",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let v = json(
+        &["fit"],
+        &input,
+        &["--params", "uv-columns", "--ctrl", "6", "--smooth", "0"],
+    );
     assert!(v["quality"]["max_error"].as_f64().unwrap() < 1e-9, "{v}");
     // correction rounds appear in the report
-    let o = run(&[
-        "fit",
-        input.to_str().unwrap(),
-        "--ctrl",
-        "6",
-        "--correct",
-        "3",
-        "--json",
-    ]);
-    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let v = json(&["fit"], &input, &["--ctrl", "6", "--correct", "3"]);
     assert!(!v["quality"]["correction_rmse"]
         .as_array()
         .unwrap()

@@ -13,6 +13,27 @@ use std::path::Path;
 use scanfit::Vector3;
 use scanfit_io::{read_cloud, ReadOptions};
 
+/// Runs `scanfit cloud SUB INPUT EXTRA.. -o OUT --png PNG --json`, which
+/// must succeed, and returns its JSON report.
+fn cloud_json(
+    sub: &str,
+    input: &Path,
+    extra: &[&str],
+    out: &Path,
+    png: &Path,
+) -> serde_json::Value {
+    let mut args = vec!["cloud", sub, input.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    args.extend([
+        "-o",
+        out.to_str().unwrap(),
+        "--png",
+        png.to_str().unwrap(),
+        "--json",
+    ]);
+    serde_json::from_str(&ok(&run(&args))).unwrap()
+}
+
 /// Fraction of non-white pixels and whether any touches the image border.
 fn png_coverage(path: &Path) -> (f64, bool) {
     let dec = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
@@ -62,17 +83,7 @@ fn normals_of_a_closed_body_point_outwards() {
     let d = tmpdir("cloud", "normals");
     let (out, png) = (d.join("n.ply"), d.join("n.png"));
     let input = examples().join("blob_30k.ply");
-    let o = run(&[
-        "cloud",
-        "normals",
-        input.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--png",
-        png.to_str().unwrap(),
-        "--json",
-    ]);
-    let v: serde_json::Value = serde_json::from_str(&ok(&o)).unwrap();
+    let v = cloud_json("normals", &input, &[], &out, &png);
     assert_eq!(v["components"], 1);
     assert_eq!(v["degenerate"], 0);
     let cloud = read_cloud(&out, &ReadOptions::default())
@@ -108,19 +119,7 @@ fn hpr_keeps_the_near_side() {
     let d = tmpdir("cloud", "hpr");
     let (out, png) = (d.join("v.xyz"), d.join("v.png"));
     let input = examples().join("blob_30k.ply");
-    let o = run(&[
-        "cloud",
-        "hpr",
-        input.to_str().unwrap(),
-        "--view",
-        "0,0,200",
-        "-o",
-        out.to_str().unwrap(),
-        "--png",
-        png.to_str().unwrap(),
-        "--json",
-    ]);
-    let v: serde_json::Value = serde_json::from_str(&ok(&o)).unwrap();
+    let v = cloud_json("hpr", &input, &["--view", "0,0,200"], &out, &png);
     let visible = v["visible"].as_u64().unwrap() as usize;
     let table = read_cloud(&out, &ReadOptions::default()).unwrap();
     assert_eq!(table.points.len(), visible);
@@ -145,18 +144,7 @@ fn boundary_finds_the_four_corners_of_the_panel() {
     let (json, ply, png) = (d.join("b.json"), d.join("b.ply"), d.join("b.png"));
     let input = examples().join("patch_20k.ply");
     for (out, crit) in [(&json, "angle"), (&ply, "curvature")] {
-        let o = run(&[
-            "cloud",
-            "boundary",
-            input.to_str().unwrap(),
-            "--criterion",
-            crit,
-            "-o",
-            out.to_str().unwrap(),
-            "--png",
-            png.to_str().unwrap(),
-        ]);
-        ok(&o);
+        cloud_json("boundary", &input, &["--criterion", crit], out, &png);
     }
     let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
     // the panel has a hole: two loops, the outer one counter-clockwise

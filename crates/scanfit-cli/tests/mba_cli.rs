@@ -291,7 +291,9 @@ fn a_y_up_terrain_is_fitted_with_y_as_height() {
         (streamed - flat).abs() <= 1e-9 * flat,
         "{streamed} vs {flat}"
     );
-    let wall = rmse(&yup, &["--up", "z"]);
+    // (the wall leaves the data's box: with the fitted start, the default
+    // since issue 18, its spikes reach past the guard's limit)
+    let wall = rmse(&yup, &["--up", "z", "--allow-extrapolation"]);
     assert!(wall > 5.0 * flat, "--up z: {wall} vs {flat}");
 }
 

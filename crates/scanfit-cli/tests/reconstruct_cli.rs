@@ -10,10 +10,21 @@ use common::{ok, run, tmpdir};
 
 use std::f64::consts::{PI, TAU};
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
+}
+
+/// Deterministic noise uniform in `[-width / 2, width / 2)` (a 64-bit
+/// linear congruential generator from `seed`).
+fn uniform_noise(mut seed: u64, width: f64) -> impl FnMut() -> f64 {
+    move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        width * ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5)
+    }
 }
 
 /// A closed can (radius 1, height 2) as a text file `x y z label`: side
@@ -26,13 +37,7 @@ fn write_can(path: &Path, label: impl Fn(usize, i64) -> String) {
 /// [`write_can`] with `sectors` side sectors (labels `0..sectors`): with 6,
 /// each cap has 6 corners and two of its sides run over two edges.
 fn write_can_sectors(path: &Path, sectors: usize, label: impl Fn(usize, i64) -> String) {
-    let mut seed = 17u64;
-    let mut noise = || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        0.004 * ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5)
-    };
+    let mut noise = uniform_noise(17, 0.004);
     let h = 0.035;
     let mut out = String::from("x y z label\n");
     let mut k = 0;
@@ -119,20 +124,20 @@ fn can_report_pictures_and_mesh() {
     assert!(out.contains("largest gap along an edge"), "{out}");
 }
 
-#[test]
-fn ignored_cap_leaves_an_open_can() {
-    let d = tmpdir("reconstruct", "ignore");
+/// The JSON report of `reconstruct` with `extra` options on the can of
+/// [`write_can`] with its own labels (in the temporary directory `name`).
+fn can_json(name: &str, extra: &[&str]) -> serde_json::Value {
+    let d = tmpdir("reconstruct", name);
     let input = d.join("can.xyz");
     write_can(&input, |_, l| l.to_string());
-    let out = ok(&run(&[
-        "reconstruct",
-        s(&input),
-        "--ignore",
-        "11",
-        "--json",
-        "-q",
-    ]));
-    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let mut args = vec!["reconstruct", s(&input), "--json", "-q"];
+    args.extend_from_slice(extra);
+    serde_json::from_str(&ok(&run(&args))).unwrap()
+}
+
+#[test]
+fn ignored_cap_leaves_an_open_can() {
+    let j = can_json("ignore", &["--ignore", "11"]);
     assert_eq!(j["totals"]["faces"], 5);
     assert_eq!(j["totals"]["closed"], false);
     let free = j["edges"]
@@ -147,20 +152,7 @@ fn ignored_cap_leaves_an_open_can() {
 
 #[test]
 fn bspline_route() {
-    let d = tmpdir("reconstruct", "bspline");
-    let input = d.join("can.xyz");
-    write_can(&input, |_, l| l.to_string());
-    let out = ok(&run(&[
-        "reconstruct",
-        s(&input),
-        "--fit",
-        "bspline",
-        "--ctrl",
-        "6x6",
-        "--json",
-        "-q",
-    ]));
-    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let j = can_json("bspline", &["--fit", "bspline", "--ctrl", "6x6"]);
     let t = &j["totals"];
     assert!(t["max_gap"].as_f64().unwrap() <= 1e-9 * t["diagonal"].as_f64().unwrap());
     assert!(t["orthogonal"]["rmse"].as_f64().unwrap() < 0.006, "{t}");
@@ -225,6 +217,25 @@ fn missing_label_attribute_is_named() {
     assert!(e.contains("'segment'") && e.contains("label"), "{e}");
 }
 
+/// `reconstruct INPUT -o m.json --step m.stp --iges m.igs --json` in `dir`:
+/// the JSON report and the three paths.
+fn model_outputs(input: &Path, dir: &Path) -> (serde_json::Value, [PathBuf; 3]) {
+    let files = ["m.json", "m.stp", "m.igs"].map(|f| dir.join(f));
+    let out = ok(&run(&[
+        "reconstruct",
+        s(input),
+        "-o",
+        s(&files[0]),
+        "--step",
+        s(&files[1]),
+        "--iges",
+        s(&files[2]),
+        "--json",
+        "-q",
+    ]));
+    (serde_json::from_str(&out).unwrap(), files)
+}
+
 fn occ_available() -> bool {
     std::process::Command::new("python3")
         .args(["-c", "import OCP"])
@@ -273,20 +284,7 @@ fn vessel_is_one_valid_solid_of_the_true_volume() {
         &std::fs::read_to_string(common::examples().join("vessel_30k.json")).unwrap(),
     )
     .unwrap();
-    let (json, step, iges) = (d.join("v.json"), d.join("v.stp"), d.join("v.igs"));
-    let out = ok(&run(&[
-        "reconstruct",
-        s(&input),
-        "-o",
-        s(&json),
-        "--step",
-        s(&step),
-        "--iges",
-        s(&iges),
-        "--json",
-        "-q",
-    ]));
-    let r: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let (r, [json, step, iges]) = model_outputs(&input, &d);
     let t = &r["totals"];
     assert_eq!(t["faces"], 14);
     assert_eq!(t["closed"], true);
@@ -337,20 +335,7 @@ fn caps_with_six_corners_are_written_as_one_solid() {
     let d = tmpdir("reconstruct", "six");
     let input = d.join("can6.xyz");
     write_can_sectors(&input, 6, |_, l| l.to_string());
-    let (json, step, iges) = (d.join("c.json"), d.join("c.stp"), d.join("c.igs"));
-    let out = ok(&run(&[
-        "reconstruct",
-        s(&input),
-        "-o",
-        s(&json),
-        "--step",
-        s(&step),
-        "--iges",
-        s(&iges),
-        "--json",
-        "-q",
-    ]));
-    let r: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let (r, [json, step, iges]) = model_outputs(&input, &d);
     let t = &r["totals"];
     assert_eq!(
         (t["faces"].as_u64(), t["edges"].as_u64()),
@@ -432,18 +417,7 @@ fn caps_with_six_corners_are_written_as_one_solid() {
 fn umbrella_is_one_open_shell_of_three_sided_panels() {
     let d = tmpdir("reconstruct", "umbrella");
     let input = common::examples().join("umbrella_20k.ply");
-    let (json, step) = (d.join("u.json"), d.join("u.stp"));
-    let out = ok(&run(&[
-        "reconstruct",
-        s(&input),
-        "-o",
-        s(&json),
-        "--step",
-        s(&step),
-        "--json",
-        "-q",
-    ]));
-    let r: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let (r, [json, step, _]) = model_outputs(&input, &d);
     assert_eq!(r["totals"]["faces"], 8);
     assert_eq!(r["totals"]["corners"], 9);
     assert_eq!(r["totals"]["edges"], 16);
@@ -474,20 +448,7 @@ fn umbrella_is_one_open_shell_of_three_sided_panels() {
 fn can_as_revolve_layout() {
     // the file's labels are replaced by 4 sectors x 2 bands and 4 three-sided
     // patches on each flat cap (closed ends, decided from the data)
-    let d = tmpdir("reconstruct", "revolve");
-    let input = d.join("can.xyz");
-    write_can(&input, |_, l| l.to_string());
-    let out = ok(&run(&[
-        "reconstruct",
-        s(&input),
-        "--layout",
-        "revolve:4x2",
-        "--axis",
-        "z",
-        "--json",
-        "-q",
-    ]));
-    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let j = can_json("revolve", &["--layout", "revolve:4x2", "--axis", "z"]);
     let t = &j["totals"];
     assert_eq!(t["faces"], 16, "{t}");
     let layout = j["layout"].as_str().unwrap();
@@ -542,4 +503,71 @@ fn layout_values_are_checked() {
         &["--layout", "grid:2x2"],
     );
     assert!(e.contains("grid layout needs a sheet"), "{e}");
+}
+
+/// A square sheet `[0, 2]^2` on a gentle dome as `x y z label` (quarters
+/// 0-3), uniform noise 0.02 wide; quarter 3 thinned to every third row and
+/// column over `[1.1, 1.9]^2`, where a 12 x 12 least-squares net flies off.
+fn write_sheet_with_a_sparse_quarter(path: &Path) {
+    let mut noise = uniform_noise(5, 0.02);
+    let n = 60;
+    let mut out = String::from("x y z label\n");
+    for i in 0..n {
+        for j in 0..n {
+            let (x, y) = ((i as f64 + 0.5) / 30.0, (j as f64 + 0.5) / 30.0);
+            let l = u8::from(x > 1.0) + 2 * u8::from(y > 1.0);
+            let inner = (x - 1.5).abs() < 0.4 && (y - 1.5).abs() < 0.4;
+            if l == 3 && inner && (i % 3 != 0 || j % 3 != 0) {
+                continue;
+            }
+            let z = 0.1 * (x * (2.0 - x) + y * (2.0 - y)) + noise();
+            writeln!(out, "{x:.6} {y:.6} {z:.6} {l}").unwrap();
+        }
+    }
+    std::fs::write(path, out).unwrap();
+}
+
+/// A patch that leaves its data is refused in one line naming it and the
+/// fixes (as fit, mba, coons and turntable refuse theirs), nothing written;
+/// `--allow-extrapolation` writes it and reports how far it left.
+#[test]
+fn a_patch_that_leaves_its_data_is_refused_by_name() {
+    let d = tmpdir("reconstruct", "leaves");
+    let input = d.join("sheet.xyz");
+    write_sheet_with_a_sparse_quarter(&input);
+    let model = d.join("m.json");
+    let args = [
+        "reconstruct",
+        s(&input),
+        "--fit",
+        "bspline",
+        "--ctrl",
+        "12x12",
+        "-o",
+        s(&model),
+        "-q",
+    ];
+    let o = run(&args);
+    assert!(!o.status.success());
+    assert!(!model.exists(), "a model was written");
+    let e = String::from_utf8_lossy(&o.stderr);
+    let line = e.lines().find(|l| l.contains("leaves the data")).unwrap();
+    assert!(
+        line.contains("patch 3: the surface leaves the data")
+            && line.contains("--ctrl, now 12x12")
+            && line.contains("--allow-extrapolation"),
+        "{e}"
+    );
+    let mut allowed = args.to_vec();
+    allowed.extend(["--allow-extrapolation", "--json"]);
+    let j: serde_json::Value = serde_json::from_str(&ok(&run(&allowed))).unwrap();
+    assert!(model.exists());
+    for p in j["patches"].as_array().unwrap() {
+        let (out, limit) = (
+            p["outside_box"].as_f64().unwrap(),
+            p["outside_box_limit"].as_f64().unwrap(),
+        );
+        assert_eq!(p["leaves_data"], p["id"] == 3, "{p}");
+        assert_eq!(out > limit, p["id"] == 3, "{p}");
+    }
 }

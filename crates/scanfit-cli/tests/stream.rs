@@ -86,9 +86,39 @@ fn streamed_mba_writes_the_in_memory_surface() {
         let worst = relative(&sa[0], &sb[0]);
         assert!(worst <= 1e-12, "chunk {chunk}: {worst:e}");
         let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-        assert_eq!(report["streamed"]["passes"], 8);
+        // bounding box, frame, 5 levels, the last level's start (the default
+        // --start fitted), measures
+        assert_eq!(report["streamed"]["passes"], 9);
         assert_eq!(report["point_count"], 50_000);
     }
+    // the mean start: the same surface in memory and streamed, one pass fewer
+    let mean = [&base[..], &[a.to_str().unwrap(), "--start", "mean"]].concat();
+    ok(&scanfit(&mean));
+    let out = scanfit(
+        &[
+            &base[..],
+            &[
+                b.to_str().unwrap(),
+                "--start",
+                "mean",
+                "--chunk-points",
+                "7000",
+                "--json",
+            ],
+        ]
+        .concat(),
+    );
+    ok(&out);
+    let (sa, sb) = (surface(&a), surface(&b));
+    assert!(relative(&sa[0], &sb[0]) <= 1e-12);
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["streamed"]["passes"], 8);
+    // the adjustment starts from the mean; asking it for the fitted start is refused
+    let e = scanfit(&[
+        "mba", sample, "--adjust", "--start", "fitted", "--levels", "2",
+    ]);
+    assert!(!e.status.success());
+    assert!(String::from_utf8_lossy(&e.stderr).contains("starts from the mean"));
     let e = scanfit(&["mba", sample, "--adjust", "--chunk-points", "1000"]);
     assert!(!e.status.success());
     assert!(String::from_utf8_lossy(&e.stderr).contains("--adjust"));
@@ -96,7 +126,7 @@ fn streamed_mba_writes_the_in_memory_surface() {
 }
 
 #[test]
-fn streamed_fit_writes_the_in_memory_surface_and_refuses_whole_cloud_options() {
+fn streamed_fit_writes_the_in_memory_surface_bit_for_bit_with_given_parameters() {
     let d = tmp("fit");
     let input = d.join("patch.csv");
     let mut text = String::from("x,y,z,u,v\n");
@@ -129,26 +159,26 @@ fn streamed_fit_writes_the_in_memory_surface_and_refuses_whole_cloud_options() {
         &[&base[..], &[b.to_str().unwrap(), "--chunk-points", "3000"]].concat(),
     ));
     assert_eq!(surface(&a), surface(&b));
-    for (extra, says) in [
-        (&["--params", "plane", "--knots", "uniform"][..], "--params"),
-        (&["--params", "uv-columns"][..], "--knots"),
-        (
+    // the per-point parameters are still refused, with the reason
+    let e = scanfit(
+        &[
+            &base[..],
             &[
-                "--params",
-                "uv-columns",
-                "--knots",
-                "uniform",
-                "--correct",
-                "2",
-            ][..],
-            "--correct",
-        ),
-    ] {
-        let e = scanfit(&[&["fit", input, "--chunk-points", "1000"][..], extra].concat());
-        assert!(!e.status.success());
-        let msg = String::from_utf8_lossy(&e.stderr);
-        assert!(msg.contains(says) && msg.contains("chunks"), "{msg}");
-    }
+                b.to_str().unwrap(),
+                "--chunk-points",
+                "3000",
+                "--points-out",
+                "p.ply",
+            ],
+        ]
+        .concat(),
+    );
+    assert!(!e.status.success());
+    let msg = String::from_utf8_lossy(&e.stderr);
+    assert!(
+        msg.contains("--points-out") && msg.contains("all points at once"),
+        "{msg}"
+    );
     std::fs::remove_dir_all(&d).unwrap();
 }
 
@@ -223,5 +253,150 @@ fn streamed_mba_says_in_one_line_that_it_is_untrimmed_and_how_to_trim() {
         thin.to_str().unwrap(),
     ]));
     assert!(thin.exists());
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// A binary little-endian PLY of `x y z` doubles.
+fn write_ply(path: &Path, points: &[[f64; 3]]) {
+    let mut bytes = format!(
+        "ply\nformat binary_little_endian 1.0\nelement vertex {}\nproperty double x\nproperty double y\nproperty double z\nend_header\n",
+        points.len()
+    )
+    .into_bytes();
+    for p in points {
+        for c in p {
+            bytes.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    std::fs::write(path, bytes).unwrap();
+}
+
+#[test]
+fn streamed_fit_with_the_plane_distribution_knots_and_correction_is_the_in_memory_fit() {
+    let d = tmp("plane");
+    let input = d.join("tilted.ply");
+    // 10^5 points of a wavy sheet, unevenly spread, tilted and sheared far from the origin
+    let mut state = 7u64;
+    let mut next = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let points: Vec<[f64; 3]> = (0..100_000)
+        .map(|_| {
+            let (s, t) = (next().powf(1.3) * 120.0, next() * 70.0);
+            let h = 4.0 * (s / 17.0).sin() * (t / 11.0).cos() + 0.05 * next();
+            [
+                4.0e5 + 0.8 * s - 0.3 * t + 0.2 * h,
+                6.1e6 + 0.5 * s + 0.9 * t - 0.1 * h,
+                80.0 + 0.3 * s + 0.2 * t + 0.95 * h,
+            ]
+        })
+        .collect();
+    write_ply(&input, &points);
+    let input = input.to_str().unwrap();
+    for (k, extra) in [
+        &[][..],
+        &["--correct", "2"][..],
+        &["--knots", "uniform", "--correct", "1"][..],
+    ]
+    .iter()
+    .enumerate()
+    {
+        let (a, b) = (d.join(format!("a{k}.json")), d.join(format!("b{k}.json")));
+        let base = ["fit", input, "--ctrl", "14x11", "--no-trim", "--quiet"];
+        ok(&scanfit(
+            &[&base[..], extra, &["-o", a.to_str().unwrap()]].concat(),
+        ));
+        let run = scanfit(
+            &[
+                &base[..],
+                extra,
+                &[
+                    "-o",
+                    b.to_str().unwrap(),
+                    "--chunk-points",
+                    "30000",
+                    "--json",
+                ],
+            ]
+            .concat(),
+        );
+        ok(&run);
+        let (x, y) = (surface(&b), surface(&a));
+        let worst = relative(&x[0], &y[0]);
+        assert!(
+            worst <= 1e-12,
+            "{extra:?}: control points differ by {worst:e}"
+        );
+        for j in [1, 2] {
+            for (s, t) in x[j]
+                .as_array()
+                .unwrap()
+                .iter()
+                .zip(y[j].as_array().unwrap())
+            {
+                let (s, t) = (s.as_f64().unwrap(), t.as_f64().unwrap());
+                assert!((s - t).abs() <= 1e-12, "{extra:?}: knots {s} {t}");
+            }
+        }
+        // the passes: box, plane x3, then per fit the knot rounds (none when
+        // uniform), the equations and (when correcting) the errors; measuring
+        let report: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+        let passes = report["streamed"]["passes"].as_u64().unwrap();
+        let doc: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&b).unwrap()).unwrap();
+        let memory: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&a).unwrap()).unwrap();
+        // (the document leaves the list out when there is no correction)
+        let count = |d: &serde_json::Value| {
+            d["quality"]["correction_rmse"]
+                .as_array()
+                .map_or(0, |a| a.len() as u64)
+        };
+        let rounds = count(&doc);
+        assert_eq!(rounds, count(&memory));
+        let fits = rounds.max(1);
+        let per_fit = match k {
+            0 => 2 + 1,
+            1 => 2 + 1 + 1,
+            _ => 1 + 1,
+        };
+        assert_eq!(passes, 1 + 3 + fits * per_fit + 1, "{extra:?}");
+    }
+    // --trim cannot be streamed; the plane's default (trimmed) gets a note
+    let run = scanfit(&[
+        "fit",
+        input,
+        "--chunk-points",
+        "30000",
+        "--trim",
+        "-o",
+        "t.json",
+    ]);
+    assert_eq!(run.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        err.contains("--trim cannot be used with --chunk-points"),
+        "{err}"
+    );
+    let o = d.join("note.json");
+    let run = scanfit(&[
+        "fit",
+        input,
+        "--ctrl",
+        "6x6",
+        "--chunk-points",
+        "50000",
+        "-o",
+        o.to_str().unwrap(),
+    ]);
+    ok(&run);
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        err.contains("NOT trimmed") && err.contains("--no-trim"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&d).unwrap();
 }

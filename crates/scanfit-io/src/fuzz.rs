@@ -78,3 +78,26 @@ pub fn surface_document(data: &[u8]) -> bool {
     }
     true
 }
+
+/// Feeds `data` to the model JSON document reader (`scanfit reconstruct -o`,
+/// read by `report` and `export`): parses and builds the patch complex,
+/// then validates its structure and geometry and takes its volume, as the
+/// commands that read it do. Returns whether the document was accepted.
+///
+/// ```
+/// assert!(!scanfit_io::fuzz::model_document(b"{}"));
+/// assert!(!scanfit_io::fuzz::model_document(b"\xff"));
+/// ```
+pub fn model_document(data: &[u8]) -> bool {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return false;
+    };
+    let Ok((_, model)) = crate::model::parse_model(Path::new("f.json"), text) else {
+        return false;
+    };
+    let _ = model.validate();
+    let _ = model.edge_faces();
+    let _ = model.border_edges();
+    let _ = model.signed_volume();
+    true
+}

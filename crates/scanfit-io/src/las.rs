@@ -312,6 +312,7 @@ fn laz_check(path: &Path, bytes: &(impl View + ?Sized), raw: &Raw) -> Result<Com
                     .filter(|&o| (o as i64) > start as i64)
             }
         });
+    let mut table_chunks = None;
     let data_end = match table {
         Some(t) if t < len => {
             // every chunk starts with one raw point: a table with more
@@ -327,6 +328,7 @@ fn laz_check(path: &Path, bytes: &(impl View + ?Sized), raw: &Raw) -> Result<Com
                     t.saturating_sub(start + 8)
                 )));
             }
+            table_chunks = Some(u64::from(chunks));
             t
         }
         _ => raw.data_end,
@@ -385,6 +387,7 @@ fn laz_check(path: &Path, bytes: &(impl View + ?Sized), raw: &Raw) -> Result<Com
             count,
             data_end,
             table,
+            table_chunks,
         }));
     }
     if !layered_ok {
@@ -454,6 +457,7 @@ fn laz_check(path: &Path, bytes: &(impl View + ?Sized), raw: &Raw) -> Result<Com
         count,
         data_end,
         table_counts,
+        table_chunks,
     }))
 }
 
@@ -479,6 +483,8 @@ struct Pointwise {
     data_end: u64,
     /// the chunk table as (points, bytes) per chunk (compressor 2)
     table: Option<Vec<(u64, u64)>>,
+    /// the number of chunks the chunk table lists
+    table_chunks: Option<u64>,
 }
 
 /// A layered LAZ file (point formats 6-10) as [`laz_check`] found it.
@@ -490,6 +496,21 @@ struct Layered {
     data_end: u64,
     /// the chunk table's point counts (variable-size chunks only)
     table_counts: Option<Vec<u64>>,
+    /// the number of chunks the chunk table lists
+    table_chunks: Option<u64>,
+}
+
+/// The warning of a LAZ file whose chunk table lists more chunks than the
+/// header's point count needs (`used`): their points are not read.
+fn unread_chunks(path: &Path, table_chunks: Option<u64>, used: usize, count: u64) -> Vec<String> {
+    match table_chunks {
+        Some(listed) if listed > used as u64 => vec![format!(
+            "{}: the LAZ chunk table lists {listed} chunks, but the header's {count} points fill only {used}; the points of the other {} were not read (the header's point count may be too small)",
+            path.display(),
+            listed - used as u64
+        )],
+        _ => Vec::new(),
+    }
 }
 
 /// Runs `f`, turning a panic into `None` without the panic message on
@@ -541,6 +562,56 @@ fn column_names(gps_time: bool, color: bool, nir: bool) -> Vec<&'static str> {
     names
 }
 
+/// Decodes the chunks `spans` of a LAZ file held in `bytes` (chunk `c`
+/// has `size(c)` bytes, `declared` points in all) with `decode`, a few per
+/// thread at a time (chunks are independent), and hands each chunk's
+/// points to `append` in file order, with the coordinates and the columns
+/// `names` to append to; the first damaged chunk in file order is the
+/// error.
+#[allow(clippy::too_many_arguments)]
+fn decode_in_order<T: Send>(
+    path: &Path,
+    bytes: &[u8],
+    declared: u64,
+    names: Vec<&'static str>,
+    spans: &[crate::laz14::ChunkSpan],
+    size: impl Fn(usize) -> u64 + Sync,
+    decode: impl Fn(usize, &[u8], &mut Vec<T>) -> std::result::Result<(), crate::laz14::Laz14Error>
+        + Sync,
+    append: impl Fn(&[T], &mut Vec<Point3>, &mut [Vec<f64>]),
+) -> Result<Decoded> {
+    use rayon::prelude::*;
+    let cap = capacity(declared, bytes.len()).min(1 << 24);
+    let mut points = Vec::with_capacity(cap);
+    let mut columns = vec![Vec::with_capacity(cap); names.len()];
+    let group = 2 * rayon::current_num_threads().max(1);
+    let count = spans.len();
+    for first in (0..count).step_by(group) {
+        let decoded: Vec<_> = (first..(first + group).min(count))
+            .into_par_iter()
+            .map(|c| {
+                let at = spans[c].offset as usize;
+                let data = bytes
+                    .get(at..at.saturating_add(size(c) as usize))
+                    .unwrap_or(&[]);
+                let mut chunk = Vec::new();
+                decode(c, data, &mut chunk).map(|()| chunk)
+            })
+            .collect();
+        for chunk in decoded {
+            let chunk = chunk.map_err(|e| layered::binary(path, e))?;
+            append(&chunk, &mut points, &mut columns);
+        }
+    }
+    Ok(Decoded {
+        points,
+        names,
+        columns,
+        declared,
+        warnings: Vec::new(),
+    })
+}
+
 /// Columns read from the crate.
 #[derive(Default)]
 struct Decoded {
@@ -548,6 +619,8 @@ struct Decoded {
     names: Vec<&'static str>,
     columns: Vec<Vec<f64>>,
     declared: u64,
+    /// the decoder's warnings (after the header's)
+    warnings: Vec<String>,
 }
 
 /// A `las` crate reader past its header, with the declared count checked
@@ -671,6 +744,7 @@ fn read_with_crate(path: &Path, bytes: Vec<u8>, raw: &Raw) -> Result<Decoded> {
         names: r.names,
         columns,
         declared: n,
+        warnings: Vec::new(),
     })
 }
 
@@ -745,7 +819,8 @@ pub(crate) fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<
     }
     let mut columns: Vec<String> = ["x", "y", "z"].iter().map(|s| s.to_string()).collect();
     columns.extend(decoded.names.iter().map(|s| s.to_string()));
-    let warnings = header_warnings(path, &raw, n as u64);
+    let mut warnings = header_warnings(path, &raw, n as u64);
+    warnings.extend(decoded.warnings);
     PointTable {
         path: path.to_path_buf(),
         format: Format::Las,

@@ -28,6 +28,7 @@ fn feed(target: &str, data: &[u8]) -> bool {
         "obj" => scanfit_io::fuzz::point_file("f.obj", data),
         "curve_json" => scanfit_io::fuzz::curve_document(data),
         "surface_json" => scanfit_io::fuzz::surface_document(data),
+        "model_json" => scanfit_io::fuzz::model_document(data),
         other => panic!("unknown fuzz target directory '{other}'"),
     }
 }
@@ -72,6 +73,7 @@ fn seed_corpora_replay_and_the_intact_seeds_are_accepted() {
             "curve_json",
             "las",
             "laz",
+            "model_json",
             "obj",
             "pcd",
             "ply",

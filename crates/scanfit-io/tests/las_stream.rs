@@ -91,6 +91,22 @@ fn pointwise_laz_streams_one_laz_chunk_at_a_time() {
     assert_eq!(same_streamed(&path, 1000).iter().sum::<usize>(), 1500);
 }
 
+/// Compressor 1 (pointwise, the whole point stream one LAZ chunk) is read
+/// a requested chunk at a time, not one LAZ chunk (all points) at a time:
+/// the points, columns, locations and warnings are the one-piece reader's.
+#[test]
+fn a_compressor_1_laz_file_streams_in_requested_chunks() {
+    for (format, extra) in [(1u8, 0usize), (5, 2)] {
+        let n = 4000;
+        let raw = laz10_gen::records(format, extra, n, 17 + u64::from(format));
+        let f = laz10_gen::compress_single(format, extra, &raw);
+        let path = dir().join(format!("single{format}.laz"));
+        std::fs::write(&path, &f.bytes).unwrap();
+        assert_eq!(same_streamed(&path, 1500), [1500, 1500, 1000]);
+        assert_eq!(same_streamed(&path, 1).len(), n);
+    }
+}
+
 #[test]
 fn layered_laz_streams_one_laz_chunk_at_a_time() {
     use laz10_gen::laz_gen;
@@ -130,6 +146,43 @@ fn a_truncated_laz_file_fails_streamed_as_whole() {
         whole.contains("LAZ chunk 2 (points 1000 to 1499)"),
         "{whole}"
     );
+}
+
+/// A LAZ header that declares fewer points than its chunk table's chunks
+/// hold: the chunks beyond the count are not read, with a warning, read
+/// whole and streamed alike (pointwise and layered).
+#[test]
+fn a_laz_count_below_the_chunk_table_is_a_warning() {
+    use laz10_gen::{laz_gen, Chunks};
+    let path = laz_file("fewer.laz", 1, 0, Chunks::Fixed(500), 1500);
+    let mut bytes = std::fs::read(&path).unwrap();
+    bytes[107..111].copy_from_slice(&900u32.to_le_bytes());
+    std::fs::write(&path, &bytes).unwrap();
+    assert_eq!(same_streamed(&path, 700), [500, 400]);
+    let w = read_cloud(&path, &ReadOptions::default()).unwrap().warnings;
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].ends_with("the LAZ chunk table lists 3 chunks, but the header's 900 points fill only 2; the points of the other 1 were not read (the header's point count may be too small)"),
+        "{w:?}"
+    );
+    let raw = laz_gen::records(6, 3000, 5);
+    let f = laz_gen::compress(6, false, laz_gen::Chunks::Fixed(1000), &raw);
+    let mut bytes = f.bytes.clone();
+    bytes[247..255].copy_from_slice(&1000u64.to_le_bytes());
+    let path = dir().join("fewer6.laz");
+    std::fs::write(&path, &bytes).unwrap();
+    assert_eq!(same_streamed(&path, 600), [600, 400]);
+    let w = read_cloud(&path, &ReadOptions::default()).unwrap().warnings;
+    assert!(
+        w.len() == 1 && w[0].contains("lists 3 chunks, but the header's 1000 points fill only 1"),
+        "{w:?}"
+    );
+    // the intact files: no warning
+    let path = laz_file("intact.laz", 1, 0, Chunks::Fixed(500), 1500);
+    assert!(read_cloud(&path, &ReadOptions::default())
+        .unwrap()
+        .warnings
+        .is_empty());
 }
 
 /// Offset of the point data of a LAS 1.2 file.

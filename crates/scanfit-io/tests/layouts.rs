@@ -103,20 +103,7 @@ fn blob_as_a_cube_is_a_closed_solid_of_the_true_volume() {
     let r = run(&cloud, &cfg, &NoProgress).unwrap();
     assert_eq!(r.patches.len(), 6);
     assert!(r.patches.iter().all(|p| p.sides == 4), "{:?}", r.patches);
-    // the layout's parameters do not fold: at most 0.5% of a patch's points
-    // (noise at the borders), per patch
-    for p in &r.patches {
-        println!(
-            "patch {}: {} points, {} folded",
-            p.id, p.points, p.fold_overs
-        );
-        assert!(
-            p.fold_overs * 200 <= p.points,
-            "patch {}: {} folded",
-            p.id,
-            p.fold_overs
-        );
-    }
+    few_folds(&r);
     assert_eq!(r.network.vertices.len(), 8);
     assert_eq!(r.network.edges.len(), 12);
     assert!(r.totals.closed);
@@ -134,38 +121,9 @@ fn blob_as_a_cube_is_a_closed_solid_of_the_true_volume() {
     assert!((v - truth).abs() < 0.01 * truth, "volume {v} vs {truth}");
     let step = step_shell_file(model, "blob").unwrap();
     assert!(step.text.contains("CLOSED_SHELL(") && step.text.contains("MANIFOLD_SOLID_BREP("));
-    if !occ_available() {
-        eprintln!("\n**************************************************************");
-        eprintln!("* OpenCASCADE (pip install cadquery-ocp) is NOT installed:   *");
-        eprintln!("* the blob's STEP solid was NOT read back by a CAD kernel     *");
-        eprintln!("**************************************************************\n");
-        assert!(
-            std::env::var_os("SCANFIT_REQUIRE_OCC").is_none(),
-            "SCANFIT_REQUIRE_OCC is set but OpenCASCADE is missing"
-        );
+    let Some(occ) = occ_read(model, "blob") else {
         return;
-    }
-    let dir = std::env::temp_dir().join(format!("scanfit-layout-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let (jp, sp) = (dir.join("blob.json"), dir.join("blob.stp"));
-    std::fs::write(&jp, ModelDoc::new(model).to_json().unwrap()).unwrap();
-    std::fs::write(&sp, &step.text).unwrap();
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/occ/check_model.py");
-    let o = Command::new("python3")
-        .arg(script)
-        .arg(&jp)
-        .arg(&sp)
-        .output()
-        .unwrap();
-    let out = String::from_utf8_lossy(&o.stdout);
-    assert!(
-        o.status.success(),
-        "{out}{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    std::fs::remove_dir_all(&dir).ok();
-    let occ: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
-    println!("OpenCASCADE: {occ}");
+    };
     assert_eq!(occ["solids"], 1, "{occ}");
     assert_eq!(occ["faces"], 6, "{occ}");
     assert_eq!(occ["valid"], true, "{occ}");
@@ -175,6 +133,23 @@ fn blob_as_a_cube_is_a_closed_solid_of_the_true_volume() {
         (vo - truth).abs() < 0.01 * truth,
         "OpenCASCADE volume {vo} vs {truth}"
     );
+}
+
+/// The layouts' parameters do not fold: at most 0.5% of a patch's points
+/// (noise at the borders), per patch.
+fn few_folds(r: &scanfit::pipeline::reconstruct::ReconstructReport) {
+    for p in &r.patches {
+        println!(
+            "patch {}: {} sides, {} points, {} folded, orth rmse {:.4}",
+            p.id, p.sides, p.points, p.fold_overs, p.orthogonal.rmse
+        );
+        assert!(
+            p.fold_overs * 200 <= p.points,
+            "patch {}: {} folded",
+            p.id,
+            p.fold_overs
+        );
+    }
 }
 
 /// OpenCASCADE's reading of `model` written as STEP (`tests/occ/check_model.py`),
@@ -221,18 +196,7 @@ fn occ_read(model: &scanfit::topology::PatchComplex, name: &str) -> Option<serde
 fn check_revolve(r: &scanfit::pipeline::reconstruct::ReconstructReport, four: usize, three: usize) {
     let sides = |n| r.patches.iter().filter(|p| p.sides == n).count();
     assert_eq!((sides(4), sides(3)), (four, three), "{:?}", r.patches);
-    for p in &r.patches {
-        println!(
-            "patch {}: {} sides, {} points, {} folded, orth rmse {:.4}",
-            p.id, p.sides, p.points, p.fold_overs, p.orthogonal.rmse
-        );
-        assert!(
-            p.fold_overs * 200 <= p.points,
-            "patch {}: {} folded",
-            p.id,
-            p.fold_overs
-        );
-    }
+    few_folds(r);
     assert!(
         r.totals.max_gap <= 1e-9 * r.totals.diagonal,
         "{}",
@@ -370,14 +334,7 @@ fn grid_fit(
     assert_eq!(r.patches.len(), 9);
     assert!(r.patches.iter().all(|p| p.sides == 4), "{:?}", r.patches);
     assert!(r.totals.max_gap <= 1e-9 * r.totals.diagonal);
-    for p in &r.patches {
-        assert!(
-            p.fold_overs * 200 <= p.points,
-            "patch {}: {} folded",
-            p.id,
-            p.fold_overs
-        );
-    }
+    few_folds(&r);
     let mut label = vec![-1.0; cloud.len()];
     for p in &r.network.patches {
         for &i in &p.points {

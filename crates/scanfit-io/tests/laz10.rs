@@ -14,12 +14,13 @@
 use std::io::Cursor;
 use std::path::Path;
 
-use scanfit_io::laz14::PointwiseRecord;
+use scanfit_io::laz14::{PointwiseLaz, PointwiseRecord};
 use scanfit_io::{parse_cloud, ReadOptions};
 
 #[path = "support/laz10_gen.rs"]
 mod laz10_gen;
-use laz10_gen::{compress, fields, laz_decode, ours, record_len, records, Chunks};
+use laz10_gen::laz_gen::laz_decode;
+use laz10_gen::{compress, compress_single, fields, ours, record_len, records, Chunks};
 
 fn same(a: &[PointwiseRecord], b: &[PointwiseRecord], what: &str) {
     assert_eq!(a.len(), b.len(), "{what}: point counts");
@@ -218,4 +219,78 @@ fn the_pointwise_gps_time_recursion_input_is_a_clear_error() {
     .unwrap();
     let gps = ok.columns.iter().position(|c| c == "gps_time").unwrap() - 3;
     assert_eq!(ok.extra[gps], [1.0e8, 1.0e8]);
+}
+
+/// Compressor 1 (pointwise, no chunk table: all points one arithmetic-coded
+/// chunk) decodes as the laz crate decodes it, and a cursor taking any
+/// number of points at a time through a window of any size gives the same
+/// points bit for bit, while the window it holds stays at its size (never
+/// grows with the chunk): the resumable decoder behind the streamed reader.
+#[test]
+fn compressor_1_resumes_anywhere_with_a_bounded_window() {
+    for (format, extra, n) in [(1u8, 0usize, 6000usize), (3, 0, 5000), (5, 2, 3000)] {
+        let raw = records(format, extra, n, 70 + u64::from(format));
+        let f = compress_single(format, extra, &raw);
+        let theirs = laz_decode(&f, n, record_len(format, extra));
+        assert_eq!(theirs, raw, "the laz crate round trip (format {format})");
+        let file = PointwiseLaz::new(
+            &f.vlr_payload,
+            227 + 54,
+            f.start,
+            f.bytes.len() as u64,
+            n as u64,
+            None,
+        )
+        .unwrap();
+        assert_eq!(file.chunks().len(), 1, "compressor 1 is one chunk");
+        let at = f.start as usize;
+        let mut whole = Vec::new();
+        file.decode_chunk(0, &f.bytes[at..], &mut whole).unwrap();
+        let what = format!("format {format}, compressor 1");
+        same(&whole, &fields(&raw, format, extra), &what);
+        let smallest = file.record_len() + file.point_bytes();
+        let chunk_bytes = f.bytes.len() - at;
+        for (window, take) in [(0usize, 1usize), (0, 7), (3000, 1000), (1 << 20, 64)] {
+            let mut cursor = file.cursor_with_window(0, window).unwrap();
+            let (mut reads, mut largest_read) = (0usize, 0usize);
+            let mut read = |offset: u64, buf: &mut [u8]| {
+                reads += 1;
+                largest_read = largest_read.max(buf.len());
+                let o = offset as usize;
+                buf.copy_from_slice(&f.bytes[o..o + buf.len()]);
+                true
+            };
+            let mut streamed = Vec::new();
+            let mut batch = Vec::new();
+            let mut held = 0;
+            loop {
+                batch.clear();
+                let got = file
+                    .decode(&mut cursor, &mut read, take, &mut batch)
+                    .unwrap();
+                if got == 0 {
+                    break;
+                }
+                assert!(got <= take);
+                held = held.max(cursor.buffer_capacity());
+                streamed.extend_from_slice(&batch);
+            }
+            let size = window.max(smallest);
+            same(
+                &streamed,
+                &whole,
+                &format!("{what}, window {window}, {take} at a time"),
+            );
+            assert!(
+                held <= size,
+                "{what}: window of {held} bytes, more than {size}"
+            );
+            assert!(largest_read <= size);
+            assert_eq!(cursor.buffer_capacity(), 0, "released at the end");
+            // the chunk did not fit: the decoder was suspended and resumed
+            if size < chunk_bytes {
+                assert!(reads >= chunk_bytes / size, "{what}: {reads} reads");
+            }
+        }
+    }
 }

@@ -20,7 +20,6 @@
 
 use numpy::{IntoPyArray, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::{PyBytes, PyTuple};
 use scanfit::base::{FlatHull, PlaneAxes, PlaneExtents, PlaneMap};
 use scanfit::bspline::{KnotVector, Surface};
 use scanfit::fit::knot_ranks::{KnotSearch, RankCounts, RankQuery};
@@ -33,7 +32,9 @@ use scanfit::wire::{Reader, Writer};
 use scanfit::{CovarianceSums, Error, Point3, Vector3};
 
 use crate::convert::{err, uv_columns, value_err, vec3};
-use crate::sums::{chunk, read, reduce, PyCentring, PyNormalEquations, PyResidualSums};
+use crate::sums::{
+    chunk, pickled, read, wire_inner, PyCentring, PyNormalEquations, PyResidualSums, Wire,
+};
 use crate::surfaces::fit_config;
 
 // ---- the best-fit plane in passes --------------------------------------------
@@ -83,7 +84,7 @@ pub struct PyPlaneStage {
 }
 
 impl PyPlaneStage {
-    fn encode(&self) -> Vec<u8> {
+    fn bytes(&self) -> Vec<u8> {
         let mut w = Writer::new(STAGE_TAG);
         self.centring.write(&mut w);
         match &self.stage {
@@ -107,27 +108,14 @@ impl PyPlaneStage {
     }
 }
 
-#[pymethods]
-impl PyPlaneStage {
-    /// Empty sums of this stage (what each task fills).
-    fn accumulator(&self) -> PyPlaneSums {
-        PyPlaneSums {
-            inner: match &self.stage {
-                Stage::Moments(p) => Sums::Moments(CovarianceSums::new(*p)),
-                Stage::Hull(_) => Sums::Hull(FlatHull::default()),
-                Stage::Extents(e) => Sums::Extents(e.clone()),
-            },
-        }
+impl Wire for PyPlaneStage {
+    const KIND: &'static str = "PlaneStage";
+
+    fn encode(&self) -> Vec<u8> {
+        self.bytes()
     }
 
-    /// The exact bytes (see ``from_bytes``).
-    fn to_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
-        PyBytes::new(py, &self.encode())
-    }
-
-    /// The stage whose ``to_bytes`` gave ``data``.
-    #[staticmethod]
-    fn from_bytes(data: &[u8]) -> PyResult<Self> {
+    fn decode(data: &[u8]) -> PyResult<Self> {
         let mut r = Reader::new(data, STAGE_TAG, "a plane pass").map_err(err)?;
         let centring = PyCentring::read(&mut r).map_err(err)?;
         let stage = match r.u64().map_err(err)? {
@@ -152,9 +140,18 @@ impl PyPlaneStage {
         };
         Ok(Self { centring, stage })
     }
+}
 
-    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
-        reduce(py, "PlaneStage", &self.encode())
+pickled!(PyPlaneStage {
+    /// Empty sums of this stage (what each task fills).
+    fn accumulator(&self) -> PyPlaneSums {
+        PyPlaneSums {
+            inner: match &self.stage {
+                Stage::Moments(p) => Sums::Moments(CovarianceSums::new(*p)),
+                Stage::Hull(_) => Sums::Hull(FlatHull::default()),
+                Stage::Extents(e) => Sums::Extents(e.clone()),
+            },
+        }
     }
 
     fn __repr__(&self) -> String {
@@ -165,7 +162,7 @@ impl PyPlaneStage {
         };
         format!("PlaneStage({s})")
     }
-}
+});
 
 #[derive(Clone)]
 enum Sums {
@@ -185,7 +182,7 @@ pub struct PyPlaneSums {
 }
 
 impl PyPlaneSums {
-    fn encode(&self) -> Vec<u8> {
+    fn bytes(&self) -> Vec<u8> {
         let mut w = Writer::new(PLANE_SUMS_TAG);
         let (kind, bytes) = match &self.inner {
             Sums::Moments(c) => (0, c.to_bytes()),
@@ -199,8 +196,29 @@ impl PyPlaneSums {
     }
 }
 
-#[pymethods]
-impl PyPlaneSums {
+impl Wire for PyPlaneSums {
+    const KIND: &'static str = "PlaneSums";
+
+    fn encode(&self) -> Vec<u8> {
+        self.bytes()
+    }
+
+    fn decode(data: &[u8]) -> PyResult<Self> {
+        let mut r = Reader::new(data, PLANE_SUMS_TAG, "plane sums").map_err(err)?;
+        let kind = r.u64().map_err(err)?;
+        // tag, kind: the stage's own record follows
+        let rest = &data[16..];
+        let inner = match kind {
+            0 => Sums::Moments(CovarianceSums::from_bytes(rest).map_err(err)?),
+            1 => Sums::Hull(FlatHull::from_bytes(rest).map_err(err)?),
+            2 => Sums::Extents(Box::new(PlaneExtents::from_bytes(rest).map_err(err)?)),
+            x => return Err(err(r.corrupt(&format!("plane sums kind {x}")))),
+        };
+        Ok(Self { inner })
+    }
+}
+
+pickled!(PyPlaneSums {
     /// Adds an ``(N, 3)`` chunk (``N = 0`` allowed) for ``stage``.
     fn add(
         &mut self,
@@ -248,31 +266,6 @@ impl PyPlaneSums {
         }
     }
 
-    /// The exact bytes (see ``from_bytes``).
-    fn to_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
-        PyBytes::new(py, &self.encode())
-    }
-
-    /// The sums whose ``to_bytes`` gave ``data``.
-    #[staticmethod]
-    fn from_bytes(data: &[u8]) -> PyResult<Self> {
-        let mut r = Reader::new(data, PLANE_SUMS_TAG, "plane sums").map_err(err)?;
-        let kind = r.u64().map_err(err)?;
-        // tag, kind: the stage's own record follows
-        let rest = &data[16..];
-        let inner = match kind {
-            0 => Sums::Moments(CovarianceSums::from_bytes(rest).map_err(err)?),
-            1 => Sums::Hull(FlatHull::from_bytes(rest).map_err(err)?),
-            2 => Sums::Extents(Box::new(PlaneExtents::from_bytes(rest).map_err(err)?)),
-            x => return Err(err(r.corrupt(&format!("plane sums kind {x}")))),
-        };
-        Ok(Self { inner })
-    }
-
-    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
-        reduce(py, "PlaneSums", &self.encode())
-    }
-
     fn __repr__(&self) -> String {
         match &self.inner {
             Sums::Moments(c) => format!("PlaneSums(covariance, points={})", c.count()),
@@ -280,7 +273,7 @@ impl PyPlaneSums {
             Sums::Extents(_) => "PlaneSums(extents)".into(),
         }
     }
-}
+});
 
 /// The best-fit plane's parameters over points in chunks (``params="plane"``
 /// of ``fit_surface``), on the client: three passes, each ``stage()``
@@ -446,7 +439,7 @@ fn read_surface(r: &mut Reader<'_>) -> scanfit::Result<Surface> {
 }
 
 impl PyParameterization {
-    fn encode(&self) -> Vec<u8> {
+    fn bytes(&self) -> Vec<u8> {
         let mut w = Writer::new(PARAM_TAG);
         self.centring.write(&mut w);
         match &self.plane {
@@ -506,8 +499,42 @@ impl PyParameterization {
     }
 }
 
-#[pymethods]
-impl PyParameterization {
+impl Wire for PyParameterization {
+    const KIND: &'static str = "Parameterization";
+
+    fn encode(&self) -> Vec<u8> {
+        self.bytes()
+    }
+
+    fn decode(data: &[u8]) -> PyResult<Self> {
+        read(data, PARAM_TAG, "a parameterization", |r| {
+            let centring = PyCentring::read(r)?;
+            let plane = match r.u64()? {
+                0 => None,
+                1 => Some(PlaneMap::read(r)?),
+                x => return Err(r.corrupt(&format!("plane flag {x}"))),
+            };
+            let n = r.usize()?;
+            let mut chain = Vec::new();
+            for _ in 0..n {
+                chain.push(read_surface(r)?);
+            }
+            let surface = match r.u64()? {
+                0 => None,
+                1 => Some(read_surface(r)?),
+                x => return Err(r.corrupt(&format!("surface flag {x}"))),
+            };
+            Ok(Self {
+                centring,
+                plane,
+                chain,
+                surface,
+            })
+        })
+    }
+}
+
+pickled!(PyParameterization {
     /// Parameters given per point (``uv=`` of ``fit_surface``).
     #[staticmethod]
     fn given(centring: &PyCentring) -> Self {
@@ -596,44 +623,6 @@ impl PyParameterization {
         self.plane.is_some()
     }
 
-    /// The exact bytes (see ``from_bytes``).
-    fn to_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
-        PyBytes::new(py, &self.encode())
-    }
-
-    /// The parameterization whose ``to_bytes`` gave ``data``.
-    #[staticmethod]
-    fn from_bytes(data: &[u8]) -> PyResult<Self> {
-        read(data, PARAM_TAG, "a parameterization", |r| {
-            let centring = PyCentring::read(r)?;
-            let plane = match r.u64()? {
-                0 => None,
-                1 => Some(PlaneMap::read(r)?),
-                x => return Err(r.corrupt(&format!("plane flag {x}"))),
-            };
-            let n = r.usize()?;
-            let mut chain = Vec::new();
-            for _ in 0..n {
-                chain.push(read_surface(r)?);
-            }
-            let surface = match r.u64()? {
-                0 => None,
-                1 => Some(read_surface(r)?),
-                x => return Err(r.corrupt(&format!("surface flag {x}"))),
-            };
-            Ok(Self {
-                centring,
-                plane,
-                chain,
-                surface,
-            })
-        })
-    }
-
-    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
-        reduce(py, "Parameterization", &self.encode())
-    }
-
     fn __repr__(&self) -> String {
         format!(
             "Parameterization({}, rounds={}, fitted={})",
@@ -646,7 +635,7 @@ impl PyParameterization {
             self.surface.is_some()
         )
     }
-}
+});
 
 // ---- the fit's settings and its knots ------------------------------------------
 
@@ -817,32 +806,16 @@ pub struct PyRankQuery {
     inner: RankQuery,
 }
 
-#[pymethods]
-impl PyRankQuery {
+wire_inner!(PyRankQuery, RankQuery, "RankQuery");
+
+pickled!(PyRankQuery {
     /// Empty counts for this query (what each task fills).
     fn counts(&self) -> PyRankCounts {
         PyRankCounts {
             inner: self.inner.counts(),
         }
     }
-
-    /// The exact bytes (see ``from_bytes``).
-    fn to_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
-        PyBytes::new(py, &self.inner.to_bytes())
-    }
-
-    /// The query whose ``to_bytes`` gave ``data``.
-    #[staticmethod]
-    fn from_bytes(data: &[u8]) -> PyResult<Self> {
-        Ok(Self {
-            inner: RankQuery::from_bytes(data).map_err(err)?,
-        })
-    }
-
-    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
-        reduce(py, "RankQuery", &self.inner.to_bytes())
-    }
-}
+});
 
 /// The counts of some chunks' parameters for a ``RankQuery``; mergeable and
 /// exact as bytes.
@@ -852,8 +825,9 @@ pub struct PyRankCounts {
     inner: RankCounts,
 }
 
-#[pymethods]
-impl PyRankCounts {
+wire_inner!(PyRankCounts, RankCounts, "RankCounts");
+
+pickled!(PyRankCounts {
     /// Counts an ``(N, 2)`` array of parameters (``N = 0`` allowed).
     fn add(&mut self, query: &PyRankQuery, uv: &Bound<'_, PyAny>) -> PyResult<()> {
         let n = uv.len()?;
@@ -881,24 +855,7 @@ impl PyRankCounts {
     fn nbytes(&self) -> usize {
         self.inner.bytes()
     }
-
-    /// The exact bytes (see ``from_bytes``).
-    fn to_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
-        PyBytes::new(py, &self.inner.to_bytes())
-    }
-
-    /// The counts whose ``to_bytes`` gave ``data``.
-    #[staticmethod]
-    fn from_bytes(data: &[u8]) -> PyResult<Self> {
-        Ok(Self {
-            inner: RankCounts::from_bytes(data).map_err(err)?,
-        })
-    }
-
-    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
-        reduce(py, "RankCounts", &self.inner.to_bytes())
-    }
-}
+});
 
 /// Adds the classes of this module to the native module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -19,6 +19,7 @@
 
 use pyo3::prelude::*;
 
+pub mod chunks;
 pub mod cloud;
 pub mod convert;
 pub mod curves;
@@ -53,5 +54,6 @@ fn _scanfit(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(reconstruct::reconstruct, m)?)?;
     sums::register(m)?;
     fit_sums::register(m)?;
+    chunks::register(m)?;
     Ok(())
 }

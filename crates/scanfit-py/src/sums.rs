@@ -13,7 +13,8 @@
 //!   broadcast per level (`MbaState`: frame, the level lattices so far,
 //!   the centring), `accumulator()` the level's empty `BaSums`.
 //! * `BaSums`: one level's BA sums; `add(state, points)` evaluates the
-//!   levels so far at the points and adds their residuals.
+//!   levels so far at the points, adds their residuals and returns the
+//!   pass's `PassSums` (a row's statistics, the fitted start's sums).
 //! * `ResidualSums`: mergeable error statistics (count, mean, max, RMSE).
 //! * `NormalEquations`: the least-squares surface's normal equations with
 //!   uniform knots, configured by `fit_surface`'s keywords.
@@ -23,10 +24,10 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList, PyTuple};
 use scanfit::centring::Centring;
 use scanfit::fit::surface::NormalEquations;
-use scanfit::mba::sums::residuals;
+use scanfit::mba::sums::pass_sums;
 use scanfit::mba::{
-    lattice_surface, BaAccumulator, ControlFormula, Frame, FrameSums, Lattice, MbaLevels,
-    ResidualSums,
+    lattice_surface, BaAccumulator, ControlFormula, Frame, FrameSums, Lattice, LevelInputs,
+    MbaLevels, PassSums, ResidualSums, Start,
 };
 use scanfit::wire::{Reader, Writer};
 use scanfit::{Point3, Vector3};
@@ -76,6 +77,71 @@ pub(crate) fn read<T>(
     r.end().map_err(err)?;
     Ok(t)
 }
+
+/// A class of `scanfit.sums` that travels as exact bytes: its record
+/// (`scanfit::wire`) and the name `scanfit.sums._restore` knows it by.
+pub(crate) trait Wire: Sized {
+    /// The class's name in `scanfit.sums._KINDS`.
+    const KIND: &'static str;
+    /// The exact bytes.
+    fn encode(&self) -> Vec<u8>;
+    /// Reads what [`encode`](Self::encode) wrote.
+    fn decode(data: &[u8]) -> PyResult<Self>;
+}
+
+/// `#[pymethods] impl` of a [`Wire`] class with its methods and the three
+/// that make it picklable: `to_bytes`, `from_bytes` and `__reduce__`
+/// (`(scanfit.sums._restore, (kind, bytes))`).
+macro_rules! pickled {
+    ($ty:ty { $($methods:tt)* }) => {
+        #[pymethods]
+        impl $ty {
+            $($methods)*
+
+            /// The exact bytes (see ``from_bytes``).
+            fn to_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, pyo3::types::PyBytes> {
+                pyo3::types::PyBytes::new(py, &$crate::sums::Wire::encode(self))
+            }
+
+            /// The object whose ``to_bytes`` gave ``data`` (refused, with the
+            /// reason, when they are of another type or version).
+            #[staticmethod]
+            fn from_bytes(data: &[u8]) -> PyResult<Self> {
+                <Self as $crate::sums::Wire>::decode(data)
+            }
+
+            fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+                $crate::sums::reduce(
+                    py,
+                    <Self as $crate::sums::Wire>::KIND,
+                    &$crate::sums::Wire::encode(self),
+                )
+            }
+        }
+    };
+}
+pub(crate) use pickled;
+
+/// [`Wire`] for a class that wraps a library accumulator `inner` with its
+/// own exact bytes (`to_bytes`/`from_bytes`).
+macro_rules! wire_inner {
+    ($ty:ty, $inner:ty, $kind:literal) => {
+        impl $crate::sums::Wire for $ty {
+            const KIND: &'static str = $kind;
+
+            fn encode(&self) -> Vec<u8> {
+                self.inner.to_bytes()
+            }
+
+            fn decode(data: &[u8]) -> PyResult<Self> {
+                Ok(Self {
+                    inner: <$inner>::from_bytes(data).map_err($crate::convert::err)?,
+                })
+            }
+        }
+    };
+}
+pub(crate) use wire_inner;
 
 /// The translation that moves the data's bounding box to the origin (as
 /// the in-memory pipelines compute), from the box's corners.
@@ -128,8 +194,21 @@ impl PyCentring {
 
 const CENTRING_TAG: &[u8; 8] = b"SFPYCEN1";
 
-#[pymethods]
-impl PyCentring {
+impl Wire for PyCentring {
+    const KIND: &'static str = "Centring";
+
+    fn encode(&self) -> Vec<u8> {
+        let mut w = Writer::new(CENTRING_TAG);
+        self.write(&mut w);
+        w.finish()
+    }
+
+    fn decode(data: &[u8]) -> PyResult<Self> {
+        read(data, CENTRING_TAG, "a centring", Self::read)
+    }
+}
+
+pickled!(PyCentring {
     /// The centring of data whose bounding box has corners `lo` and `hi`.
     #[new]
     fn new(lo: &Bound<'_, PyAny>, hi: &Bound<'_, PyAny>) -> PyResult<Self> {
@@ -150,28 +229,11 @@ impl PyCentring {
         (c.x, c.y, c.z)
     }
 
-    /// The exact bytes (see ``from_bytes``).
-    fn to_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
-        let mut w = Writer::new(CENTRING_TAG);
-        self.write(&mut w);
-        PyBytes::new(py, &w.finish())
-    }
-
-    /// The centring whose ``to_bytes`` gave ``data``.
-    #[staticmethod]
-    fn from_bytes(data: &[u8]) -> PyResult<Self> {
-        read(data, CENTRING_TAG, "a centring", Self::read)
-    }
-
-    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
-        reduce(py, "Centring", self.to_bytes(py).as_bytes())
-    }
-
     fn __repr__(&self) -> String {
         let c = self.centre();
         format!("Centring(centre=({}, {}, {}))", c.0, c.1, c.2)
     }
-}
+});
 
 /// The sums behind the MBA frame: bounding box in x and y and the sum of
 /// the heights, of centred points.
@@ -189,8 +251,9 @@ pub struct PyFrameSums {
     inner: FrameSums,
 }
 
-#[pymethods]
-impl PyFrameSums {
+wire_inner!(PyFrameSums, FrameSums, "FrameSums");
+
+pickled!(PyFrameSums {
     /// Empty sums.
     #[new]
     fn new() -> Self {
@@ -224,27 +287,10 @@ impl PyFrameSums {
         self.inner.points()
     }
 
-    /// The exact bytes (see ``from_bytes``).
-    fn to_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
-        PyBytes::new(py, &self.inner.to_bytes())
-    }
-
-    /// The sums whose ``to_bytes`` gave ``data``.
-    #[staticmethod]
-    fn from_bytes(data: &[u8]) -> PyResult<Self> {
-        Ok(Self {
-            inner: FrameSums::from_bytes(data).map_err(err)?,
-        })
-    }
-
-    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
-        reduce(py, "FrameSums", &self.inner.to_bytes())
-    }
-
     fn __repr__(&self) -> String {
         format!("FrameSums(points={})", self.inner.points())
     }
-}
+});
 
 /// Mergeable statistics of absolute errors: count, mean, max (and the
 /// index of the largest over all values, in merge order) and RMSE.
@@ -260,8 +306,9 @@ pub struct PyResidualSums {
     pub(crate) inner: ResidualSums,
 }
 
-#[pymethods]
-impl PyResidualSums {
+wire_inner!(PyResidualSums, ResidualSums, "ResidualSums");
+
+pickled!(PyResidualSums {
     /// No values.
     #[new]
     fn new() -> Self {
@@ -307,23 +354,6 @@ impl PyResidualSums {
         stats(py, &self.inner.stats())
     }
 
-    /// The exact bytes (see ``from_bytes``).
-    fn to_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
-        PyBytes::new(py, &self.inner.to_bytes())
-    }
-
-    /// The statistics whose ``to_bytes`` gave ``data``.
-    #[staticmethod]
-    fn from_bytes(data: &[u8]) -> PyResult<Self> {
-        Ok(Self {
-            inner: ResidualSums::from_bytes(data).map_err(err)?,
-        })
-    }
-
-    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
-        reduce(py, "ResidualSums", &self.inner.to_bytes())
-    }
-
     fn __repr__(&self) -> String {
         let s = self.inner.stats();
         format!(
@@ -331,24 +361,132 @@ impl PyResidualSums {
             s.count, s.rmse, s.max
         )
     }
+});
+
+/// What one MBA pass over a chunk measures besides a level's BA sums: the
+/// residual statistics of the row it measures (``row``) and the sums behind
+/// the fitted start (``start``: ``sum r c / sum c^2`` of the residuals after
+/// the levels so far). Merged in chunk order like ``ResidualSums``.
+///
+/// Example::
+///
+///     >>> sums = acc.add(state, pts[:5000]); sums.merge(acc.add(state, pts[5000:]))
+///     >>> run.record(sums)
+#[pyclass(name = "PassSums", module = "scanfit.sums")]
+#[derive(Clone, Default)]
+pub struct PyPassSums {
+    inner: PassSums,
 }
 
+wire_inner!(PyPassSums, PassSums, "PassSums");
+
+pickled!(PyPassSums {
+    /// No points.
+    #[new]
+    fn new() -> Self {
+        Self::default()
+    }
+
+    /// An independent copy.
+    fn copy(&self) -> Self {
+        self.clone()
+    }
+
+    /// Adds the sums of the points after these.
+    fn merge(&mut self, other: &PyPassSums) {
+        self.inner.merge(&other.inner);
+    }
+
+    /// Points of the pass.
+    #[getter]
+    fn count(&self) -> u64 {
+        self.inner.count
+    }
+
+    /// The statistics of the row measured (``count`` 0 when none).
+    fn row<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        stats(py, &self.inner.row.stats())
+    }
+
+    /// The fitted start of the levels so far (0 for the mean start).
+    #[getter]
+    fn start(&self) -> f64 {
+        self.inner.start()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "PassSums(count={}, start={})",
+            self.inner.count,
+            self.inner.start()
+        )
+    }
+});
+
 /// What an MBA level broadcasts to the workers: the frame, the lattices of
-/// the levels so far and the centring (bytes: the lattice sizes, never the
-/// point count).
+/// the levels so far (the heights' and, for the fitted start, the
+/// constant's), the row the pass measures and the centring (bytes: the
+/// lattice sizes, never the point count).
 #[pyclass(name = "MbaState", module = "scanfit.sums", frozen)]
 #[derive(Clone)]
 pub struct PyMbaState {
     centring: PyCentring,
     frame: Frame,
     levels: Vec<Lattice>,
+    constant: Vec<Lattice>,
+    start: Start,
+    /// `LevelInputs::row`.
+    row: Option<(usize, f64)>,
     /// Cells of the next level's lattice and its control formula.
     next: (usize, usize, ControlFormula),
 }
 
-const STATE_TAG: &[u8; 8] = b"SFPYMBS1";
+/// Version 2: the constant's lattices, the start and the row.
+const STATE_TAG: &[u8; 8] = b"SFPYMBS2";
 
 impl PyMbaState {
+    fn inputs(&self) -> LevelInputs<'_> {
+        LevelInputs {
+            frame: self.frame,
+            heights: &self.levels,
+            constant: &self.constant,
+            start: self.start,
+            row: self.row,
+        }
+    }
+}
+
+/// Writes lattices: their count, then each one's cells and values.
+fn write_lattices(w: &mut Writer, lattices: &[Lattice]) {
+    w.usize(lattices.len());
+    for l in lattices {
+        w.usize(l.m);
+        w.usize(l.n);
+        w.f64s(&l.phi);
+    }
+}
+
+/// Reads what [`write_lattices`] wrote.
+fn read_lattices(r: &mut Reader<'_>) -> scanfit::Result<Vec<Lattice>> {
+    let count = r.usize()?;
+    let mut levels = Vec::new();
+    for _ in 0..count {
+        let (m, n, phi) = (r.usize()?, r.usize()?, r.f64s()?);
+        if m.checked_add(3)
+            .zip(n.checked_add(3))
+            .and_then(|(a, b)| a.checked_mul(b))
+            != Some(phi.len())
+        {
+            return Err(r.corrupt(&format!("a {m} x {n} lattice of {} values", phi.len())));
+        }
+        levels.push(Lattice { m, n, phi });
+    }
+    Ok(levels)
+}
+
+impl Wire for PyMbaState {
+    const KIND: &'static str = "MbaState";
+
     fn encode(&self) -> Vec<u8> {
         let mut w = Writer::new(STATE_TAG);
         self.centring.write(&mut w);
@@ -359,56 +497,16 @@ impl PyMbaState {
         w.usize(self.next.0);
         w.usize(self.next.1);
         w.u64(u64::from(self.next.2 == ControlFormula::Hjelle));
-        w.usize(self.levels.len());
-        for l in &self.levels {
-            w.usize(l.m);
-            w.usize(l.n);
-            w.f64s(&l.phi);
-        }
+        write_lattices(&mut w, &self.levels);
+        write_lattices(&mut w, &self.constant);
+        w.u64(u64::from(self.start == Start::Fitted));
+        let (j, d) = self.row.unwrap_or((usize::MAX, 0.0));
+        w.usize(j);
+        w.f64(d);
         w.finish()
     }
-}
 
-#[pymethods]
-impl PyMbaState {
-    /// The statistics of the vertical residuals ``|z - f(x, y)|`` of an
-    /// ``(N, 3)`` chunk after the levels so far.
-    fn residuals(&self, py: Python<'_>, points: &Bound<'_, PyAny>) -> PyResult<PyResidualSums> {
-        let p = self.centring.apply(chunk(points)?);
-        let inner = py
-            .detach(|| residuals(&self.frame, &self.levels, &p))
-            .map_err(err)?;
-        Ok(PyResidualSums { inner })
-    }
-
-    /// Empty BA sums of the next level (what each worker fills).
-    fn accumulator(&self) -> PyResult<PyBaSums> {
-        let (m, n, formula) = self.next;
-        Ok(PyBaSums {
-            inner: BaAccumulator::new(m, n, formula).map_err(err)?,
-        })
-    }
-
-    /// Levels so far.
-    #[getter]
-    fn levels(&self) -> usize {
-        self.levels.len()
-    }
-
-    /// Bytes of the lattices (what is sent to each worker per level).
-    #[getter]
-    fn nbytes(&self) -> usize {
-        self.levels.iter().map(|l| 8 * l.phi.len()).sum()
-    }
-
-    /// The exact bytes (see ``from_bytes``).
-    fn to_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
-        PyBytes::new(py, &self.encode())
-    }
-
-    /// The state whose ``to_bytes`` gave ``data``.
-    #[staticmethod]
-    fn from_bytes(data: &[u8]) -> PyResult<Self> {
+    fn decode(data: &[u8]) -> PyResult<Self> {
         read(data, STATE_TAG, "an MBA level state", |r| {
             let centring = PyCentring::read(r)?;
             let frame = Frame {
@@ -424,30 +522,86 @@ impl PyMbaState {
                 1 => ControlFormula::Hjelle,
                 x => return Err(r.corrupt(&format!("control formula {x}"))),
             };
-            let count = r.usize()?;
-            let mut levels = Vec::new();
-            for _ in 0..count {
-                let (m, n, phi) = (r.usize()?, r.usize()?, r.f64s()?);
-                if m.checked_add(3)
-                    .zip(n.checked_add(3))
-                    .and_then(|(a, b)| a.checked_mul(b))
-                    != Some(phi.len())
-                {
-                    return Err(r.corrupt(&format!("a {m} x {n} lattice of {} values", phi.len())));
-                }
-                levels.push(Lattice { m, n, phi });
-            }
+            let levels = read_lattices(r)?;
+            let constant = read_lattices(r)?;
+            let start = match r.u64()? {
+                0 => Start::Mean,
+                1 => Start::Fitted,
+                x => return Err(r.corrupt(&format!("start {x}"))),
+            };
+            let (j, d) = (r.usize()?, r.f64()?);
             Ok(Self {
                 centring,
                 frame,
                 levels,
+                constant,
+                start,
+                row: (j != usize::MAX).then_some((j, d)),
                 next: (m, n, formula),
             })
         })
     }
+}
 
-    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
-        reduce(py, "MbaState", &self.encode())
+pickled!(PyMbaState {
+    /// The statistics of the vertical residuals ``|z - f(x, y)|`` of an
+    /// ``(N, 3)`` chunk after the levels so far, started from the mean or
+    /// (fitted start) from the start of the levels so far (an error while
+    /// ``MbaLevels.needs_pass``).
+    fn residuals(&self, py: Python<'_>, points: &Bound<'_, PyAny>) -> PyResult<PyResidualSums> {
+        let h = self.levels.len();
+        let d = match (self.start, self.row) {
+            (Start::Mean, _) => 0.0,
+            (Start::Fitted, Some((j, d))) if j == h => d,
+            (Start::Fitted, _) if h == 0 => 0.0,
+            (Start::Fitted, _) => {
+                return Err(value_err(
+                    "the fitted start of the last level is not known yet: run the pass of MbaState.pass_sums while MbaLevels.needs_pass, record it, then take the state again".into(),
+                ))
+            }
+        };
+        let p = self.centring.apply(chunk(points)?);
+        let inputs = LevelInputs {
+            row: Some((h, d)),
+            ..self.inputs()
+        };
+        let inner = py.detach(|| pass_sums(&inputs, &p)).map_err(err)?.row;
+        Ok(PyResidualSums { inner })
+    }
+
+    /// The pass sums of an ``(N, 3)`` chunk after the levels so far,
+    /// without a level's BA sums: the fitted start's pass after the last
+    /// level (``MbaLevels.needs_pass``).
+    fn pass_sums(&self, py: Python<'_>, points: &Bound<'_, PyAny>) -> PyResult<PyPassSums> {
+        let p = self.centring.apply(chunk(points)?);
+        let inner = py
+            .detach(|| pass_sums(&self.inputs(), &p))
+            .map_err(err)?;
+        Ok(PyPassSums { inner })
+    }
+
+    /// Empty BA sums of the next level (what each worker fills).
+    fn accumulator(&self) -> PyResult<PyBaSums> {
+        let (m, n, formula) = self.next;
+        Ok(PyBaSums {
+            inner: BaAccumulator::for_start(m, n, formula, self.start).map_err(err)?,
+        })
+    }
+
+    /// Levels so far.
+    #[getter]
+    fn levels(&self) -> usize {
+        self.levels.len()
+    }
+
+    /// Bytes of the lattices (what is sent to each worker per level).
+    #[getter]
+    fn nbytes(&self) -> usize {
+        self.levels
+            .iter()
+            .chain(&self.constant)
+            .map(|l| 8 * l.phi.len())
+            .sum()
     }
 
     fn __repr__(&self) -> String {
@@ -457,7 +611,7 @@ impl PyMbaState {
             self.nbytes()
         )
     }
-}
+});
 
 /// The BA sums of one MBA level ([LWS97] eqs. 3-4): per control value the
 /// numerator and denominator of eq. 4. Made by ``MbaLevels.accumulator()``.
@@ -473,22 +627,24 @@ pub struct PyBaSums {
     inner: BaAccumulator,
 }
 
-#[pymethods]
-impl PyBaSums {
+wire_inner!(PyBaSums, BaAccumulator, "BaSums");
+
+pickled!(PyBaSums {
     /// Adds the residuals of an ``(N, 3)`` chunk (``N = 0`` allowed) after
-    /// the levels of ``state``; returns their statistics (the residuals of
-    /// the level before, for its report).
+    /// the levels of ``state``; returns what the pass measures
+    /// (``PassSums``: the statistics of a level before, for its report, and
+    /// the fitted start's sums).
     fn add(
         &mut self,
         py: Python<'_>,
         state: &PyMbaState,
         points: &Bound<'_, PyAny>,
-    ) -> PyResult<PyResidualSums> {
+    ) -> PyResult<PyPassSums> {
         let p = state.centring.apply(chunk(points)?);
         let inner = py
-            .detach(|| self.inner.add_residuals(&state.frame, &state.levels, &p))
+            .detach(|| self.inner.add_levels(&state.inputs(), &p))
             .map_err(err)?;
-        Ok(PyResidualSums { inner })
+        Ok(PyPassSums { inner })
     }
 
     /// An independent copy (tasks copy a broadcast value before changing it).
@@ -513,39 +669,27 @@ impl PyBaSums {
         self.inner.cells()
     }
 
-    /// Bytes of one set of sums (2 values per control value).
+    /// Bytes of one set of sums (per control value a numerator per value
+    /// set and the denominator).
     #[getter]
     fn nbytes(&self) -> usize {
         self.inner.bytes()
-    }
-
-    /// The exact bytes (see ``from_bytes``).
-    fn to_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
-        PyBytes::new(py, &self.inner.to_bytes())
-    }
-
-    /// The sums whose ``to_bytes`` gave ``data``.
-    #[staticmethod]
-    fn from_bytes(data: &[u8]) -> PyResult<Self> {
-        Ok(Self {
-            inner: BaAccumulator::from_bytes(data).map_err(err)?,
-        })
-    }
-
-    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
-        reduce(py, "BaSums", &self.inner.to_bytes())
     }
 
     fn __repr__(&self) -> String {
         let (m, n) = self.inner.cells();
         format!("BaSums(cells=({m}, {n}), points={})", self.inner.points())
     }
-}
+});
 
 /// The MBA level loop on the client (``scanfit.mba``'s keywords ``levels``,
-/// ``base``, ``tolerance``, ``hjelle``): per level, ``state()`` is
-/// broadcast, the workers return ``BaSums`` of their points, merged and
-/// ``push``-ed; ``finish()`` gives the surface.
+/// ``base``, ``tolerance``, ``hjelle``, ``start``): per level, ``state()``
+/// is broadcast, the workers return ``BaSums`` of their points and their
+/// ``PassSums``, merged; the pass sums are ``record``-ed (which says
+/// whether the tolerance is met) and the BA sums ``push``-ed. With the
+/// fitted start (the default) one more pass of ``MbaState.pass_sums`` finds
+/// the last level's start while ``needs_pass``; ``finish()`` gives the
+/// surface, and ``record_last`` the last row from a measuring pass.
 ///
 /// ``frame`` holds the sums of the centred points; ``domain=(x0, y0, x1,
 /// y1)`` (data units) replaces their bounding box in x and y by that
@@ -555,7 +699,11 @@ impl PyBaSums {
 ///
 ///     >>> run = scanfit.sums.MbaLevels(frame, centring, levels=4)
 ///     >>> while not run.done:
-///     ...     acc = run.accumulator(); acc.add(run.state(), pts); run.push(acc)
+///     ...     acc = run.accumulator(); sums = acc.add(run.state(), pts)
+///     ...     if run.record(sums): break
+///     ...     run.push(acc)
+///     >>> while run.needs_pass:
+///     ...     run.record(run.state().pass_sums(pts))
 ///     >>> run.finish()["surface"]
 #[pyclass(name = "MbaLevels", module = "scanfit.sums")]
 pub struct PyMbaLevels {
@@ -570,13 +718,20 @@ impl PyMbaLevels {
             .as_ref()
             .ok_or_else(|| value_err("this MbaLevels has finished; make a new one".into()))
     }
+
+    fn run_mut(&mut self) -> PyResult<&mut MbaLevels> {
+        self.run
+            .as_mut()
+            .ok_or_else(|| value_err("this MbaLevels has finished; make a new one".into()))
+    }
 }
 
 #[pymethods]
 impl PyMbaLevels {
     /// The loop over the data summed in ``frame`` (centred by ``centring``).
     #[new]
-    #[pyo3(signature = (frame, centring, levels = 6, base = None, tolerance = None, hjelle = false, domain = None))]
+    #[pyo3(signature = (frame, centring, levels = 6, base = None, tolerance = None, hjelle = false, domain = None, start = "fitted"))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         frame: &PyFrameSums,
         centring: &PyCentring,
@@ -585,12 +740,12 @@ impl PyMbaLevels {
         tolerance: Option<f64>,
         hjelle: bool,
         domain: Option<(f64, f64, f64, f64)>,
+        start: &str,
     ) -> PyResult<Self> {
         if levels == 0 {
             return Err(value_err("levels must be at least 1".into()));
         }
-        // the mean: the start whose sums the level loop keeps exact
-        let config = mba_config(levels, base.as_ref(), tolerance, hjelle, "mean")?;
+        let config = mba_config(levels, base.as_ref(), tolerance, hjelle, start)?;
         let f = match domain {
             None => frame.inner.finish().map_err(err)?,
             Some((x0, y0, x1, y1)) => {
@@ -636,10 +791,14 @@ impl PyMbaLevels {
     fn state(&self) -> PyResult<PyMbaState> {
         let run = self.run()?;
         let (m, n) = run.next_cells();
+        let inputs = run.inputs();
         Ok(PyMbaState {
             centring: self.centring.clone(),
-            frame: run.frame(),
-            levels: run.levels().to_vec(),
+            frame: inputs.frame,
+            levels: inputs.heights.to_vec(),
+            constant: inputs.constant.to_vec(),
+            start: inputs.start,
+            row: inputs.row,
             next: (m, n, self.formula),
         })
     }
@@ -653,22 +812,29 @@ impl PyMbaLevels {
 
     /// Finishes the next level from its merged sums.
     fn push(&mut self, sums: &PyBaSums) -> PyResult<()> {
-        self.run
-            .as_mut()
-            .ok_or_else(|| value_err("this MbaLevels has finished; make a new one".into()))?
-            .push(sums.inner.clone())
-            .map_err(err)
+        self.run_mut()?.push(sums.inner.clone()).map_err(err)
     }
 
-    /// Records the residual statistics after the last level pushed (what
-    /// the next level's ``BaSums.add`` calls returned, merged in point
-    /// order); returns whether they meet the tolerance (stop).
-    fn record_residual(&mut self, sums: &PyResidualSums) -> PyResult<bool> {
-        Ok(self
-            .run
-            .as_mut()
-            .ok_or_else(|| value_err("this MbaLevels has finished; make a new one".into()))?
-            .record_residual(sums.inner.stats()))
+    /// Records what a pass over all points measured (the ``PassSums`` of
+    /// its chunks, merged in point order): a row of a level before and the
+    /// fitted start so far; returns whether the tolerance is met (stop
+    /// before pushing the level).
+    fn record(&mut self, sums: &PyPassSums) -> PyResult<bool> {
+        self.run_mut()?.record(&sums.inner).map_err(err)
+    }
+
+    /// Whether the fitted start of the last level is unknown: one more pass
+    /// of ``MbaState.pass_sums``, ``record``-ed, before ``finish``.
+    #[getter]
+    fn needs_pass(&self) -> PyResult<bool> {
+        Ok(self.run()?.needs_pass())
+    }
+
+    /// Records the last level's row from a measuring pass over the
+    /// finished surface (``MbaState.residuals``), unless a pass recorded it.
+    fn record_last(&mut self, sums: &PyResidualSums) -> PyResult<()> {
+        self.run_mut()?.record_last(sums.inner.stats());
+        Ok(())
     }
 
     /// The approximation: a dict with ``surface`` (in data coordinates, as
@@ -721,7 +887,7 @@ pub struct PyNormalEquations {
 const NORMAL_TAG: &[u8; 8] = b"SFPYNEQ1";
 
 impl PyNormalEquations {
-    fn encode(&self) -> Vec<u8> {
+    fn bytes(&self) -> Vec<u8> {
         let mut w = Writer::new(NORMAL_TAG);
         self.centring.write(&mut w);
         w.f64(self.smoothing);
@@ -733,8 +899,31 @@ impl PyNormalEquations {
     }
 }
 
-#[pymethods]
-impl PyNormalEquations {
+impl Wire for PyNormalEquations {
+    const KIND: &'static str = "NormalEquations";
+
+    fn encode(&self) -> Vec<u8> {
+        self.bytes()
+    }
+
+    fn decode(data: &[u8]) -> PyResult<Self> {
+        let mut r = Reader::new(data, NORMAL_TAG, "least-squares normal equations").map_err(err)?;
+        let centring = PyCentring::read(&mut r).map_err(err)?;
+        let smoothing = r.f64().map_err(err)?;
+        let len = r.usize().map_err(err)?;
+        let start = 8 + 6 * 8 + 8 + 8;
+        if data.len() != start + len {
+            return Err(err(r.corrupt(&format!("an inner record of {len} bytes"))));
+        }
+        Ok(Self {
+            inner: NormalEquations::from_bytes(&data[start..]).map_err(err)?,
+            smoothing,
+            centring,
+        })
+    }
+}
+
+pickled!(PyNormalEquations {
     /// Adds an ``(N, 3)`` chunk (``N = 0`` allowed) with its ``(N, 2)``
     /// parameters.
     fn add(
@@ -787,33 +976,6 @@ impl PyNormalEquations {
         Ok(PySurface::new(self.centring.inner.restore(s)))
     }
 
-    /// The exact bytes (see ``from_bytes``).
-    fn to_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
-        PyBytes::new(py, &self.encode())
-    }
-
-    /// The equations whose ``to_bytes`` gave ``data``.
-    #[staticmethod]
-    fn from_bytes(data: &[u8]) -> PyResult<Self> {
-        let mut r = Reader::new(data, NORMAL_TAG, "least-squares normal equations").map_err(err)?;
-        let centring = PyCentring::read(&mut r).map_err(err)?;
-        let smoothing = r.f64().map_err(err)?;
-        let len = r.usize().map_err(err)?;
-        let start = 8 + 6 * 8 + 8 + 8;
-        if data.len() != start + len {
-            return Err(err(r.corrupt(&format!("an inner record of {len} bytes"))));
-        }
-        Ok(Self {
-            inner: NormalEquations::from_bytes(&data[start..]).map_err(err)?,
-            smoothing,
-            centring,
-        })
-    }
-
-    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
-        reduce(py, "NormalEquations", &self.encode())
-    }
-
     fn __repr__(&self) -> String {
         format!(
             "NormalEquations(points={}, smoothing={})",
@@ -821,7 +983,7 @@ impl PyNormalEquations {
             self.smoothing
         )
     }
-}
+});
 
 /// The errors ``|p - S(u, v)|`` of an ``(N, 3)`` chunk at its ``(N, 2)``
 /// parameters on ``surface``, as mergeable statistics (``N = 0`` allowed).
@@ -861,6 +1023,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyCentring>()?;
     m.add_class::<PyFrameSums>()?;
     m.add_class::<PyResidualSums>()?;
+    m.add_class::<PyPassSums>()?;
     m.add_class::<PyMbaState>()?;
     m.add_class::<PyBaSums>()?;
     m.add_class::<PyMbaLevels>()?;

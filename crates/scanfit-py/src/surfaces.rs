@@ -222,9 +222,11 @@ pub fn fit_surface<'py>(
 ///         ``"axis4"`` (eq. 15).
 ///     adjust_steps: most adjustment steps per level (default 5).
 ///     start: the function level 0 starts from, as ``scanfit mba --start``:
-///         ``"mean"`` (the mean height, the default) or ``"fitted"`` (the
-///         constant that leaves the smallest residual at the points after
-///         all levels; about 1.25 times the time).
+///         ``"fitted"`` (the default: the constant that leaves the smallest
+///         residual at the points after all levels, at the mean's cost) or
+///         ``"mean"`` (the mean height); ``None`` is ``"fitted"``, or
+///         ``"mean"`` with ``adjust=True`` (the adjustment starts from the
+///         mean; ``"fitted"`` with it is refused).
 ///     up: the height axis, as ``scanfit mba --up``: ``"auto"`` (the
 ///         default: the thin axis of a sheet, else z), ``"x"``, ``"y"`` or
 ///         ``"z"``. A y-up scan is fitted as ``y = f(x, -z)`` (the z-up fit
@@ -241,7 +243,7 @@ pub fn fit_surface<'py>(
 ///     >>> r = scanfit.mba(cloud, levels=5, adjust=True)
 ///     >>> [l["grid_rmse"] for l in r["levels"]]  # doctest: +SKIP
 #[pyfunction]
-#[pyo3(signature = (points, levels = 6, base = None, tolerance = None, hjelle = false, adjust = false, alpha = 1.49, weight = "moon", adjust_steps = 5, start = "mean", up = "auto"))]
+#[pyo3(signature = (points, levels = 6, base = None, tolerance = None, hjelle = false, adjust = false, alpha = 1.49, weight = "moon", adjust_steps = 5, start = None, up = "auto"))]
 #[allow(clippy::too_many_arguments)]
 pub fn mba<'py>(
     py: Python<'py>,
@@ -254,9 +256,19 @@ pub fn mba<'py>(
     alpha: f64,
     weight: &str,
     adjust_steps: usize,
-    start: &str,
+    start: Option<&str>,
     up: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let start = match (start, adjust) {
+        (Some("fitted"), true) => {
+            return Err(value_err(
+                "start='fitted' with adjust=True: the adjustment changes the lattices between levels, so the constant's levels no longer give the start; it starts from the mean (leave start out)".into(),
+            ))
+        }
+        (Some(s), _) => s,
+        (None, true) => "mean",
+        (None, false) => "fitted",
+    };
     let cloud = cloud_arg(points, "points")?;
     let mut cfg = MbaRunConfig::default();
     cfg.up = match up {

@@ -74,27 +74,46 @@ def close(a, b, what):
     assert worst <= 1e-12, f"{what}: relative difference {worst:.3e}"
 
 
+def broadcast(k, lattices, start):
+    """Bytes of an MBA level state: a header of 120 (tag, centring, frame, next
+    lattice), per lattice set a count of 8 and 24 + 8 per value for each lattice
+    (the constant's too for the fitted start), the start and the row (24)."""
+    sets = 2 if start == "fitted" else 1
+    return 120 + sets * (8 + 24 * k + lattices) + (8 if sets == 1 else 0) + 24
+
+
 def test_mba_on_two_workers_equals_the_single_process_mba(client, pts):
+    # the default start: fitted (the constant run through the levels beside the heights)
     once = scanfit.mba(pts, levels=7)
     # the points are sent to the workers once (persisted), not with every pass
     r = sd.mba(client.persist(da.from_array(pts, chunks=(CHUNKS, 3))), levels=7)
     close(r["surface"].control_points, once["surface"].control_points, "control points")
     assert r["cells"] == once["cells"]
-    assert r["points"] == N and r["passes"] == 2 + 7 + 1
+    # bounding box, frame, 7 levels, the last level's start, measures
+    assert r["points"] == N and r["passes"] == 2 + 7 + 1 + 1
     for a, b in zip(r["levels"], once["levels"]):
         assert a["control_points"] == b["control_points"]
         assert a["vertical"]["rmse"] == pytest.approx(b["vertical"]["rmse"], rel=1e-12)
         assert a["vertical"]["max"] == pytest.approx(b["vertical"]["max"], rel=1e-12)
     # the final residual statistics are those of the last level's report
     assert r["vertical"]["rmse"] == pytest.approx(once["levels"][-1]["vertical"]["rmse"], rel=1e-12)
-    # what is broadcast per level is the lattices so far, exactly: a header of 128 bytes
-    # (tag, centring, frame, next lattice, count), 24 per lattice, 8 per control value
+    # what is broadcast per level is the lattices so far, exactly
     lattices = 0
     for k, sent in enumerate(r["broadcast_bytes"]):
-        assert sent == 128 + 24 * k + lattices, (k, sent, lattices)
+        assert sent == broadcast(k, lattices, "fitted"), (k, sent, lattices)
         m, n = once["levels"][k]["control_points"]
         lattices += 8 * m * n
-    small = sd.mba(client.persist(da.from_array(pts[::10], chunks=(30_000, 3))), levels=7)
+    # the mean start: the heights' sums alone, one pass fewer
+    few = pts[::10]
+    mean = sd.mba(client.persist(da.from_array(few, chunks=(30_000, 3))), levels=7, start="mean")
+    close(mean["surface"].control_points, scanfit.mba(few, levels=7, start="mean")["surface"].control_points, "mean start")
+    assert mean["passes"] == 2 + 7 + 1
+    lattices = 0
+    for k, sent in enumerate(mean["broadcast_bytes"]):
+        assert sent == broadcast(k, lattices, "mean"), (k, sent, lattices)
+        m, n = once["levels"][k]["control_points"]
+        lattices += 8 * m * n
+    small = sd.mba(client.persist(da.from_array(few, chunks=(30_000, 3))), levels=7)
     assert small["broadcast_bytes"] == r["broadcast_bytes"]
 
 
@@ -116,8 +135,8 @@ def test_fit_surface_on_two_workers_equals_the_single_process_fit(client, pts):
     # what stays single-process is refused before any pass, with the reason
     with pytest.raises(scanfit.ScanfitError, match="whole cloud"):
         sd.mba(da.from_array(pts), adjust=True)
-    with pytest.raises(scanfit.ScanfitError, match="start from the mean|starts from the mean"):
-        sd.mba(da.from_array(pts), start="fitted")
+    with pytest.raises(scanfit.ScanfitError, match="'mean' or 'fitted'"):
+        sd.mba(da.from_array(pts), start="zero")
     with pytest.raises(scanfit.ScanfitError, match="a plane cannot close"):
         sd.fit_surface(da.from_array(pts), periodic_u=True)
 
@@ -218,15 +237,106 @@ def test_tiles_are_read_by_the_workers_and_a_bad_tile_is_named(client, tmp_path)
     close(r["surface"].control_points, scanfit.mba(p, levels=5)["surface"].control_points, "tiles")
     # a given domain replaces the bounding-box pass
     lo, hi = p.min(axis=0), p.max(axis=0)
-    d = sd.mba(paths, levels=5, domain=(lo[0], lo[1], hi[0], hi[1]))
+    d = sd.mba(paths, levels=5, domain=(lo[0], lo[1], hi[0], hi[1]), up="z")
     assert d["passes"] == r["passes"] - 1
     close(d["surface"].control_points, r["surface"].control_points, "domain")
     bad = tmp_path / "broken.ply"
     bad.write_bytes(b"ply\nformat binary_little_endian 1.0\nelement vertex 10\n")
     with pytest.raises(scanfit.ScanfitError, match="broken.ply"):
         sd.mba([*paths, bad], levels=3)
-    with pytest.raises(scanfit.ScanfitError, match="no attributes u and v"):
+    with pytest.raises(scanfit.ScanfitError, match=r"tile\d.ply.*no columns named u and v"):
         sd.fit_surface(paths, params="uv", knots="uniform")
+
+
+def test_point_chunks_serve_the_rows_of_read_cloud_a_bounded_chunk_at_a_time(tmp_path):
+    p = terrain(25_000, seed=9)
+    uv = np.random.default_rng(1).random((len(p), 2))
+    path = tmp_path / "rows.ply"
+    scanfit.write_cloud(str(path), p, attributes={"u": uv[:, 0], "v": uv[:, 1]})
+    whole = scanfit.read_cloud(str(path)).positions
+    rows = scanfit.PointChunks(str(path), 4_000, uv=True, start=6_500, stop=19_000)
+    assert rows.bounded  # binary PLY: read a chunk of records at a time
+    got = list(rows)
+    # the chunks of the reader, cut to [start, stop): never more than chunk_points rows
+    assert [len(x) for x, _ in got] == [1_500, 4_000, 4_000, 3_000]
+    assert np.array_equal(np.concatenate([x for x, _ in got]), whole[6_500:19_000])
+    assert np.array_equal(np.concatenate([u for _, u in got]), uv[6_500:19_000])
+    assert rows.rows_read == 20_000  # reading stops at the chunk holding `stop`
+    assert [len(x) for x, u in scanfit.PointChunks(str(path), 10_000, start=24_000)] == [1_000]
+    with pytest.raises(scanfit.ScanfitError, match="chunk_points must be at least 1"):
+        scanfit.PointChunks(str(path), 0)
+    with pytest.raises(scanfit.ScanfitError, match="before start"):
+        scanfit.PointChunks(str(path), 10, start=5, stop=4)
+    with pytest.raises(scanfit.ScanfitError, match="none.ply"):
+        scanfit.PointChunks(str(tmp_path / "none.ply"), 100)
+
+
+def test_a_big_tile_is_split_into_tasks_that_read_it_a_chunk_at_a_time(client, tmp_path):
+    p = terrain(200_000, seed=11)
+    sizes = [30_000, 150_000, 20_000]  # one big tile between two small ones
+    paths = []
+    for k, part in enumerate(np.split(p, np.cumsum(sizes)[:-1])):
+        paths.append(tmp_path / f"t{k}.ply")
+        scanfit.write_cloud(str(paths[-1]), part)
+    once = scanfit.mba(p, levels=6)
+    r = sd.mba(paths, levels=6, chunk_points=12_000, task_points=40_000)
+    # the big tile in 4 tasks of at most 40 000 rows, the small ones whole
+    assert r["tasks"] == 1 + 4 + 1
+    close(r["surface"].control_points, once["surface"].control_points, "split tiles, mba")
+    assert r["points"] == len(p) and r["up"] == once["up"] == "z"
+    whole = sd.mba(paths, levels=6, chunk_points=12_000)
+    assert whole["tasks"] == 3
+    close(whole["surface"].control_points, once["surface"].control_points, "tiles, mba")
+    # the default fit (plane, distribution knots) over the split tiles
+    fit = scanfit.fit_surface(p, ctrl=(12, 10))
+    f = sd.fit_surface(paths, ctrl=(12, 10), chunk_points=12_000, task_points=40_000)
+    assert f["tasks"] == 6 and f["points"] == len(p)
+    close(f["surface"].control_points, fit["surface"].control_points, "split tiles, fit")
+    knots_close(f, fit, "split tiles, fit")
+    # a tile cut short is named, whichever of its tasks meets the cut
+    cut = tmp_path / "cut.ply"
+    cut.write_bytes(paths[1].read_bytes()[:-100_000])
+    with pytest.raises(scanfit.ScanfitError, match="tile .*cut.ply could not be read"):
+        sd.mba([paths[0], cut], levels=3, chunk_points=12_000, task_points=40_000)
+    with pytest.raises(scanfit.ScanfitError, match="task_points must be a positive"):
+        sd.mba(paths, task_points=0)
+    with pytest.raises(scanfit.ScanfitError, match="chunk_points must be a positive"):
+        sd.fit_surface(paths, chunk_points=2.5)
+
+
+def test_up_on_the_workers_is_the_single_process_up(client, tmp_path):
+    zup = terrain(120_000, seed=12)
+    # the same terrain stored y-up: world (x, z, -y) is the frame (x, -z, y) turned back
+    yup = np.column_stack([zup[:, 0], zup[:, 2], -zup[:, 1]])
+    arr = client.persist(da.from_array(yup, chunks=(40_000, 3)))
+    once = scanfit.mba(yup, levels=6, up="y")
+    r = sd.mba(arr, levels=6, up="y")
+    # box (with the sample), frame, 6 levels, the fitted start's pass, the vertical residuals
+    assert r["up"] == "y" and r["passes"] == 2 + 6 + 1 + 1
+    close(r["surface"].control_points, once["surface"].control_points, "up='y'")
+    for a, b in zip(r["levels"], once["levels"]):
+        assert a["vertical"]["rmse"] == pytest.approx(b["vertical"]["rmse"], rel=1e-12)
+    # auto finds y from the bounding-box pass's sample, as the single-process call does
+    auto = sd.mba(arr, levels=6)
+    assert auto["up"] == scanfit.mba(yup, levels=6)["up"] == "y"
+    assert np.array_equal(auto["surface"].control_points, r["surface"].control_points)
+    # z as height is the other surface (a wall of spikes), also as the single-process one
+    z = sd.mba(arr, levels=4, up="z")
+    close(z["surface"].control_points, scanfit.mba(yup, levels=4, up="z")["surface"].control_points, "z")
+    # tiles, x up, with the domain in the x-up frame's (y, z)
+    xup = np.column_stack([zup[:, 2], zup[:, 0], zup[:, 1]])
+    paths = []
+    for k, part in enumerate(np.array_split(xup, 2)):
+        paths.append(tmp_path / f"x{k}.ply")
+        scanfit.write_cloud(str(paths[-1]), part)
+    x = sd.mba(paths, levels=5, up="x", chunk_points=25_000)
+    close(x["surface"].control_points, scanfit.mba(xup, levels=5, up="x")["surface"].control_points, "x")
+    lo, hi = xup.min(axis=0), xup.max(axis=0)
+    d = sd.mba(paths, levels=5, up="x", domain=(lo[1], lo[2], hi[1], hi[2]))
+    assert d["passes"] == x["passes"] - 1
+    close(d["surface"].control_points, x["surface"].control_points, "x, domain")
+    with pytest.raises(scanfit.ScanfitError, match="up = 'w' is not one of"):
+        sd.mba(arr, up="w")
 
 
 def test_bad_points_are_refused_with_the_reason(client):
@@ -247,22 +357,41 @@ def test_accumulators_pickle_exactly_and_merge_as_one_pass():
     assert pickle.loads(pickle.dumps(c)).centre == c.centre
     f = S.FrameSums()
     f.add(p, c)
-    run = S.MbaLevels(pickle.loads(pickle.dumps(f)), c, levels=4)
-    while not run.done:
-        state = pickle.loads(pickle.dumps(run.state()))
-        a, b = state.accumulator(), state.accumulator()
-        a.add(state, p[:15_000])
-        b.add(state, p[15_000:])
-        b2 = pickle.loads(pickle.dumps(b))
-        assert b2.to_bytes() == b.to_bytes() and b2.points == 25_000
-        a.merge(b2)
-        run.push(a)
-    got = run.finish()["surface"].control_points
-    close(got, scanfit.mba(p, levels=4)["surface"].control_points, "merged by hand")
+    for start in ("fitted", "mean"):
+        run = S.MbaLevels(pickle.loads(pickle.dumps(f)), c, levels=4, start=start)
+        while not run.done:
+            state = pickle.loads(pickle.dumps(run.state()))
+            a, b = state.accumulator(), state.accumulator()
+            sums = a.add(state, p[:15_000])
+            sums.merge(pickle.loads(pickle.dumps(b.add(state, p[15_000:]))))
+            b2 = pickle.loads(pickle.dumps(b))
+            assert b2.to_bytes() == b.to_bytes() and b2.points == 25_000
+            a.merge(b2)
+            assert not run.record(sums)
+            run.push(a)
+        # the fitted start of the last level: one more pass
+        assert run.needs_pass == (start == "fitted")
+        while run.needs_pass:
+            state = pickle.loads(pickle.dumps(run.state()))
+            sums = state.pass_sums(p[:15_000])
+            sums.merge(state.pass_sums(p[15_000:]))
+            run.record(sums)
+        run.record_last(run.state().residuals(p))
+        r = run.finish()
+        once = scanfit.mba(p, levels=4, start=start)
+        close(r["surface"].control_points, once["surface"].control_points, f"merged by hand, {start}")
+        for x, y in zip(r["levels"], once["levels"]):
+            assert x["vertical"]["rmse"] == pytest.approx(y["vertical"]["rmse"], rel=1e-12)
     with pytest.raises(scanfit.ScanfitError, match="BA sums"):
         S.BaSums.from_bytes(b"not sums at all")
     with pytest.raises(scanfit.ScanfitError, match="cut short"):
         S.BaSums.from_bytes(b2.to_bytes()[:-9])
+    # bytes of the format before the fitted start's second value set are refused as such
+    old = b"SFBASUM1" + b2.to_bytes()[8:]
+    with pytest.raises(scanfit.ScanfitError, match="version 1, but this scanfit reads version 2"):
+        S.BaSums.from_bytes(old)
+    with pytest.raises(scanfit.ScanfitError, match="version 1"):
+        S.MbaState.from_bytes(b"SFPYMBS1" + bytes(200))
     eq = S.FitSetup(100, c, ctrl=6, params="uv", knots="uniform").equations()
     assert pickle.loads(pickle.dumps(eq)).to_bytes() == eq.to_bytes()
 

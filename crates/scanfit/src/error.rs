@@ -131,6 +131,26 @@ pub enum Error {
         /// what went wrong in it
         source: Box<Error>,
     },
+    /// A fitted surface reaches farther outside the bounding box of its
+    /// points than [`crate::pipeline::Extent::limit`] (a fit that flew off
+    /// where there are no data); a pipeline returns it unless told to allow
+    /// extrapolation.
+    #[error(
+        "{}the surface leaves the data: samples reach {:e} ({:.0} point spacings, {:.1}% of the diagonal) outside {} points' bounding box and control points {:e} (limit {:e}); fit it with fewer control points or terms, or allow extrapolation",
+        patch.map(|p| format!("patch {p}: ")).unwrap_or_default(),
+        extent.samples_outside,
+        extent.samples_outside_spacings,
+        100.0 * extent.samples_outside / extent.diagonal.max(f64::MIN_POSITIVE),
+        if patch.is_some() { "its" } else { "the" },
+        extent.control_outside,
+        extent.limit
+    )]
+    LeavesData {
+        /// The patch's id (label), for one patch of several.
+        patch: Option<i64>,
+        /// How far it left.
+        extent: crate::pipeline::Extent,
+    },
     /// Any other invalid argument.
     #[error("{0}")]
     InvalidInput(String),

@@ -113,32 +113,19 @@ pub(crate) fn surface_variation(values: &[f64; 3]) -> f64 {
 /// Centroid and covariance of `points` (`None` for no points), the
 /// covariance as `[c00, c11, c22, c01, c02, c12]`. It is accumulated about
 /// the first point and then re-centred, which keeps it accurate for
-/// coordinates far from the origin (georeferenced scans).
+/// coordinates far from the origin (georeferenced scans). The sums are
+/// [`CovarianceSums`]' (one accumulation for the normals' neighbourhoods
+/// and the chunked PCA).
 pub(crate) fn covariance(points: impl IntoIterator<Item = Vector3>) -> Option<(Point3, [f64; 6])> {
     let mut it = points.into_iter();
     let first = it.next()?;
-    let (mut n, mut sum, mut c) = (1.0, Vector3::zeros(), [0.0; 6]);
+    let mut sums = CovarianceSums::new(Point3::from(first));
+    // the first point adds zeros: counted, not summed
+    sums.n = 1.0;
     for p in it {
-        let d = p - first;
-        sum += d;
-        c[0] += d.x * d.x;
-        c[1] += d.y * d.y;
-        c[2] += d.z * d.z;
-        c[3] += d.x * d.y;
-        c[4] += d.x * d.z;
-        c[5] += d.y * d.z;
-        n += 1.0;
+        sums.add_offset(p - first);
     }
-    let m = sum / n;
-    let cov = [
-        c[0] / n - m.x * m.x,
-        c[1] / n - m.y * m.y,
-        c[2] / n - m.z * m.z,
-        c[3] / n - m.x * m.y,
-        c[4] / n - m.x * m.z,
-        c[5] / n - m.y * m.z,
-    ];
-    Some((Point3::from(first + m), cov))
+    Some(sums.centred())
 }
 
 /// PCA of `points` (`None` for no points). The covariance is accumulated
@@ -179,7 +166,8 @@ pub struct CovarianceSums {
     reference: Vector3,
     n: f64,
     sum: Vector3,
-    cov: nalgebra::Matrix3<f64>,
+    /// The distinct sums of `(p - r)(p - r)^T`: xx, yy, zz, xy, xz, yz.
+    cov: [f64; 6],
 }
 
 const COVARIANCE_TAG: &[u8; 8] = b"SFCOVS01";
@@ -192,16 +180,26 @@ impl CovarianceSums {
             reference: reference.coords,
             n: 0.0,
             sum: Vector3::zeros(),
-            cov: nalgebra::Matrix3::zeros(),
+            cov: [0.0; 6],
         }
     }
 
     /// Adds one point.
     #[inline]
     pub fn add(&mut self, p: &Point3) {
-        let d = p.coords - self.reference;
+        self.add_offset(p.coords - self.reference);
+    }
+
+    /// Adds the point at `d` from the reference.
+    #[inline]
+    fn add_offset(&mut self, d: Vector3) {
         self.sum += d;
-        self.cov += d * d.transpose();
+        self.cov[0] += d.x * d.x;
+        self.cov[1] += d.y * d.y;
+        self.cov[2] += d.z * d.z;
+        self.cov[3] += d.x * d.y;
+        self.cov[4] += d.x * d.z;
+        self.cov[5] += d.y * d.z;
         self.n += 1.0;
     }
 
@@ -219,7 +217,9 @@ impl CovarianceSums {
             )));
         }
         self.sum += other.sum;
-        self.cov += other.cov;
+        for (a, b) in self.cov.iter_mut().zip(&other.cov) {
+            *a += b;
+        }
         self.n += other.n;
         Ok(())
     }
@@ -229,18 +229,24 @@ impl CovarianceSums {
         if self.n == 0.0 {
             return None;
         }
-        let n = self.n;
+        let (centroid, cov) = self.centred();
+        Some(pca_of(centroid, &cov))
+    }
+
+    /// The centroid and the covariance about it (of at least one point), in
+    /// [`covariance`]'s form.
+    fn centred(&self) -> (Point3, [f64; 6]) {
+        let (n, c) = (self.n, &self.cov);
         let m = self.sum / n;
-        let c = self.cov / n - m * m.transpose();
         let cov = [
-            c[(0, 0)],
-            c[(1, 1)],
-            c[(2, 2)],
-            c[(0, 1)],
-            c[(0, 2)],
-            c[(1, 2)],
+            c[0] / n - m.x * m.x,
+            c[1] / n - m.y * m.y,
+            c[2] / n - m.z * m.z,
+            c[3] / n - m.x * m.y,
+            c[4] / n - m.x * m.z,
+            c[5] / n - m.y * m.z,
         ];
-        Some(pca_of(Point3::from(self.reference + m), &cov))
+        (Point3::from(self.reference + m), cov)
     }
 
     /// The sums as exact bytes ([`crate::wire`]).
@@ -263,7 +269,10 @@ impl CovarianceSums {
         w.f64s(self.reference.as_slice());
         w.f64(self.n);
         w.f64s(self.sum.as_slice());
-        w.f64s(self.cov.as_slice());
+        // the whole symmetric matrix, column by column (the format of the
+        // first version, which summed all nine)
+        let [xx, yy, zz, xy, xz, yz] = self.cov;
+        w.f64s(&[xx, xy, xz, xy, yy, yz, xz, yz, zz]);
     }
 
     /// Reads the fields [`write`](Self::write) wrote.
@@ -278,7 +287,7 @@ impl CovarianceSums {
             reference: Vector3::from_column_slice(&reference),
             n,
             sum: Vector3::from_column_slice(&sum),
-            cov: nalgebra::Matrix3::from_column_slice(&cov),
+            cov: [cov[0], cov[4], cov[8], cov[3], cov[6], cov[7]],
         })
     }
 }

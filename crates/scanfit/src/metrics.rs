@@ -158,7 +158,10 @@ pub struct ParamQuality {
     /// surface normal) is opposite to their orientation in `(u, v)`.
     pub fold_overs: usize,
     /// Area-weighted L2 stretch of the map `(u, v) -> P` (Sander et al. 2001),
-    /// normalised so that a map uniform up to scale gives 1.
+    /// normalised so that a map uniform up to scale gives 1. This and the
+    /// two measures below leave out the slivers along the border of the
+    /// triangulation (an angle over 150 degrees opposite a border edge:
+    /// nearly collinear outline points, not surface; see `inner_faces`).
     pub l2_stretch: f64,
     /// Largest ratio of the singular values of a triangle's map (anisotropy).
     pub max_anisotropy: f64,
@@ -235,6 +238,7 @@ pub(crate) fn parameterization_quality_where(
             .copied()
             .unwrap_or(f64::INFINITY);
     let faces: Vec<[usize; 3]> = all.into_iter().filter(|f| longest(f) <= limit).collect();
+    let inner = inner_faces(&faces, uv);
     let (p, q) = surface.degrees();
     // per triangle: (folded, 3D area, uv area, L2^2, anisotropy)
     let per: Vec<(bool, f64, f64, f64, f64)> = faces
@@ -276,13 +280,26 @@ pub(crate) fn parameterization_quality_where(
             },
         )
         .collect();
+    Ok(q_from(per, &inner, faces.len()))
+}
+
+/// The summary of the per-triangle `(folded, 3D area, uv area, L2^2,
+/// anisotropy)` of `count` triangles: fold-overs over all, the stretch
+/// measures over those `inner` marks.
+fn q_from(per: Vec<(bool, f64, f64, f64, f64)>, inner: &[bool], count: usize) -> ParamQuality {
+    let folds = per.iter().filter(|t| t.0).count();
+    let per: Vec<_> = per
+        .into_iter()
+        .zip(inner)
+        .filter_map(|(t, &keep)| keep.then_some(t))
+        .collect();
     let total3: f64 = per.iter().map(|t| t.1).sum();
     let total_uv: f64 = per.iter().map(|t| t.2).sum();
     let mut q = ParamQuality {
-        triangles: faces.len(),
+        triangles: count,
+        fold_overs: folds,
         ..Default::default()
     };
-    q.fold_overs = per.iter().filter(|t| t.0).count();
     if total3 > 0.0 && total_uv > 0.0 {
         let l2: f64 = per.iter().map(|t| t.3 * t.1).sum::<f64>() / total3;
         q.l2_stretch = (l2 * total_uv / total3).sqrt();
@@ -303,7 +320,71 @@ pub(crate) fn parameterization_quality_where(
             q.area_ratio_percentiles = [pick(0.05), pick(0.5), pick(0.95)];
         }
     }
-    Ok(q)
+    q
+}
+
+/// Largest angle of a triangle, opposite an edge of the triangulation's
+/// border, above which [`inner_faces`] peels it off: 150 degrees.
+const BORDER_SLIVER_COS: f64 = -0.866_025_403_784_438_6;
+
+/// Which of `faces` (triangles of the Delaunay triangulation of `uv`) the
+/// stretch measures use: all but the slivers along the border, peeled off
+/// layer by layer. A border triangle whose angle opposite its border edge
+/// exceeds 150 degrees joins three nearly collinear points of the outline
+/// (on a grid clipped to a disc, exactly collinear up to round-off): a
+/// triangle of the convex hull, not of the surface, whose parameter area is
+/// a sliver of its 3D area, so it would make the L2 stretch (which divides
+/// by the parameter area, Sander et al. 2001 eq. 3) as large as 1e11.
+/// Interior triangles, however thin (scan lines), are kept: their shape is
+/// the data's. The rule is relative to each triangle's own edges, so it does
+/// not depend on the data's density or units.
+fn inner_faces(faces: &[[usize; 3]], uv: &[[f64; 2]]) -> Vec<bool> {
+    use std::collections::HashMap;
+    let key = |a: usize, b: usize| (a.min(b), a.max(b));
+    let mut uses: HashMap<(usize, usize), u32> = HashMap::with_capacity(3 * faces.len());
+    for f in faces {
+        for k in 0..3 {
+            *uses.entry(key(f[k], f[(k + 1) % 3])).or_default() += 1;
+        }
+    }
+    // the cosine of the angle at c, opposite the edge (a, b)
+    let cos_at = |a: usize, b: usize, c: usize| {
+        let (x, y) = (
+            [uv[a][0] - uv[c][0], uv[a][1] - uv[c][1]],
+            [uv[b][0] - uv[c][0], uv[b][1] - uv[c][1]],
+        );
+        let n = x[0].hypot(x[1]) * y[0].hypot(y[1]);
+        if n > 0.0 {
+            (x[0] * y[0] + x[1] * y[1]) / n
+        } else {
+            1.0
+        }
+    };
+    let mut keep = vec![true; faces.len()];
+    loop {
+        let mut peeled = Vec::new();
+        for (i, f) in faces.iter().enumerate().filter(|(i, _)| keep[*i]) {
+            let sliver = (0..3).any(|k| {
+                let (a, b, c) = (f[k], f[(k + 1) % 3], f[(k + 2) % 3]);
+                uses[&key(a, b)] == 1 && cos_at(a, b, c) < BORDER_SLIVER_COS
+            });
+            if sliver {
+                peeled.push(i);
+            }
+        }
+        if peeled.is_empty() {
+            return keep;
+        }
+        for i in peeled {
+            keep[i] = false;
+            let f = faces[i];
+            for k in 0..3 {
+                if let Some(n) = uses.get_mut(&key(f[k], f[(k + 1) % 3])) {
+                    *n -= 1;
+                }
+            }
+        }
+    }
 }
 
 #[cfg(test)]

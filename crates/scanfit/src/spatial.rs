@@ -80,10 +80,16 @@ fn dist2(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     x * x + y * y + z * z
 }
 
+/// One candidate: squared distance, index in the input, tree position (16
+/// bytes, as the pair without the position would be after padding). Packing
+/// it in one `u128` ordered as (distance, index) was tried: more
+/// instructions (callgrind), the same CPU time.
+type Candidate = (f64, u32, u32);
+
 /// The `k` best candidates so far, sorted by (squared distance, index).
 struct Best {
     k: usize,
-    items: Vec<(f64, u32)>,
+    items: Vec<Candidate>,
 }
 
 impl Best {
@@ -94,7 +100,43 @@ impl Best {
         }
     }
 
-    /// Candidates farther than this (squared) cannot enter.
+    /// Empties it for the next query (keeping its memory).
+    fn restart(&mut self, k: usize) {
+        self.k = k;
+        self.items.clear();
+    }
+
+    fn offer(&mut self, d2: f64, id: u32, pos: u32) {
+        let before = |c: &Candidate| d2 < c.0 || (d2 == c.0 && id < c.1);
+        let n = self.items.len();
+        if n == self.k {
+            if !before(&self.items[n - 1]) {
+                return;
+            }
+            self.items[n - 1] = (d2, id, pos);
+        } else {
+            self.items.push((d2, id, pos));
+        }
+        // one insertion-sort step (k is small: no binary search, no memmove)
+        let mut at = self.items.len() - 1;
+        while at > 0 && before(&self.items[at - 1]) {
+            self.items[at] = self.items[at - 1];
+            at -= 1;
+        }
+        self.items[at] = (d2, id, pos);
+    }
+}
+
+/// What a descent of the tree collects: the points of each bucket it
+/// reaches, and the squared distance beyond which a cell holds nothing for it.
+trait Visit {
+    /// Cells farther than this (squared) are skipped.
+    fn bound(&self) -> f64;
+    /// Takes the points of the bucket `lo..hi`.
+    fn bucket(&mut self, tree: &KdTree, lo: usize, hi: usize, q: &[f64; 3]);
+}
+
+impl Visit for Best {
     fn bound(&self) -> f64 {
         if self.items.len() < self.k {
             f64::INFINITY
@@ -103,24 +145,39 @@ impl Best {
         }
     }
 
-    fn offer(&mut self, d2: f64, id: u32) {
-        let before = |c: &(f64, u32)| d2 < c.0 || (d2 == c.0 && id < c.1);
-        let n = self.items.len();
-        if n == self.k {
-            if !before(&self.items[n - 1]) {
-                return;
+    fn bucket(&mut self, tree: &KdTree, lo: usize, hi: usize, q: &[f64; 3]) {
+        // most points of a bucket are farther than the k-th: the test here
+        // spares them the call (`<=`: an equal distance may win by index)
+        let mut worst = self.bound();
+        let (pts, ids) = (&tree.pts[lo..hi], &tree.ids[lo..hi]);
+        for (j, (p, &id)) in (lo as u32..).zip(pts.iter().zip(ids)) {
+            let d2 = dist2(p, q);
+            if d2 <= worst {
+                self.offer(d2, id, j);
+                worst = self.bound();
             }
-            self.items[n - 1] = (d2, id);
-        } else {
-            self.items.push((d2, id));
         }
-        // one insertion-sort step (k is small: no binary search, no memmove)
-        let mut at = self.items.len() - 1;
-        while at > 0 && before(&self.items[at - 1]) {
-            self.items[at] = self.items[at - 1];
-            at -= 1;
+    }
+}
+
+/// The points within a squared distance, unsorted.
+struct Within {
+    r2: f64,
+    found: Vec<(f64, u32)>,
+}
+
+impl Visit for Within {
+    fn bound(&self) -> f64 {
+        self.r2
+    }
+
+    fn bucket(&mut self, tree: &KdTree, lo: usize, hi: usize, q: &[f64; 3]) {
+        for j in lo..hi {
+            let d2 = dist2(&tree.pts[j], q);
+            if d2 <= self.r2 {
+                self.found.push((d2, tree.ids[j]));
+            }
         }
-        self.items[at] = (d2, id);
     }
 }
 
@@ -283,22 +340,11 @@ impl KdTree {
         dist: fn(f64) -> B,
     ) -> Vec<u32> {
         let n = self.len();
-        let kq = (k + 1).min(n);
         let mut indices = vec![0u32; n * k];
         let positions: Vec<u32> = (0..n as u32).collect();
         let rows = |pos: usize, idx: &mut [u32], d: &mut [B]| {
-            let me = self.ids[pos];
-            let found = self.best(&self.pts[pos], kq).items;
-            let skip = found
-                .iter()
-                .position(|c| c.1 == me)
-                .unwrap_or(found.len() - 1);
-            let kept = found
-                .iter()
-                .enumerate()
-                .filter(|&(j, _)| j != skip)
-                .map(|(_, c)| c);
-            for (j, &(d2, id)) in kept.take(k).enumerate() {
+            let mut best = Best::new(k + 1);
+            for (j, (d2, id, _)) in self.own_row(pos, k, &mut best).enumerate() {
                 idx[j] = id;
                 d[j] = dist(d2);
             }
@@ -308,13 +354,81 @@ impl KdTree {
         indices
     }
 
-    /// Offers the points of the cell `lo..hi` to `best`; `off` holds the
-    /// cell's offset from `q` per axis, `rd` their sum of squares.
-    fn search(&self, lo: usize, hi: usize, q: &[f64; 3], off: &mut [f64; 3], best: &mut Best) {
+    /// The `k` nearest others of the point at tree position `pos` (at most
+    /// `len() - 1`), nearest first, as [`KdTree::graph_rows`] chooses them;
+    /// `best` is scratch space.
+    fn own_row<'b>(
+        &self,
+        pos: usize,
+        k: usize,
+        best: &'b mut Best,
+    ) -> impl Iterator<Item = Candidate> + 'b {
+        best.restart((k + 1).min(self.len()));
+        self.descend(0, self.len(), &self.pts[pos], &mut [0.0; 3], best);
+        let found = &best.items;
+        let me = self.ids[pos];
+        let skip = found
+            .iter()
+            .position(|c| c.1 == me)
+            .unwrap_or(found.len() - 1);
+        found
+            .iter()
+            .enumerate()
+            .filter(move |&(j, _)| j != skip)
+            .map(|(_, c)| *c)
+            .take(k)
+    }
+
+    /// The neighbour graph of [`KdTree::graph_rows`] in the tree's own
+    /// terms, with per-point work done while a point's neighbours are fresh
+    /// in the cache: row `t` (`k` values, `k` at most `len() - 1`) holds
+    /// the tree positions of the `k` nearest others of the point at tree
+    /// position `t` (the same points, in the same order, as the row of the
+    /// input index `spatial_order()[t]` in `graph_rows`), and `f(t, row)`
+    /// is evaluated with it; both are returned in tree order. Parallel
+    /// chunks of consecutive positions, no allocation per query.
+    pub(crate) fn graph_in_tree_order<T, F>(&self, k: usize, f: F) -> (Vec<u32>, Vec<T>)
+    where
+        T: Copy + Default + Send,
+        F: Fn(usize, &[u32]) -> T + Sync,
+    {
+        let n = self.len();
+        let k = k.min(n - 1);
+        let mut rows = vec![0u32; n * k];
+        let mut out = vec![T::default(); n];
+        if k == 0 {
+            return (rows, out);
+        }
+        rows.par_chunks_mut(CHUNK * k)
+            .zip(out.par_chunks_mut(CHUNK))
+            .enumerate()
+            .for_each(|(c, (rows, out))| {
+                let mut best = Best::new(k + 1);
+                for (r, (row, o)) in rows.chunks_mut(k).zip(out).enumerate() {
+                    let t = c * CHUNK + r;
+                    for (x, c) in row.iter_mut().zip(self.own_row(t, k, &mut best)) {
+                        *x = c.2;
+                    }
+                    *o = f(t, row);
+                }
+            });
+        (rows, out)
+    }
+
+    /// Hands `visit` the buckets of the cell `lo..hi` that may hold what it
+    /// collects, the nearer child first; `off` holds the cell's offset from
+    /// `q` per axis, and a cell whose sum of squared offsets exceeds
+    /// `visit.bound()` is skipped.
+    fn descend<V: Visit>(
+        &self,
+        lo: usize,
+        hi: usize,
+        q: &[f64; 3],
+        off: &mut [f64; 3],
+        visit: &mut V,
+    ) {
         if hi - lo <= BUCKET {
-            for j in lo..hi {
-                best.offer(dist2(&self.pts[j], q), self.ids[j]);
-            }
+            visit.bucket(self, lo, hi, q);
             return;
         }
         let mid = lo + (hi - lo) / 2;
@@ -325,12 +439,12 @@ impl KdTree {
         } else {
             ((mid, hi), (lo, mid))
         };
-        self.search(near.0, near.1, q, off, best);
+        self.descend(near.0, near.1, q, off, visit);
         let old = off[a];
         off[a] = diff;
         let rd = off[0] * off[0] + off[1] * off[1] + off[2] * off[2];
-        if rd <= best.bound() {
-            self.search(far.0, far.1, q, off, best);
+        if rd <= visit.bound() {
+            self.descend(far.0, far.1, q, off, visit);
         }
         off[a] = old;
     }
@@ -338,7 +452,7 @@ impl KdTree {
     /// The `k` nearest (by distance, then index) to `q`.
     fn best(&self, q: &[f64; 3], k: usize) -> Best {
         let mut best = Best::new(k);
-        self.search(0, self.len(), q, &mut [0.0; 3], &mut best);
+        self.descend(0, self.len(), q, &mut [0.0; 3], &mut best);
         best
     }
 
@@ -346,7 +460,7 @@ impl KdTree {
     /// smallest index among equally near ones).
     pub fn nearest(&self, query: &Point3) -> Neighbour {
         let b = self.best(&coords(query), 1);
-        let (d2, id) = b.items[0];
+        let (d2, id, _) = b.items[0];
         Neighbour {
             index: id as usize,
             distance: d2.sqrt(),
@@ -371,48 +485,11 @@ impl KdTree {
         self.best(&coords(query), k)
             .items
             .into_iter()
-            .map(|(d2, id)| Neighbour {
+            .map(|(d2, id, _)| Neighbour {
                 index: id as usize,
                 distance: d2.sqrt(),
             })
             .collect()
-    }
-
-    /// Collects into `out` the points of the cell `lo..hi` within squared
-    /// distance `r2` of `q` (`off` as in [`KdTree::search`]).
-    fn collect_within(
-        &self,
-        lo: usize,
-        hi: usize,
-        q: &[f64; 3],
-        r2: f64,
-        off: &mut [f64; 3],
-        out: &mut Vec<(f64, u32)>,
-    ) {
-        if hi - lo <= BUCKET {
-            for j in lo..hi {
-                let d2 = dist2(&self.pts[j], q);
-                if d2 <= r2 {
-                    out.push((d2, self.ids[j]));
-                }
-            }
-            return;
-        }
-        let mid = lo + (hi - lo) / 2;
-        let a = self.axis[mid] as usize;
-        let diff = q[a] - self.split[mid];
-        let (near, far) = if diff < 0.0 {
-            ((lo, mid), (mid, hi))
-        } else {
-            ((mid, hi), (lo, mid))
-        };
-        self.collect_within(near.0, near.1, q, r2, off, out);
-        let old = off[a];
-        off[a] = diff;
-        if off[0] * off[0] + off[1] * off[1] + off[2] * off[2] <= r2 {
-            self.collect_within(far.0, far.1, q, r2, off, out);
-        }
-        off[a] = old;
     }
 
     /// All indexed points within distance `radius` of `query` (inclusive),
@@ -427,9 +504,13 @@ impl KdTree {
     /// assert_eq!(near.iter().map(|n| n.index).collect::<Vec<_>>(), [2, 1, 3]);
     /// ```
     pub fn within(&self, query: &Point3, radius: f64) -> Vec<Neighbour> {
-        let mut out = Vec::new();
+        let mut within = Within {
+            r2: radius * radius,
+            found: Vec::new(),
+        };
         let q = coords(query);
-        self.collect_within(0, self.len(), &q, radius * radius, &mut [0.0; 3], &mut out);
+        self.descend(0, self.len(), &q, &mut [0.0; 3], &mut within);
+        let mut out = within.found;
         out.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         out.into_iter()
             .map(|(d2, id)| Neighbour {
@@ -597,6 +678,27 @@ mod tests {
         assert_eq!(all.len(), 500);
     }
 
+    /// Point sets that test ties: `n` random points in a unit square
+    /// (heights scaled by `z`), a `side x side x layers` grid (equal
+    /// distances everywhere) and random points with duplicates (the first
+    /// 15% and then the first 2.5% again).
+    fn hard_sets(seed: u64, n: usize, side: usize, layers: usize, z: f64) -> [Vec<Point3>; 3] {
+        let mut rng = crate::testdata::Lcg::new(seed);
+        let mut rnd = || rng.next_f64();
+        let random: Vec<Point3> = (0..n)
+            .map(|_| Point3::new(rnd(), rnd(), z * rnd()))
+            .collect();
+        let grid = (0..side * side * layers)
+            .map(|i| {
+                let (x, y, h) = (i % side, i / side % side, i / (side * side));
+                Point3::new(x as f64, y as f64, h as f64)
+            })
+            .collect();
+        let mut dups = random[..n * 3 / 20].to_vec();
+        dups.extend_from_slice(&random[..n / 40]);
+        [random, grid, dups]
+    }
+
     /// The tree against kiddo 6's `ImmutableKdTree` (the index it replaced,
     /// an independent implementation): on random points, a grid (ties
     /// everywhere) and duplicates, the k nearest have the same distances,
@@ -605,17 +707,7 @@ mod tests {
     #[test]
     fn answers_agree_with_kiddo() {
         use kiddo::{ImmutableKdTree, SquaredEuclidean};
-        let mut rng = crate::testdata::Lcg::new(17);
-        let mut rnd = || rng.next_f64();
-        let random: Vec<Point3> = (0..20_000)
-            .map(|_| Point3::new(rnd(), rnd(), 0.2 * rnd()))
-            .collect();
-        let grid: Vec<Point3> = (0..4000)
-            .map(|i| Point3::new((i % 20) as f64, (i / 20 % 20) as f64, (i / 400) as f64))
-            .collect();
-        let mut dups = random[..3000].to_vec();
-        dups.extend_from_slice(&random[..500]);
-        for pts in [random, grid, dups] {
+        for pts in hard_sets(17, 20_000, 20, 10, 0.2) {
             let ours = KdTree::new(&pts, "points").unwrap();
             let c: Vec<[f64; 3]> = pts.iter().map(coords).collect();
             let theirs: ImmutableKdTree<f64, 3> = ImmutableKdTree::new_from_slice(&c).unwrap();
@@ -652,6 +744,51 @@ mod tests {
                 assert_eq!(ours.nearest(&q).index, a[0].index);
             }
         }
+    }
+
+    /// The rows in tree order against a brute-force search over all pairs:
+    /// on random points, a grid (ties everywhere) and duplicates, row `t`
+    /// is the `k` nearest others of the point at tree position `t`, by
+    /// (distance, index), the point itself left out (or, among coincident
+    /// points ordered before it, the last of the `k + 1`), and equals the
+    /// row of `graph_rows` at that point's input index.
+    #[test]
+    fn rows_in_tree_order_are_the_brute_force_neighbours() {
+        let [random, grid, dups] = hard_sets(23, 1500, 10, 10, 0.1);
+        for (pts, k) in [(random, 20), (grid, 9), (dups, 12), (grid_of(5), 4)] {
+            let tree = KdTree::new(&pts, "points").unwrap();
+            let order = tree.spatial_order();
+            let (rows, firsts) = tree.graph_in_tree_order(k, |t, row| (t, row[0]));
+            let (indices, _) = tree.graph_rows(k);
+            let k = k.min(pts.len() - 1);
+            assert_eq!(rows.len(), pts.len() * k);
+            for (t, &i) in order.iter().enumerate() {
+                let i = i as usize;
+                let row: Vec<u32> = rows[t * k..(t + 1) * k]
+                    .iter()
+                    .map(|&s| order[s as usize])
+                    .collect();
+                assert_eq!(firsts[t], (t, rows[t * k]));
+                assert_eq!(row, indices[i * k..(i + 1) * k], "point {i}");
+                let q = coords(&pts[i]);
+                let mut all: Vec<(f64, u32)> = pts
+                    .iter()
+                    .enumerate()
+                    .map(|(j, p)| (dist2(&coords(p), &q), j as u32))
+                    .collect();
+                all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                all.truncate(k + 1);
+                let me = all.iter().position(|c| c.1 as usize == i).unwrap_or(k);
+                all.remove(me);
+                let brute: Vec<u32> = all.iter().map(|c| c.1).collect();
+                assert_eq!(row, brute, "point {i}");
+            }
+        }
+    }
+
+    /// `n` points on a line: fewer than the `k + 1` asked for.
+    fn grid_of(n: usize) -> Vec<Point3> {
+        (0..n).map(|i| Point3::new(i as f64, 0.0, 0.0)).collect()
     }
 
     #[test]

@@ -6,7 +6,9 @@
 //! little-endian bytes), so an accumulator read back continues, merges and
 //! finishes bit for bit as the original would.
 //!
-//! A record is an 8-byte tag naming the type and the format version, then
+//! A record is an 8-byte tag naming the type (7 bytes) and the format
+//! version (the last, a digit: bytes of another version are refused as
+//! such, never misread), then
 //! fixed-width fields: `u64` and `f64` little-endian, a vector as its `u64`
 //! length and its values. [`Reader`] checks the tag, every length against
 //! the bytes left, and that nothing follows the record; a wrong or damaged
@@ -88,6 +90,16 @@ impl<'a> Reader<'a> {
     /// record in errors ("the BA sums of an MBA level").
     pub fn new(bytes: &'a [u8], tag: &[u8; 8], what: &'static str) -> Result<Self> {
         if bytes.get(..8) != Some(&tag[..]) {
+            // the same type in another format version: say so
+            if let Some(t) = bytes
+                .get(..8)
+                .filter(|t| t[..7] == tag[..7] && t[7].is_ascii_digit())
+            {
+                return Err(Error::InvalidInput(format!(
+                    "these bytes are {what} in format version {}, but this scanfit reads version {}; make them again with this scanfit version (every worker and the client must run the same one)",
+                    t[7] as char, tag[7] as char
+                )));
+            }
             let got = bytes.get(..8).map_or_else(
                 || format!("{} bytes", bytes.len()),
                 |t| format!("tag {:?}", String::from_utf8_lossy(t)),

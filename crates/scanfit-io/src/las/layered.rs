@@ -6,12 +6,12 @@
 
 use std::path::Path;
 
-use rayon::prelude::*;
 use scanfit::Point3;
 
-use super::{column_names, transforms, vlr_bytes, Decoded, Layered, Raw};
+use super::{
+    column_names, decode_in_order, transforms, unread_chunks, vlr_bytes, Decoded, Layered, Raw,
+};
 use crate::laz14::{LayeredLaz, Laz14Error, Point14, ReadAt};
-use crate::table::capacity;
 use crate::{Error, Result};
 
 pub(super) fn binary(path: &Path, e: Laz14Error) -> Error {
@@ -115,34 +115,21 @@ pub(super) fn read_layered(
     let file = open(path, &read, vlr, format, raw, layered)?;
     let transform = transforms(path, bytes)?;
     let names = names(&file);
-    let cap = capacity(layered.count, bytes.len()).min(1 << 24);
-    let mut points = Vec::with_capacity(cap);
-    let mut columns = vec![Vec::with_capacity(cap); names.len()];
-    // chunks are independent: decode a few per thread at a time, append in
-    // file order (the first damaged chunk in file order is the error)
-    let group = 2 * rayon::current_num_threads().max(1);
-    let count = file.chunks().len();
-    for first in (0..count).step_by(group) {
-        let decoded: Vec<_> = (first..(first + group).min(count))
-            .into_par_iter()
-            .map(|c| {
-                let at = file.chunks()[c].offset as usize;
-                let data = bytes
-                    .get(at..at.saturating_add(file.chunk_bytes(c) as usize))
-                    .unwrap_or(&[]);
-                let mut chunk = Vec::new();
-                file.decode_chunk(c, data, &mut chunk).map(|()| chunk)
-            })
-            .collect();
-        for chunk in decoded {
-            let chunk = chunk.map_err(|e| binary(path, e))?;
-            append(&file, &transform, &chunk, &mut points, &mut columns);
-        }
-    }
-    Ok(Decoded {
-        points,
+    let mut decoded = decode_in_order(
+        path,
+        bytes,
+        layered.count,
         names,
-        columns,
-        declared: layered.count,
-    })
+        file.chunks(),
+        |c| file.chunk_bytes(c),
+        |c, data, out| file.decode_chunk(c, data, out),
+        |chunk, points, columns| append(&file, &transform, chunk, points, columns),
+    )?;
+    decoded.warnings = unread_chunks(
+        path,
+        layered.table_chunks,
+        file.chunks().len(),
+        layered.count,
+    );
+    Ok(decoded)
 }

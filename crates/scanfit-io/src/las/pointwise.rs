@@ -6,13 +6,11 @@
 
 use std::path::Path;
 
-use rayon::prelude::*;
 use scanfit::Point3;
 
 use super::layered::binary;
-use super::{column_names, transforms, Decoded, Pointwise};
+use super::{column_names, decode_in_order, transforms, unread_chunks, Decoded, Pointwise};
 use crate::laz14::{PointwiseLaz, PointwiseRecord};
-use crate::table::capacity;
 use crate::{Error, Result};
 
 /// The columns of a pointwise file's points (see [`column_names`]).
@@ -85,36 +83,18 @@ pub(super) fn read_pointwise(path: &Path, bytes: &[u8], pw: &Pointwise) -> Resul
     )?;
     let transform = transforms(path, bytes)?;
     let names = names(&file);
-    let cap = capacity(pw.count, bytes.len()).min(1 << 24);
-    let mut points = Vec::with_capacity(cap);
-    let mut columns = vec![Vec::with_capacity(cap); names.len()];
-    // chunks are independent: decode a few per thread at a time, append in
-    // file order (the first damaged chunk in file order is the error)
-    let group = 2 * rayon::current_num_threads().max(1);
-    let count = file.chunks().len();
-    for first in (0..count).step_by(group) {
-        let decoded: Vec<_> = (first..(first + group).min(count))
-            .into_par_iter()
-            .map(|c| {
-                let at = file.chunks()[c].offset as usize;
-                let data = bytes
-                    .get(at..at.saturating_add(file.chunk_bytes(c) as usize))
-                    .unwrap_or(&[]);
-                let mut chunk = Vec::new();
-                file.decode_chunk(c, data, &mut chunk).map(|()| chunk)
-            })
-            .collect();
-        for chunk in decoded {
-            let chunk = chunk.map_err(|e| binary(path, e))?;
-            append(&file, &transform, &chunk, &mut points, &mut columns);
-        }
-    }
-    Ok(Decoded {
-        points,
+    let mut decoded = decode_in_order(
+        path,
+        bytes,
+        pw.count,
         names,
-        columns,
-        declared: pw.count,
-    })
+        file.chunks(),
+        |c| file.chunk_bytes(c),
+        |c, data, out| file.decode_chunk(c, data, out),
+        |chunk, points, columns| append(&file, &transform, chunk, points, columns),
+    )?;
+    decoded.warnings = unread_chunks(path, pw.table_chunks, file.chunks().len(), pw.count);
+    Ok(decoded)
 }
 
 /// The header's point format must be the one the LASzip items describe.

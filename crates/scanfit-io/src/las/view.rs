@@ -45,6 +45,16 @@ impl View for FileView {
     }
 }
 
+impl FileView {
+    /// Fills `buf` with the bytes at `at`; `false` when they are not all
+    /// in the file.
+    pub(crate) fn read_into(&self, at: u64, buf: &mut [u8]) -> bool {
+        at.checked_add(buf.len() as u64)
+            .is_some_and(|end| end <= self.len)
+            && self.file.read_exact_at(buf, at).is_ok()
+    }
+}
+
 pub(crate) fn u8_at(b: &(impl View + ?Sized), at: usize) -> Option<u8> {
     b.read(at as u64, 1).map(|s| s[0])
 }

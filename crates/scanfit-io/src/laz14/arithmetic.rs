@@ -1,7 +1,10 @@
 //! The LASzip arithmetic decoder (a range decoder with 32-bit registers
 //! after Amir Said's FastAC, as LASzip uses it) reading one layer held in
 //! a byte slice. It never reads past the slice: running out of bytes is
-//! a [`Fault`], as are the states only damaged data can reach.
+//! a [`Fault`], as are the states only damaged data can reach. A decoder
+//! can be suspended ([`Decoder::suspend`]: its position and registers) and
+//! resumed on another slice holding the same bytes from that position on,
+//! which is how a long pointwise chunk is decoded through a bounded window.
 
 use super::models::{BitModel, SymbolModel, BIT_SHIFT, SYMBOL_SHIFT};
 
@@ -22,6 +25,19 @@ pub(super) enum Fault {
 /// Result of one decoding step.
 pub(super) type Step<T> = std::result::Result<T, Fault>;
 
+/// The registers of a suspended [`Decoder`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Registers {
+    value: u32,
+    length: u32,
+}
+
+/// Most bytes one decoding step ([`Decoder::bit`], [`Decoder::symbol`],
+/// [`Decoder::raw_bits`]) reads: each starts with a length of at least
+/// 2^24 and leaves at least 2^5 (a raw value of 19 bits; a symbol leaves
+/// 2^9, a bit 2^11), so renormalising takes at most three bytes.
+pub(super) const STEP_BYTES: usize = 3;
+
 /// Decoder over one layer.
 pub(super) struct Decoder<'a> {
     bytes: &'a [u8],
@@ -33,8 +49,13 @@ pub(super) struct Decoder<'a> {
 impl<'a> Decoder<'a> {
     /// Starts decoding `bytes` (the first four bytes set the value).
     pub(super) fn new(bytes: &'a [u8]) -> Step<Self> {
+        Self::start(bytes, 0)
+    }
+
+    /// Starts decoding `bytes` at `at` (the four bytes there set the value).
+    pub(super) fn start(bytes: &'a [u8], at: usize) -> Step<Self> {
         let head: [u8; 4] = bytes
-            .get(..4)
+            .get(at..at.checked_add(4).ok_or(Fault::Ended)?)
             .ok_or(Fault::Ended)?
             .try_into()
             .map_err(|_| Fault::Ended)?;
@@ -45,10 +66,37 @@ impl<'a> Decoder<'a> {
         }
         Ok(Self {
             bytes,
-            at: 4,
+            at: at + 4,
             value,
             length: u32::MAX,
         })
+    }
+
+    /// Continues a suspended decoder on `bytes`, whose byte `at` is the
+    /// next one it reads.
+    pub(super) fn resume(bytes: &'a [u8], at: usize, registers: Registers) -> Self {
+        Self {
+            bytes,
+            at,
+            value: registers.value,
+            length: registers.length,
+        }
+    }
+
+    /// The position of the next byte to read in the slice.
+    pub(super) fn position(&self) -> usize {
+        self.at
+    }
+
+    /// Where to resume: the next byte's position and the registers.
+    pub(super) fn suspend(self) -> (usize, Registers) {
+        (
+            self.at,
+            Registers {
+                value: self.value,
+                length: self.length,
+            },
+        )
     }
 
     #[inline]

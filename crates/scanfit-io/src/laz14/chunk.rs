@@ -25,15 +25,128 @@ const NAMES: [&str; POINT_LAYERS] = [
     "GPS time",
 ];
 
-fn u16_at(b: &[u8], at: usize) -> Option<u16> {
+pub(super) fn u16_at(b: &[u8], at: usize) -> Option<u16> {
     Some(u16::from_le_bytes(
         b.get(at..at.checked_add(2)?)?.try_into().ok()?,
     ))
 }
-fn u32_at(b: &[u8], at: usize) -> Option<u32> {
+pub(super) fn u32_at(b: &[u8], at: usize) -> Option<u32> {
     Some(u32::from_le_bytes(
         b.get(at..at.checked_add(4)?)?.try_into().ok()?,
     ))
+}
+
+/// The fixed fields of a LASzip VLR that both compressors read: the
+/// compressor, the chunk size (`u32::MAX`: variable-size chunks) and the
+/// items as (type, size, version).
+pub(super) struct VlrItems {
+    pub(super) compressor: u16,
+    pub(super) chunk_size: u32,
+    pub(super) items: Vec<(u16, u16, u16)>,
+}
+
+impl VlrItems {
+    /// Reads the VLR payload `vlr` (found at byte `at`, for messages).
+    pub(super) fn read(vlr: &[u8], at: u64) -> Result<Self, Laz14Error> {
+        let err = |message: String| Laz14Error {
+            offset: at,
+            message,
+        };
+        let (Some(compressor), Some(chunk_size), Some(count)) =
+            (u16_at(vlr, 0), u32_at(vlr, 12), u16_at(vlr, 32))
+        else {
+            return Err(err(format!(
+                "the LASzip VLR has {} bytes, too few for its fixed fields; the file is damaged",
+                vlr.len()
+            )));
+        };
+        let items = (0..usize::from(count))
+            .map(|k| {
+                match (
+                    u16_at(vlr, 34 + 6 * k),
+                    u16_at(vlr, 36 + 6 * k),
+                    u16_at(vlr, 38 + 6 * k),
+                ) {
+                    (Some(kind), Some(size), Some(version)) => Ok((kind, size, version)),
+                    _ => Err(err(format!("the LASzip VLR declares {count} items, but its {} bytes hold fewer; the file is damaged", vlr.len()))),
+                }
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(Self {
+            compressor,
+            chunk_size,
+            items,
+        })
+    }
+}
+
+/// The chunks of a file found by a walk from the point data's start:
+/// `next(c, pos, left)` checks chunk `c` at byte `pos` with `left` points
+/// still to come and returns the points expected from it (before the cap
+/// by `left`) and its size in bytes. A chunk expected to hold no point is
+/// an error.
+pub(super) fn walk_chunks(
+    start: u64,
+    count: u64,
+    mut next: impl FnMut(usize, u64, u64) -> Result<(u64, u64), Laz14Error>,
+) -> Result<(Vec<ChunkSpan>, Vec<u64>), Laz14Error> {
+    let mut chunks = Vec::new();
+    let mut sizes = Vec::new();
+    let mut pos = start;
+    let mut done = 0u64;
+    while done < count {
+        let c = chunks.len();
+        let (expected, bytes) = next(c, pos, count - done)?;
+        let points = expected.min(count - done);
+        if points == 0 {
+            return Err(Laz14Error {
+                offset: pos,
+                message: format!("LAZ chunk {c} holds no points, but {} of the header's {count} points are still to come; the file is damaged", count - done),
+            });
+        }
+        chunks.push(ChunkSpan {
+            offset: pos,
+            points,
+            first_point: done,
+        });
+        sizes.push(bytes);
+        done += points;
+        pos = pos.saturating_add(bytes);
+    }
+    Ok((chunks, sizes))
+}
+
+/// Chunk `index` of `chunks`, and a maker of errors that name it.
+pub(super) fn chunk_at(
+    chunks: &[ChunkSpan],
+    index: usize,
+) -> Result<(ChunkSpan, impl Fn(String) -> Laz14Error), Laz14Error> {
+    let span = *chunks.get(index).ok_or_else(|| Laz14Error {
+        offset: 0,
+        message: format!(
+            "there is no LAZ chunk {index} (the file has {})",
+            chunks.len()
+        ),
+    })?;
+    let err = move |message: String| Laz14Error {
+        offset: span.offset,
+        message: format!(
+            "LAZ chunk {index} (points {} to {}): {message}",
+            span.first_point,
+            span.first_point + span.points - 1
+        ),
+    };
+    Ok((span, err))
+}
+
+/// The message of a point that cannot be decoded (`k`: its index in the
+/// file); `ended` says what running out of bytes means for this chunk.
+pub(super) fn point_fault(f: Fault, k: u64, ended: &str) -> String {
+    let why = match f {
+        Fault::Switches => "its GPS time switches sequences more often than there are sequences (an encoder switches at most once)",
+        _ => ended,
+    };
+    format!("point {k} cannot be decoded: {why}; the file is damaged")
 }
 
 /// What follows the point-14 item in the record.
@@ -74,28 +187,18 @@ impl Items {
             offset: at,
             message,
         };
-        let (Some(compressor), Some(chunk_size), Some(count)) =
-            (u16_at(vlr, 0), u32_at(vlr, 12), u16_at(vlr, 32))
-        else {
-            return Err(err(format!(
-                "the LASzip VLR has {} bytes, too few for its fixed fields; the file is damaged",
-                vlr.len()
-            )));
-        };
+        let VlrItems {
+            compressor,
+            chunk_size,
+            items: list,
+        } = VlrItems::read(vlr, at)?;
         if compressor != 3 {
             return Err(err(format!("the LASzip VLR declares compressor {compressor}; LAS 1.4 points (formats 6-10) use the layered compressor 3")));
         }
         let mut items = Items::default();
         let mut version = None;
         let mut stage = 0; // 0: point14 expected, 1: colour, 2: extra bytes, 3: wave packet, 4: done
-        for k in 0..usize::from(count) {
-            let (Some(kind), Some(size), Some(v)) = (
-                u16_at(vlr, 34 + 6 * k),
-                u16_at(vlr, 36 + 6 * k),
-                u16_at(vlr, 38 + 6 * k),
-            ) else {
-                return Err(err(format!("the LASzip VLR declares {count} items, but its {} bytes hold fewer; the file is damaged", vlr.len())));
-            };
+        for (k, &(kind, size, v)) in list.iter().enumerate() {
             if !matches!(v, 3 | 4) || version.is_some_and(|w| w != v) {
                 return Err(err(format!("LASzip item {k} has version {v}; the layered items of one file are all of version 3 or all of version 4")));
             }
@@ -193,19 +296,15 @@ impl LayeredLaz {
     ) -> Result<Self, Laz14Error> {
         let (items, chunk_size) = Items::from_vlr(vlr, vlr_at)?;
         let head = (items.record() + 4 + 4 * items.layers()) as u64;
-        let mut chunks = Vec::new();
-        let mut lens = Vec::new();
-        let mut pos = start.saturating_add(8);
-        let mut done = 0u64;
-        while done < count {
-            let c = chunks.len();
+        let (chunks, sizes) = walk_chunks(start.saturating_add(8), count, |c, pos, left| {
             let err = |message: String| Laz14Error {
                 offset: pos,
                 message,
             };
             if pos.saturating_add(head) > end {
                 return Err(err(format!(
-                    "the header declares {count} points, but the compressed data ends after {done} of them (before the header of chunk {c}); the file is truncated"
+                    "the header declares {count} points, but the compressed data ends after {} of them (before the header of chunk {c}); the file is truncated",
+                    count - left
                 )));
             }
             let header = read(pos, head as usize).unwrap_or_default();
@@ -226,28 +325,18 @@ impl LayeredLaz {
                 None if chunk_size == u32::MAX => declared,
                 None => u64::from(chunk_size),
             };
-            let points = expected.min(count - done);
-            if points == 0 {
-                return Err(err(format!("LAZ chunk {c} holds no points, but {} of the header's {count} points are still to come; the file is damaged", count - done)));
-            }
-            if declared < points {
+            let points = expected.min(left);
+            if points > 0 && declared < points {
                 return Err(err(format!(
                     "LAZ chunk {c} declares {declared} points, but {points} are expected from it (chunk size and point count); the file is damaged"
                 )));
             }
-            chunks.push(ChunkSpan {
-                offset: pos,
-                points,
-                first_point: done,
-            });
-            lens.push(head + sizes);
-            done += points;
-            pos += head + sizes;
-        }
+            Ok((expected, head + sizes))
+        })?;
         Ok(Self {
             items,
             chunks,
-            sizes: lens,
+            sizes,
         })
     }
 
@@ -280,21 +369,7 @@ impl LayeredLaz {
         bytes: &[u8],
         out: &mut Vec<Point14>,
     ) -> Result<(), Laz14Error> {
-        let span = *self.chunks.get(index).ok_or_else(|| Laz14Error {
-            offset: 0,
-            message: format!(
-                "there is no LAZ chunk {index} (the file has {})",
-                self.chunks.len()
-            ),
-        })?;
-        let err = |message: String| Laz14Error {
-            offset: span.offset,
-            message: format!(
-                "LAZ chunk {index} (points {} to {}): {message}",
-                span.first_point,
-                span.first_point + span.points - 1
-            ),
-        };
+        let (span, err) = chunk_at(&self.chunks, index)?;
         let items = self.items;
         // the walk in `new` checked that the header and layers fit
         let p = 0usize;
@@ -365,13 +440,10 @@ impl LayeredLaz {
         let mut point = first;
         for k in 1..span.points {
             let fail = |f: Fault| {
-                let why = match f {
-                    Fault::Switches => "its GPS time switches sequences more often than there are sequences (an encoder switches at most once)",
-                    _ => "a layer ends before it, or holds data no encoder writes",
-                };
-                err(format!(
-                    "point {} cannot be decoded: {why}; the file is damaged",
-                    span.first_point + k
+                err(point_fault(
+                    f,
+                    span.first_point + k,
+                    "a layer ends before it, or holds data no encoder writes",
                 ))
             };
             let switched = points.next(&mut pl, &mut point).map_err(fail)?;

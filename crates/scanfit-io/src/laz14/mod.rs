@@ -21,10 +21,13 @@
 //! fields above are unaffected).
 //!
 //! The pointwise compressor of point formats 0-5 (compressors 1 and 2,
-//! items of version 2: [`point10`], GPS time in [`gps11`], RGB, wave
-//! packet and extra bytes in [`pointwise`]) is decoded here too, for the
-//! same reason: the `laz` crate's version-2 GPS-time decoder recurses on
-//! every "switch sequence" symbol (finding 5 of `docs/robustness.md`).
+//! items of version 2: [`point10`], GPS time in [`gps`] (shared with the
+//! layered compressor), RGB, wave packet and extra bytes in [`pointwise`])
+//! is decoded here too, for the same reason: the `laz` crate's version-2
+//! GPS-time decoder recurses on every "switch sequence" symbol (finding 5
+//! of `docs/robustness.md`). A pointwise chunk is decoded through a
+//! [`PointwiseCursor`] holding a bounded window of its bytes, any number
+//! of points at a time: a compressor-1 file is one chunk of all its points.
 //!
 //! The API works per chunk, so that a caller can decode chunks in any
 //! order or in parallel: [`LayeredLaz::new`] walks the chunk headers and
@@ -34,7 +37,6 @@ mod arithmetic;
 mod chunk;
 mod color;
 mod gps;
-mod gps11;
 mod integer;
 mod median;
 mod models;
@@ -44,7 +46,7 @@ mod pointwise;
 
 pub use chunk::{ChunkSpan, LayeredLaz, ReadAt};
 pub use point10::Point10;
-pub use pointwise::{PointwiseLaz, PointwiseRecord};
+pub use pointwise::{PointwiseCursor, PointwiseLaz, PointwiseRecord, ReadInto, WINDOW};
 
 /// One decoded point: the raw fields of the LAS 1.4 point record (formats
 /// 6-10), coordinates as the stored integers (apply the header's scale and

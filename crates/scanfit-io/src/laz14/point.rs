@@ -5,7 +5,7 @@
 //! its own context: last point, predictors and models.
 
 use super::arithmetic::{Decoder, Step};
-use super::gps::GpsState;
+use super::gps::{GpsTime, GpsVariant};
 use super::integer::IntegerDecoder;
 use super::median::Median5;
 use super::models::SymbolModel;
@@ -80,7 +80,7 @@ struct Channel {
     iintensity: IntegerDecoder,
     iscan: IntegerDecoder,
     isource: IntegerDecoder,
-    gps: GpsState,
+    gps: GpsTime,
 }
 
 impl Channel {
@@ -106,7 +106,7 @@ impl Channel {
             iintensity: IntegerDecoder::new(16, 4),
             iscan: IntegerDecoder::new(16, 2),
             isource: IntegerDecoder::new(16, 1),
-            gps: GpsState::new(last.gps_time.to_bits() as i64),
+            gps: GpsTime::new(last.gps_time.to_bits() as i64, GpsVariant::Point14),
         })
     }
 }
@@ -245,8 +245,7 @@ fn decode_fields(ch: &mut Channel, changes: u32, l: &mut Layers<'_>) -> Step<()>
     }
     ch.time_changed = time_changed;
     if let (Some(dec), true) = (&mut l.gps_time, time_changed) {
-        ch.gps.read(dec)?;
-        ch.last.gps_time = f64::from_bits(ch.gps.time() as u64);
+        ch.last.gps_time = f64::from_bits(ch.gps.next(dec)? as u64);
     }
     Ok(())
 }

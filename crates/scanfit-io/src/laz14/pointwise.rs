@@ -2,33 +2,44 @@
 //! 2, items of version 2): a chunk is the first record raw, then one
 //! arithmetic-coded stream in which every following point codes its items
 //! in the order of the LASzip VLR: point-10 ([`super::point10`]), GPS time
-//! ([`super::gps11`]), RGB (the byte-wise colour differences of
+//! ([`super::gps`]), RGB (the byte-wise colour differences of
 //! [`super::color`]), wave packet and extra bytes. Compressor 1 has a
 //! single chunk starting at the point data; compressor 2 starts with the
 //! 8-byte chunk-table offset, and the chunk table gives every chunk's size
 //! in bytes (and, for variable-size chunks, in points).
 //!
+//! A chunk is decoded through a [`PointwiseCursor`]: the decoders' state
+//! and a window of at most [`WINDOW`] bytes of the chunk, read as the
+//! stream advances, so any number of points can be taken at a time and
+//! memory does not grow with the chunk (a compressor-1 file is one chunk of
+//! all its points).
+//!
 //! Files with items of version 1 (LASzip 1.x) are not handled here (the
 //! `laz` crate reads them; its version-1 GPS decoder does not recurse).
 
-use super::arithmetic::{Decoder, Fault, Step};
+use super::arithmetic::{Decoder, Registers, Step, STEP_BYTES};
+use super::chunk::{chunk_at, point_fault, u16_at, u32_at, walk_chunks, VlrItems};
 use super::color::{decode_rgb, RgbModels};
-use super::gps11::Gps11Decoder;
+use super::gps::{GpsTime, GpsVariant};
 use super::integer::IntegerDecoder;
 use super::models::SymbolModel;
 use super::point10::{Point10, Point10Decoder};
 use super::{ChunkSpan, Laz14Error};
 
-fn u16_at(b: &[u8], at: usize) -> Option<u16> {
-    Some(u16::from_le_bytes(
-        b.get(at..at.checked_add(2)?)?.try_into().ok()?,
-    ))
-}
-fn u32_at(b: &[u8], at: usize) -> Option<u32> {
-    Some(u32::from_le_bytes(
-        b.get(at..at.checked_add(4)?)?.try_into().ok()?,
-    ))
-}
+/// Bytes of a chunk a [`PointwiseCursor`] holds at a time (unless one
+/// point may need more: see [`PointwiseLaz::point_bytes`]).
+pub const WINDOW: usize = 1 << 20;
+
+/// Decoding steps of one point besides its extra bytes (one step each):
+/// point-10 5 symbols and 5 integers of at most 4 steps (25), GPS time at
+/// most 4 switches, a symbol and a full time of an integer and two raw
+/// halves (11), RGB 7 symbols, a wave packet 2 symbols, an offset of 4 steps
+/// and 5 integers (26).
+const POINT_STEPS: usize = 25 + 11 + 7 + 26;
+
+/// Fills `buf` with the file's bytes at an offset; `false` when they are
+/// not all in the file.
+pub type ReadInto<'r> = &'r mut dyn FnMut(u64, &mut [u8]) -> bool;
 
 /// One decoded point of formats 0-5: the point-10 fields, the GPS time
 /// (0 when the format has none) and RGB (zero when it has none).
@@ -69,27 +80,17 @@ impl Items {
             offset: at,
             message,
         };
-        let (Some(compressor), Some(chunk_size), Some(count)) =
-            (u16_at(vlr, 0), u32_at(vlr, 12), u16_at(vlr, 32))
-        else {
-            return Err(err(format!(
-                "the LASzip VLR has {} bytes, too few for its fixed fields; the file is damaged",
-                vlr.len()
-            )));
-        };
+        let VlrItems {
+            compressor,
+            chunk_size,
+            items: list,
+        } = VlrItems::read(vlr, at)?;
         if !matches!(compressor, 1 | 2) {
             return Err(err(format!("the LASzip VLR declares compressor {compressor}; point formats 0-5 use the pointwise compressors 1 and 2")));
         }
         let mut items = Items::default();
         let mut stage = 0; // 0: point-10 expected, then 1 GPS, 2 RGB, 3 wave packet, 4 extra bytes, 5 done
-        for k in 0..usize::from(count) {
-            let (Some(kind), Some(size), Some(version)) = (
-                u16_at(vlr, 34 + 6 * k),
-                u16_at(vlr, 36 + 6 * k),
-                u16_at(vlr, 38 + 6 * k),
-            ) else {
-                return Err(err(format!("the LASzip VLR declares {count} items, but its {} bytes hold fewer; the file is damaged", vlr.len())));
-            };
+        for (k, &(kind, size, version)) in list.iter().enumerate() {
             let ok_version = version == 2 || (kind == 9 && version == 1);
             if !ok_version {
                 return Err(err(format!("LASzip item {k} (type {kind}) has version {version}; scanfit decodes the pointwise items of version 2")));
@@ -130,8 +131,9 @@ impl Items {
 
 /// A pointwise LAZ file's chunks, found from its LASzip VLR and chunk
 /// table and checked against the point data's bounds. Holds no file bytes:
-/// [`PointwiseLaz::decode_chunk`] is given each chunk's bytes, so a caller
-/// can read one chunk at a time.
+/// a chunk is decoded from bytes the caller reads ([`PointwiseLaz::decode`]
+/// through a cursor, or [`PointwiseLaz::decode_chunk`] from the whole
+/// chunk), so a caller can read one window of one chunk at a time.
 pub struct PointwiseLaz {
     items: Items,
     chunks: Vec<ChunkSpan>,
@@ -166,49 +168,34 @@ impl PointwiseLaz {
     ) -> Result<Self, Laz14Error> {
         let (items, compressor, chunk_size) = Items::from_vlr(vlr, vlr_at)?;
         let record = items.record() as u64;
-        let mut chunks = Vec::new();
-        let mut sizes = Vec::new();
-        if count == 0 {
-            return Ok(Self {
-                items,
-                chunks,
-                sizes,
-            });
-        }
         if compressor == 1 {
             // one chunk, no chunk-table offset
-            let bytes = end.saturating_sub(start);
-            if bytes < record {
-                return Err(Laz14Error {
-                    offset: start,
-                    message: format!("the header declares {count} points, but the {bytes} bytes of point data do not hold the first record of {record} bytes; the file is truncated"),
-                });
-            }
-            chunks.push(ChunkSpan {
-                offset: start,
-                points: count,
-                first_point: 0,
-            });
-            sizes.push(bytes);
+            let (chunks, sizes) = walk_chunks(start, count, |_, _, left| {
+                let bytes = end.saturating_sub(start);
+                if bytes < record {
+                    return Err(Laz14Error {
+                        offset: start,
+                        message: format!("the header declares {count} points, but the {bytes} bytes of point data do not hold the first record of {record} bytes; the file is truncated"),
+                    });
+                }
+                Ok((left, bytes))
+            })?;
             return Ok(Self {
                 items,
                 chunks,
                 sizes,
             });
         }
-        let Some(table) = table else {
-            return Err(Laz14Error {
-                offset: start,
-                message: "the LAZ chunk table cannot be read (its offset at the start of the point data and at the file's end points nowhere valid); the file is damaged or was not finished".into(),
-            });
-        };
-        let mut pos = start.saturating_add(8);
-        let mut done = 0u64;
-        while done < count {
-            let c = chunks.len();
+        let (chunks, sizes) = walk_chunks(start.saturating_add(8), count, |c, pos, _| {
             let err = |message: String| Laz14Error {
                 offset: pos,
                 message,
+            };
+            let Some(table) = table else {
+                return Err(Laz14Error {
+                    offset: start,
+                    message: "the LAZ chunk table cannot be read (its offset at the start of the point data and at the file's end points nowhere valid); the file is damaged or was not finished".into(),
+                });
             };
             let Some(&(table_points, bytes)) = table.get(c) else {
                 return Err(err(format!("the LAZ chunk table lists {} chunks, but the header's {count} points need more; the file is damaged", table.len())));
@@ -218,25 +205,14 @@ impl PointwiseLaz {
             } else {
                 u64::from(chunk_size)
             };
-            let points = expected.min(count - done);
-            if points == 0 {
-                return Err(err(format!("LAZ chunk {c} holds no points, but {} of the header's {count} points are still to come; the file is damaged", count - done)));
-            }
-            if bytes < record || pos.saturating_add(bytes) > end {
+            if expected > 0 && (bytes < record || pos.saturating_add(bytes) > end) {
                 return Err(err(format!(
                     "the LAZ chunk table gives chunk {c} {bytes} bytes, but {} bytes of point data are left and a chunk holds at least its first record of {record} bytes; the file is damaged",
                     end.saturating_sub(pos)
                 )));
             }
-            chunks.push(ChunkSpan {
-                offset: pos,
-                points,
-                first_point: done,
-            });
-            sizes.push(bytes);
-            done += points;
-            pos += bytes;
-        }
+            Ok((expected, bytes))
+        })?;
         Ok(Self {
             items,
             chunks,
@@ -259,6 +235,14 @@ impl PointwiseLaz {
         self.items.record()
     }
 
+    /// The most compressed bytes one point can take: [`STEP_BYTES`] per
+    /// decoding step, the fixed items' steps and one per extra byte, twice
+    /// over for safety, plus the stream's four starting bytes. A cursor's
+    /// window holds at least this much more than its first record.
+    pub fn point_bytes(&self) -> usize {
+        2 * STEP_BYTES * (POINT_STEPS + self.items.extra) + 4
+    }
+
     /// Whether the points have a GPS time (formats 1, 3, 4, 5).
     pub fn has_gps_time(&self) -> bool {
         self.items.gps
@@ -274,48 +258,148 @@ impl PointwiseLaz {
         self.items.wave
     }
 
-    /// Decodes chunk `index` from `bytes` (the chunk's
-    /// [`PointwiseLaz::chunk_bytes`] bytes, starting at its offset),
-    /// appending its points to `out`.
-    pub fn decode_chunk(
+    /// A cursor at the start of chunk `index`, holding at most [`WINDOW`]
+    /// bytes of it at a time (more only if one point may need more).
+    pub fn cursor(&self, index: usize) -> Result<PointwiseCursor, Laz14Error> {
+        self.cursor_with_window(index, WINDOW)
+    }
+
+    /// A cursor at the start of chunk `index` whose window holds `window`
+    /// bytes, raised to the first record plus [`PointwiseLaz::point_bytes`]
+    /// (small windows make many refills: the tests' way to check that the
+    /// stream resumes exactly).
+    pub fn cursor_with_window(
         &self,
         index: usize,
-        bytes: &[u8],
+        window: usize,
+    ) -> Result<PointwiseCursor, Laz14Error> {
+        let (span, _) = chunk_at(&self.chunks, index)?;
+        Ok(PointwiseCursor {
+            index,
+            span,
+            len: self.chunk_bytes(index),
+            decoded: 0,
+            state: None,
+            registers: None,
+            window: Vec::new(),
+            at: 0,
+            window_start: 0,
+            capacity: window.max(self.items.record() + self.point_bytes()),
+        })
+    }
+
+    /// Decodes at most `max` more points of the cursor's chunk, reading its
+    /// bytes through `read` (at file offsets) as the window needs them,
+    /// and appends them to `out`; returns how many (0 once the chunk is
+    /// done). The points are those of [`PointwiseLaz::decode_chunk`], bit
+    /// for bit, however the chunk is cut.
+    ///
+    /// ```
+    /// use scanfit_io::laz14::PointwiseLaz;
+    /// // a VLR of compressor 1 with one point-10 item of version 2
+    /// let mut vlr = vec![0u8; 40];
+    /// vlr[0] = 1;
+    /// vlr[32] = 1;
+    /// vlr[34..40].copy_from_slice(&[6, 0, 20, 0, 2, 0]);
+    /// // one point: its raw record is all of the chunk
+    /// let mut record = [0u8; 20];
+    /// record[8] = 42; // Z
+    /// let file = PointwiseLaz::new(&vlr, 0, 100, 120, 1, None).unwrap();
+    /// let mut cursor = file.cursor(0).unwrap();
+    /// let mut read = |at: u64, buf: &mut [u8]| {
+    ///     let at = (at - 100) as usize;
+    ///     buf.copy_from_slice(&record[at..at + buf.len()]);
+    ///     true
+    /// };
+    /// let mut out = Vec::new();
+    /// assert_eq!(file.decode(&mut cursor, &mut read, 10, &mut out).unwrap(), 1);
+    /// assert_eq!((out[0].point.z, cursor.finished()), (42, true));
+    /// ```
+    pub fn decode(
+        &self,
+        cursor: &mut PointwiseCursor,
+        read: ReadInto<'_>,
+        max: usize,
         out: &mut Vec<PointwiseRecord>,
-    ) -> Result<(), Laz14Error> {
-        let span = *self.chunks.get(index).ok_or_else(|| Laz14Error {
-            offset: 0,
-            message: format!(
-                "there is no LAZ chunk {index} (the file has {})",
-                self.chunks.len()
-            ),
-        })?;
-        let err = |message: String| Laz14Error {
-            offset: span.offset,
-            message: format!(
-                "LAZ chunk {index} (points {} to {}): {message}",
-                span.first_point,
-                span.first_point + span.points - 1
-            ),
-        };
+    ) -> Result<usize, Laz14Error> {
+        let (span, err) = chunk_at(&self.chunks, cursor.index)?;
+        let bound = self.point_bytes();
+        let mut produced = 0usize;
+        out.reserve((span.points - cursor.decoded).min(max as u64).min(1 << 16) as usize);
+        if cursor.state.is_none() && max > 0 && cursor.decoded < span.points {
+            let record = self.items.record();
+            cursor.fill(read, record, &err)?;
+            let raw = cursor.window.get(..record).ok_or_else(|| {
+                err(format!("the chunk has {} bytes, fewer than its first record's {record}; the file is truncated", cursor.len))
+            })?;
+            let (state, first) = self.start_chunk(raw);
+            cursor.state = Some(state);
+            cursor.at = record;
+            out.push(first);
+            cursor.decoded = 1;
+            produced = 1;
+        }
+        while produced < max && cursor.decoded < span.points {
+            cursor.fill(read, bound, &err)?;
+            let more = cursor.window_start + (cursor.window.len() as u64) < cursor.len;
+            let stream = cursor.len.saturating_sub(self.items.record() as u64);
+            let PointwiseCursor {
+                window,
+                at,
+                registers,
+                state,
+                decoded,
+                ..
+            } = cursor;
+            let Some(state) = state.as_mut() else {
+                break;
+            };
+            let mut dec = match registers {
+                Some(r) => Decoder::resume(window, *at, *r),
+                None => Decoder::start(window, *at).map_err(|_| {
+                    err(format!("its compressed stream ({} bytes) is shorter than 4 bytes or starts with a value no encoder writes; the file is damaged", stream))
+                })?,
+            };
+            loop {
+                let k = span.first_point + *decoded;
+                let p = state.next(&mut dec).map_err(|f| {
+                    err(point_fault(
+                        f,
+                        k,
+                        "the chunk's bytes end before it, or hold data no encoder writes",
+                    ))
+                })?;
+                out.push(p);
+                *decoded += 1;
+                produced += 1;
+                let low = more && dec.position() + bound > window.len();
+                if produced == max || *decoded == span.points || low {
+                    break;
+                }
+            }
+            let (position, r) = dec.suspend();
+            *at = position;
+            *registers = Some(r);
+        }
+        if cursor.finished() {
+            // the chunk is done: its window is not needed any more
+            cursor.window = Vec::new();
+        }
+        Ok(produced)
+    }
+
+    /// The item decoders after a chunk's raw first record, and that record.
+    fn start_chunk(&self, raw: &[u8]) -> (ItemDecoders, PointwiseRecord) {
         let items = self.items;
-        let record = items.record();
-        let (Some(raw), Some(stream)) = (bytes.get(..record), bytes.get(record..)) else {
-            return Err(err(format!(
-                "the chunk has {} bytes, fewer than its first record's {record}; the file is truncated",
-                bytes.len()
-            )));
-        };
-        let head: &[u8; 20] = raw[..20]
-            .try_into()
-            .map_err(|_| err("the chunk is truncated".into()))?;
-        let first_point = Point10::from_record(head);
-        let mut at = 20;
-        let mut gps = None;
+        let mut head = [0u8; 20];
+        head.copy_from_slice(&raw[..20]);
+        let point = Point10::from_record(&head);
         let mut first = PointwiseRecord {
-            point: first_point,
+            point,
             ..PointwiseRecord::default()
         };
+        let mut at = 20;
+        let mut gps = None;
         if items.gps {
             let t = raw
                 .get(at..at + 8)
@@ -323,7 +407,7 @@ impl PointwiseLaz {
                 .map(i64::from_le_bytes)
                 .unwrap_or(0);
             first.gps_time = f64::from_bits(t as u64);
-            gps = Some(Gps11Decoder::new(t));
+            gps = Some(GpsTime::new(t, GpsVariant::Pointwise));
             at += 8;
         }
         let mut rgb = None;
@@ -338,43 +422,144 @@ impl PointwiseLaz {
             wave = Some(WaveDecoder::new(raw.get(at..at + 29).unwrap_or(&[])));
             at += 29;
         }
-        let mut extra = ExtraDecoder::new(raw.get(at..at + items.extra).unwrap_or(&[]));
-        out.reserve(span.points.min(1 << 16) as usize);
-        out.push(first);
-        if span.points == 1 {
+        let extra = ExtraDecoder::new(raw.get(at..at + items.extra).unwrap_or(&[]));
+        let state = ItemDecoders {
+            point: Point10Decoder::new(&point),
+            gps,
+            rgb,
+            wave,
+            extra,
+        };
+        (state, first)
+    }
+
+    /// Decodes chunk `index` from `bytes` (the chunk's
+    /// [`PointwiseLaz::chunk_bytes`] bytes, starting at its offset),
+    /// appending its points to `out`.
+    pub fn decode_chunk(
+        &self,
+        index: usize,
+        bytes: &[u8],
+        out: &mut Vec<PointwiseRecord>,
+    ) -> Result<(), Laz14Error> {
+        let mut cursor = self.cursor(index)?;
+        let offset = cursor.span.offset;
+        let mut read = |at: u64, buf: &mut [u8]| {
+            let Some(from) = at.checked_sub(offset).and_then(|a| usize::try_from(a).ok()) else {
+                return false;
+            };
+            match bytes.get(from..from.saturating_add(buf.len())) {
+                Some(b) => {
+                    buf.copy_from_slice(b);
+                    true
+                }
+                None => false,
+            }
+        };
+        while self.decode(&mut cursor, &mut read, usize::MAX, out)? > 0 {}
+        Ok(())
+    }
+}
+
+/// The decoders of a pointwise chunk's items after its first record.
+struct ItemDecoders {
+    point: Point10Decoder,
+    gps: Option<GpsTime>,
+    rgb: Option<([u16; 3], Box<RgbModels>)>,
+    wave: Option<WaveDecoder>,
+    extra: ExtraDecoder,
+}
+
+impl ItemDecoders {
+    /// The next point's items, in the VLR's order.
+    fn next(&mut self, dec: &mut Decoder<'_>) -> Step<PointwiseRecord> {
+        let mut p = PointwiseRecord {
+            point: self.point.next(dec)?,
+            ..PointwiseRecord::default()
+        };
+        if let Some(g) = self.gps.as_mut() {
+            p.gps_time = f64::from_bits(g.next(dec)? as u64);
+        }
+        if let Some((last, models)) = self.rgb.as_mut() {
+            *last = decode_rgb(dec, models, *last)?;
+            p.rgb = *last;
+        }
+        if let Some(w) = self.wave.as_mut() {
+            w.next(dec)?;
+        }
+        self.extra.next(dec)?;
+        Ok(p)
+    }
+}
+
+/// A pointwise chunk being decoded ([`PointwiseLaz::decode`]): the item
+/// decoders' state, the arithmetic decoder's registers and a window of the
+/// chunk's bytes. Its memory is the window (see
+/// [`PointwiseCursor::buffer_capacity`]) and the adaptive models, whatever
+/// the chunk's size.
+pub struct PointwiseCursor {
+    index: usize,
+    span: ChunkSpan,
+    /// the chunk's size in bytes
+    len: u64,
+    /// points of the chunk decoded so far
+    decoded: u64,
+    state: Option<ItemDecoders>,
+    registers: Option<Registers>,
+    window: Vec<u8>,
+    /// the next byte of the window to decode
+    at: usize,
+    /// the chunk-relative offset of the window's first byte
+    window_start: u64,
+    /// the window's size
+    capacity: usize,
+}
+
+impl PointwiseCursor {
+    /// Whether every point of the chunk has been decoded.
+    pub fn finished(&self) -> bool {
+        self.decoded == self.span.points
+    }
+
+    /// The chunk.
+    pub fn chunk(&self) -> ChunkSpan {
+        self.span
+    }
+
+    /// Bytes the window holds allocated now (at most its size, set when the
+    /// cursor was made; 0 once the chunk is done).
+    pub fn buffer_capacity(&self) -> usize {
+        self.window.capacity()
+    }
+
+    /// Makes the window hold at least `need` bytes past the decoding
+    /// position (or all that is left of the chunk): drops the bytes decoded
+    /// and reads up to the window's size.
+    fn fill(
+        &mut self,
+        read: ReadInto<'_>,
+        need: usize,
+        err: &impl Fn(String) -> Laz14Error,
+    ) -> Result<(), Laz14Error> {
+        let held = self.window.len() - self.at;
+        let end = self.window_start + self.window.len() as u64;
+        if held >= need || end >= self.len {
             return Ok(());
         }
-        let mut dec = Decoder::new(stream).map_err(|_| {
-            err(format!("its compressed stream ({} bytes) is shorter than 4 bytes or starts with a value no encoder writes; the file is damaged", stream.len()))
-        })?;
-        let mut points = Point10Decoder::new(&first_point);
-        for k in 1..span.points {
-            let fail = |f: Fault| {
-                let why = match f {
-                    Fault::Switches => "its GPS time switches sequences more often than there are sequences (an encoder switches at most once)",
-                    _ => "the chunk's bytes end before it, or hold data no encoder writes",
-                };
-                err(format!(
-                    "point {} cannot be decoded: {why}; the file is damaged",
-                    span.first_point + k
-                ))
-            };
-            let mut p = PointwiseRecord {
-                point: points.next(&mut dec).map_err(fail)?,
-                ..PointwiseRecord::default()
-            };
-            if let Some(g) = gps.as_mut() {
-                p.gps_time = f64::from_bits(g.next(&mut dec).map_err(fail)? as u64);
-            }
-            if let Some((last, models)) = rgb.as_mut() {
-                *last = decode_rgb(&mut dec, models, *last).map_err(fail)?;
-                p.rgb = *last;
-            }
-            if let Some(w) = wave.as_mut() {
-                w.next(&mut dec).map_err(fail)?;
-            }
-            extra.next(&mut dec).map_err(fail)?;
-            out.push(p);
+        if self.window.capacity() < self.capacity {
+            self.window.reserve_exact(self.capacity - self.window.len());
+        }
+        self.window.copy_within(self.at.., 0);
+        self.window.truncate(held);
+        self.window_start += self.at as u64;
+        self.at = 0;
+        let grow = ((self.capacity - held) as u64).min(self.len - end) as usize;
+        self.window.resize(held + grow, 0);
+        if !read(self.span.offset + end, &mut self.window[held..]) {
+            return Err(err(format!(
+                "the chunk's {} bytes run past the end of the file; it is truncated",
+                self.len
+            )));
         }
         Ok(())
     }

@@ -8,12 +8,14 @@
 use std::io::{Cursor, Seek, SeekFrom};
 
 use laz::las::{Point0, Point1, Point2, Point3, Point4, Point5};
-use laz::{LasZipCompressor, LasZipDecompressor, LazItemRecordBuilder, LazVlr, LazVlrBuilder};
+use laz::record::{RecordCompressor, SequentialPointRecordCompressor};
+use laz::{LazItemRecordBuilder, LazVlr};
 use scanfit_io::laz14::{Point10, PointwiseLaz, PointwiseRecord};
 
 #[path = "laz_gen.rs"]
 pub mod laz_gen;
-pub use laz_gen::{Chunks, Rng};
+use laz_gen::{laszip_vlr, with_laszip_vlr, write_points};
+pub use laz_gen::{table_end, Chunks, Laz, Rng};
 
 /// Bytes of a record of `format` (0-5) with `extra` extra bytes.
 pub fn record_len(format: u8, extra: usize) -> usize {
@@ -162,15 +164,6 @@ fn items(format: u8, extra: u16) -> Vec<laz::LazItem> {
     }
 }
 
-/// A whole LAS 1.2 LAZ file: a 227-byte header, the LASzip VLR, the
-/// compressed points and their chunk table, written by the laz crate.
-pub struct Laz {
-    pub bytes: Vec<u8>,
-    pub vlr: LazVlr,
-    pub vlr_payload: Vec<u8>,
-    pub start: u64,
-}
-
 /// The LAS 1.2 header (and VLR header) of a file of `n` records of
 /// `format` with `len` bytes, points at `start`.
 pub fn las12_header(format: u8, len: usize, n: u64, start: u64, vlrs: u32) -> Vec<u8> {
@@ -191,43 +184,33 @@ pub fn las12_header(format: u8, len: usize, n: u64, start: u64, vlrs: u32) -> Ve
     h
 }
 
+/// A LAS 1.2 LAZ file of the records `raw` (compressor 2: chunks and a
+/// chunk table), written by the laz crate.
 pub fn compress(format: u8, extra: usize, chunks: Chunks, raw: &[u8]) -> Laz {
-    let builder = LazVlrBuilder::new(items(format, extra as u16));
-    let vlr = match chunks {
-        Chunks::Fixed(c) => builder.with_fixed_chunk_size(c),
-        Chunks::Variable(_) => builder.with_variable_chunk_size(),
-    }
-    .build();
-    let mut payload = Vec::new();
-    vlr.write_to(&mut payload).unwrap();
+    let (vlr, payload) = laszip_vlr(items(format, extra as u16), chunks);
     let len = record_len(format, extra);
     let n = (raw.len() / len) as u64;
     let start = 227 + 54 + payload.len() as u64;
-    let mut h = las12_header(format | 0x80, len, n, start, 1);
-    let mut vh = vec![0u8; 54];
-    vh[2..16].copy_from_slice(b"laszip encoded");
-    vh[18..20].copy_from_slice(&22204u16.to_le_bytes());
-    vh[20..22].copy_from_slice(&(payload.len() as u16).to_le_bytes());
-    h.extend_from_slice(&vh);
-    h.extend_from_slice(&payload);
-    let mut cursor = Cursor::new(h);
+    let head = with_laszip_vlr(las12_header(format | 0x80, len, n, start, 1), &payload);
+    write_points(head, vlr, payload, chunks, raw, len)
+}
+
+/// A LAS 1.2 LAZ file of the records `raw` with LASzip's compressor 1
+/// (pointwise, no chunk table: the whole point stream one chunk), the
+/// records compressed by the laz crate's pointwise record compressor.
+pub fn compress_single(format: u8, extra: usize, raw: &[u8]) -> Laz {
+    let (_, mut payload) = laszip_vlr(items(format, extra as u16), Chunks::Fixed(50_000));
+    payload[0] = 1; // compressor 1: pointwise, one chunk
+    let vlr = LazVlr::from_buffer(&payload).unwrap();
+    let len = record_len(format, extra);
+    let n = (raw.len() / len) as u64;
+    let start = 227 + 54 + payload.len() as u64;
+    let head = with_laszip_vlr(las12_header(format | 0x80, len, n, start, 1), &payload);
+    let mut cursor = Cursor::new(head);
     cursor.seek(SeekFrom::End(0)).unwrap();
-    let mut c = LasZipCompressor::new(cursor, vlr.clone()).unwrap();
-    match chunks {
-        Chunks::Fixed(_) => c.compress_many(raw).unwrap(),
-        Chunks::Variable(sizes) => {
-            let mut at = 0;
-            for &s in sizes.iter().cycle() {
-                if at == raw.len() {
-                    break;
-                }
-                let end = (at + s * len).min(raw.len());
-                c.compress_many(&raw[at..end]).unwrap();
-                c.finish_current_chunk().unwrap();
-                at = end;
-            }
-        }
-    }
+    let mut c = SequentialPointRecordCompressor::new(cursor);
+    c.set_fields_from(vlr.items()).unwrap();
+    c.compress_many(raw).unwrap();
     c.done().unwrap();
     Laz {
         bytes: c.into_inner().into_inner(),
@@ -235,16 +218,6 @@ pub fn compress(format: u8, extra: usize, chunks: Chunks, raw: &[u8]) -> Laz {
         vlr_payload: payload,
         start,
     }
-}
-
-/// The records as the laz crate decodes them.
-pub fn laz_decode(f: &Laz, n: usize, len: usize) -> Vec<u8> {
-    let mut src = Cursor::new(&f.bytes);
-    src.set_position(f.start);
-    let mut d = LasZipDecompressor::new(src, f.vlr.clone()).unwrap();
-    let mut out = vec![0u8; n * len];
-    d.decompress_many(&mut out).unwrap();
-    out
 }
 
 /// The fields scanfit decodes, of raw records.
@@ -279,11 +252,6 @@ pub fn table(f: &Laz) -> Vec<(u64, u64)> {
         .collect()
 }
 
-pub fn table_end(f: &Laz) -> u64 {
-    let s = f.start as usize;
-    u64::from_le_bytes(f.bytes[s..s + 8].try_into().unwrap())
-}
-
 /// Ours, chunk by chunk.
 pub fn ours(f: &Laz, n: u64) -> (Vec<PointwiseRecord>, usize) {
     let t = table(f);
@@ -302,25 +270,11 @@ pub fn ours(f: &Laz, n: u64) -> (Vec<PointwiseRecord>, usize) {
 /// (LASzip 1.x), in chunks of `chunk` points.
 pub fn compress_v1(n: usize, chunk: u32) -> Vec<u8> {
     let raw = records(1, 0, n, 5);
-    let vlr = LazVlrBuilder::new(LazItemRecordBuilder::version_1_of::<Point1>(0))
-        .with_fixed_chunk_size(chunk)
-        .build();
-    let mut payload = Vec::new();
-    vlr.write_to(&mut payload).unwrap();
+    let chunks = Chunks::Fixed(chunk);
+    let (vlr, payload) = laszip_vlr(LazItemRecordBuilder::version_1_of::<Point1>(0), chunks);
     let start = 227 + 54 + payload.len() as u64;
-    let mut h = las12_header(0x81, 28, n as u64, start, 1);
-    let mut vh = vec![0u8; 54];
-    vh[2..16].copy_from_slice(b"laszip encoded");
-    vh[18..20].copy_from_slice(&22204u16.to_le_bytes());
-    vh[20..22].copy_from_slice(&(payload.len() as u16).to_le_bytes());
-    h.extend_from_slice(&vh);
-    h.extend_from_slice(&payload);
-    let mut cursor = Cursor::new(h);
-    cursor.seek(SeekFrom::End(0)).unwrap();
-    let mut c = LasZipCompressor::new(cursor, vlr).unwrap();
-    c.compress_many(&raw).unwrap();
-    c.done().unwrap();
-    c.into_inner().into_inner()
+    let head = with_laszip_vlr(las12_header(0x81, 28, n as u64, start, 1), &payload);
+    write_points(head, vlr, payload, chunks, &raw, 28).bytes
 }
 
 /// A two-point LAZ file of format 1 (compressor 1: one chunk, no chunk
@@ -363,20 +317,13 @@ pub fn gps_switches(switches: usize) -> Vec<u8> {
     enc.encode_symbol(&mut no_diff, 0).unwrap();
     enc.done().unwrap();
     let stream = enc.into_inner().into_inner();
-    let vlr = LazVlrBuilder::new(LazItemRecordBuilder::version_2_of::<Point1>(0))
-        .with_fixed_chunk_size(u32::MAX - 1)
-        .build();
-    let mut payload = Vec::new();
-    vlr.write_to(&mut payload).unwrap();
+    let (_, mut payload) = laszip_vlr(
+        LazItemRecordBuilder::version_2_of::<Point1>(0),
+        Chunks::Fixed(u32::MAX - 1),
+    );
     payload[0] = 1; // compressor 1: pointwise, one chunk
     let start = 227 + 54 + payload.len() as u64;
-    let mut f = las12_header(0x81, 28, 2, start, 1);
-    let mut vh = vec![0u8; 54];
-    vh[2..16].copy_from_slice(b"laszip encoded");
-    vh[18..20].copy_from_slice(&22204u16.to_le_bytes());
-    vh[20..22].copy_from_slice(&(payload.len() as u16).to_le_bytes());
-    f.extend_from_slice(&vh);
-    f.extend_from_slice(&payload);
+    let mut f = with_laszip_vlr(las12_header(0x81, 28, 2, start, 1), &payload);
     // the first point raw: X = Y = Z = 0, return 1 of 1, GPS time 1e8
     let mut first = [0u8; 28];
     first[14] = 1 | (1 << 3);

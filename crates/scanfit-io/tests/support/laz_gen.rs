@@ -179,8 +179,9 @@ pub struct Laz {
     pub start: u64,
 }
 
-pub fn compress(format: u8, version4: bool, chunks: Chunks, raw: &[u8]) -> Laz {
-    let builder = LazVlrBuilder::new(items(format, version4));
+/// The LASzip VLR of `items` cut into `chunks`, and its payload bytes.
+pub fn laszip_vlr(items: Vec<laz::LazItem>, chunks: Chunks) -> (LazVlr, Vec<u8>) {
+    let builder = LazVlrBuilder::new(items);
     let vlr = match chunks {
         Chunks::Fixed(c) => builder.with_fixed_chunk_size(c),
         Chunks::Variable(_) => builder.with_variable_chunk_size(),
@@ -188,30 +189,34 @@ pub fn compress(format: u8, version4: bool, chunks: Chunks, raw: &[u8]) -> Laz {
     .build();
     let mut payload = Vec::new();
     vlr.write_to(&mut payload).unwrap();
-    let len = record_len(format);
-    let n = (raw.len() / len) as u64;
-    let start = 375 + 54 + payload.len() as u64;
-    let mut h = vec![0u8; 375];
-    h[0..4].copy_from_slice(b"LASF");
-    h[24] = 1;
-    h[25] = 4;
-    h[94..96].copy_from_slice(&375u16.to_le_bytes());
-    h[96..100].copy_from_slice(&(start as u32).to_le_bytes());
-    h[100..104].copy_from_slice(&1u32.to_le_bytes());
-    h[104] = format | 0x80;
-    h[105..107].copy_from_slice(&(len as u16).to_le_bytes());
-    for (k, s) in [0.01f64, 0.01, 0.001].iter().enumerate() {
-        h[131 + 8 * k..139 + 8 * k].copy_from_slice(&s.to_le_bytes());
-        h[155 + 8 * k..163 + 8 * k].copy_from_slice(&(1.0e5 * (k + 1) as f64).to_le_bytes());
-    }
-    h[247..255].copy_from_slice(&n.to_le_bytes());
+    (vlr, payload)
+}
+
+/// `header` followed by the LASzip VLR (its 54-byte VLR header and
+/// `payload`).
+pub fn with_laszip_vlr(mut header: Vec<u8>, payload: &[u8]) -> Vec<u8> {
     let mut vh = vec![0u8; 54];
     vh[2..16].copy_from_slice(b"laszip encoded");
     vh[18..20].copy_from_slice(&22204u16.to_le_bytes());
     vh[20..22].copy_from_slice(&(payload.len() as u16).to_le_bytes());
-    h.extend_from_slice(&vh);
-    h.extend_from_slice(&payload);
-    let mut cursor = Cursor::new(h);
+    header.extend_from_slice(&vh);
+    header.extend_from_slice(payload);
+    header
+}
+
+/// A whole LAZ file: `head` (the LAS header and the LASzip VLR, ending
+/// where the points start), then the records `raw` of `len` bytes
+/// compressed by the laz crate in `chunks` (and the chunk table).
+pub fn write_points(
+    head: Vec<u8>,
+    vlr: LazVlr,
+    payload: Vec<u8>,
+    chunks: Chunks,
+    raw: &[u8],
+    len: usize,
+) -> Laz {
+    let start = head.len() as u64;
+    let mut cursor = Cursor::new(head);
     cursor.seek(SeekFrom::End(0)).unwrap();
     let mut c = LasZipCompressor::new(cursor, vlr.clone()).unwrap();
     match chunks {
@@ -236,6 +241,29 @@ pub fn compress(format: u8, version4: bool, chunks: Chunks, raw: &[u8]) -> Laz {
         vlr_payload: payload,
         start,
     }
+}
+
+pub fn compress(format: u8, version4: bool, chunks: Chunks, raw: &[u8]) -> Laz {
+    let (vlr, payload) = laszip_vlr(items(format, version4), chunks);
+    let len = record_len(format);
+    let n = (raw.len() / len) as u64;
+    let start = 375 + 54 + payload.len() as u64;
+    let mut h = vec![0u8; 375];
+    h[0..4].copy_from_slice(b"LASF");
+    h[24] = 1;
+    h[25] = 4;
+    h[94..96].copy_from_slice(&375u16.to_le_bytes());
+    h[96..100].copy_from_slice(&(start as u32).to_le_bytes());
+    h[100..104].copy_from_slice(&1u32.to_le_bytes());
+    h[104] = format | 0x80;
+    h[105..107].copy_from_slice(&(len as u16).to_le_bytes());
+    for (k, s) in [0.01f64, 0.01, 0.001].iter().enumerate() {
+        h[131 + 8 * k..139 + 8 * k].copy_from_slice(&s.to_le_bytes());
+        h[155 + 8 * k..163 + 8 * k].copy_from_slice(&(1.0e5 * (k + 1) as f64).to_le_bytes());
+    }
+    h[247..255].copy_from_slice(&n.to_le_bytes());
+    let head = with_laszip_vlr(h, &payload);
+    write_points(head, vlr, payload, chunks, raw, len)
 }
 
 /// The records as the laz crate decodes them.

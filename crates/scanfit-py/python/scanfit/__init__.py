@@ -5,7 +5,8 @@ the GIL is released while it runs). Every pipeline of the ``scanfit`` command li
 is one function with the command's defaults as keyword defaults, returning its
 report as a dict:
 
-- points: ``read_cloud``, ``write_cloud``, ``Cloud``, ``normals``, ``hpr``, ``boundary``
+- points: ``read_cloud``, ``write_cloud``, ``Cloud``, ``normals``, ``hpr``, ``boundary``,
+  ``PointChunks`` (a file's rows a bounded chunk at a time), ``up_axis``
 - surfaces: ``fit_surface``, ``mba``, ``coons``, ``turntable``, ``reconstruct``
 - curves: ``fit_curve``, ``compare_curves``
 - results: ``Surface``, ``Curve``, ``Model`` (evaluate, derivatives, project, export)
@@ -25,6 +26,7 @@ from ._scanfit import (
     Cloud,
     Curve,
     Model,
+    PointChunks,
     ScanfitError,
     Surface,
     __version__,
@@ -39,6 +41,7 @@ from ._scanfit import (
     read_cloud,
     reconstruct,
     turntable,
+    up_axis,
     write_cloud,
 )
 
@@ -46,6 +49,7 @@ __all__ = [
     "Cloud",
     "Curve",
     "Model",
+    "PointChunks",
     "ScanfitError",
     "Surface",
     "__version__",
@@ -60,5 +64,6 @@ __all__ = [
     "read_cloud",
     "reconstruct",
     "turntable",
+    "up_axis",
     "write_cloud",
 ]

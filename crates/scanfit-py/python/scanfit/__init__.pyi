@@ -158,6 +158,29 @@ def write_cloud(
     attributes: Optional[dict[str, ArrayLike]] = None,
     ascii: bool = False,
 ) -> None: ...
+
+class PointChunks:
+    """Rows start..stop of a point file, chunk_points rows at a time, as (points, uv)."""
+
+    def __init__(
+        self,
+        path: StrPath,
+        chunk_points: int = 1_000_000,
+        uv: bool = False,
+        start: int = 0,
+        stop: Optional[int] = None,
+    ) -> None: ...
+    def __iter__(self) -> "PointChunks": ...
+    def __next__(self) -> Tuple[F64, Optional[F64]]:
+        """points (n, 3) and, with uv=True, the u, v columns (n, 2)."""
+    @property
+    def bounded(self) -> bool:
+        """Whether memory is bounded by chunk_points (not the whole file read)."""
+    @property
+    def rows_read(self) -> int: ...
+
+def up_axis(points: Points) -> Literal["x", "y", "z"]:
+    """The axis up="auto" takes: the thin axis of a sheet, else "z"."""
 def normals(
     points: Points,
     k: int = 16,
@@ -197,7 +220,7 @@ def mba(
     alpha: float = 1.49,
     weight: Literal["moon", "aza04", "as05", "axis4"] = "moon",
     adjust_steps: int = 5,
-    start: Literal["mean", "fitted"] = "mean",
+    start: Optional[Literal["fitted", "mean"]] = None,
     up: Literal["auto", "x", "y", "z"] = "auto",
 ) -> dict[str, Any]: ...
 def coons(

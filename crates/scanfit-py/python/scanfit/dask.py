@@ -12,8 +12,11 @@ one merged set of sums; no point ever travels to the client.
 ``points`` is either a Dask array of shape ``(N, 3)`` chunked by rows (any chunking,
 empty chunks allowed; an unpersisted array is recomputed per pass, a persisted one is
 read from the workers' memory), or a list of point files (LAS/LAZ/PLY/XYZ/... tiles,
-paths the workers can read) that each worker reads itself, once per pass; a tile that
-fails to read raises a ``ScanfitError`` naming the tile.
+paths the workers can read) that the workers read themselves, once per pass, a chunk
+of ``chunk_points`` rows at a time (``scanfit.PointChunks``, the reader of
+``--chunk-points``): a worker's memory is bounded by the chunk, not the tile, and
+with ``task_points`` a big tile is split into several tasks of row ranges. A tile
+that fails to read raises a ``ScanfitError`` naming the tile.
 
 The keywords are those of ``scanfit.mba`` and ``scanfit.fit_surface``, with their
 defaults. The fit's settings that look at all points at once run as more passes of
@@ -23,8 +26,8 @@ worker computes its points' parameters), ``knots="distribution"`` (the few order
 statistics eq. 9.69 needs, found exactly by rounds of histograms) and ``correct``
 (per round, the workers re-project their points onto the surfaces of the accepted
 rounds in turn, as the single-process correction does). MBA's ``adjust`` (the
-nearest points of the whole cloud per knot) and ``start="fitted"`` remain
-single-process and are a ``ScanfitError`` saying why. The surface equals the
+nearest points of the whole cloud per knot) remains
+single-process and is a ``ScanfitError`` saying why. The surface equals the
 single-process one up to the rounding of the merged additions (about 1e-15
 relative, tested at 1e-12 on 10^6 points).
 
@@ -42,15 +45,16 @@ import time
 
 import numpy as np
 
-from . import read_cloud
-from ._scanfit import ScanfitError
+from ._scanfit import PointChunks, ScanfitError, Surface, up_axis
 from .sums import (
     Centring,
     FitSetup,
     FrameSums,
     MbaLevels,
     Parameterization,
+    PassSums,
     PlanePasses,
+    ResidualSums,
 )
 
 __all__ = ["mba", "fit_surface"]
@@ -81,36 +85,64 @@ def _client(client):
 # ---- reading a part of the points (runs on the workers) ------------------------
 
 
-def _read_tile(path, uv):
-    """The points (and with ``uv`` the u, v attributes) of one tile."""
-    try:
-        cloud = read_cloud(path)
-    except Exception as e:  # the message names the file too; say it is a tile
-        raise ScanfitError(f"tile {path!s} could not be read: {e}") from None
-    pts = np.ascontiguousarray(cloud.positions, dtype=np.float64)
-    if not uv:
-        return pts, None
-    a = cloud.attributes
-    if "u" not in a or "v" not in a:
-        raise ScanfitError(
-            f"tile {path!s} has no attributes u and v (it has: {', '.join(sorted(a)) or 'none'}); "
-            "params='uv' reads the parameters from each tile's u and v columns"
-        )
-    return pts, np.column_stack([a["u"], a["v"]])
-
-
 class _Tile:
-    """A tile read inside the task that sums it (its points never leave that task)."""
+    """Rows ``start`` to ``stop`` of a tile, read by the task that sums them a
+    chunk of ``chunk`` rows at a time (``scanfit.PointChunks``): the points
+    never leave that task, and its memory is bounded by the chunk, not the tile."""
 
-    def __init__(self, path, uv):
-        self.path, self.uv = path, uv
+    def __init__(self, path, uv, chunk, start=0, stop=None):
+        self.path, self.uv, self.chunk, self.start, self.stop = path, uv, chunk, start, stop
 
-    def load(self):
-        return _read_tile(self.path, self.uv)
+    def part(self, start, stop):
+        """The rows ``start`` to ``stop`` of the same tile."""
+        return _Tile(self.path, self.uv, self.chunk, start, stop)
+
+    def blocks(self):
+        """``(points, uv)`` per chunk; a read error names the tile."""
+        try:
+            for pts, uv in PointChunks(self.path, self.chunk, self.uv, self.start, self.stop):
+                yield pts, uv
+        except ScanfitError as e:  # the message names the file too; say it is a tile
+            raise ScanfitError(f"tile {self.path!s} could not be read: {e}") from None
 
 
-def _load(part):
-    return part.load() if isinstance(part, _Tile) else part
+def _blocks(part, up="z"):
+    """The points of a part (in the z-up frame of ``up``) and their parameters,
+    a bounded block at a time: a tile's chunks, or a Dask array's block."""
+    for pts, uv in part.blocks() if isinstance(part, _Tile) else (part,):
+        yield _to_frame(pts, up), uv
+
+
+def _to_frame(pts, up):
+    """Points in the z-up frame of the axis ``up`` (``scanfit.mba``'s, a rotation:
+    y up gives ``(x, -z, y)``, x up ``(y, z, x)``; exact, no rounding)."""
+    if up == "z":
+        return pts
+    if up == "y":
+        return np.column_stack([pts[:, 0], -pts[:, 2], pts[:, 1]])
+    return np.ascontiguousarray(pts[:, [1, 2, 0]])
+
+
+def _from_frame(pts, up):
+    """The inverse of ``_to_frame``."""
+    if up == "z":
+        return pts
+    if up == "y":
+        return np.stack([pts[..., 0], pts[..., 2], -pts[..., 1]], axis=-1)
+    return np.stack([pts[..., 2], pts[..., 0], pts[..., 1]], axis=-1)
+
+
+def _surface_from_frame(surface, up):
+    """A surface fitted in the z-up frame of ``up``, turned back to world axes
+    (its control points turned, exactly; knots unchanged)."""
+    if up == "z":
+        return surface
+    import json
+
+    doc = json.loads(surface.to_json())
+    node = doc["surface"] if "surface" in doc else doc
+    node["control_points"] = _from_frame(np.asarray(node["control_points"]), up).tolist()
+    return Surface.from_json(json.dumps(doc))
 
 
 def _block(pts, uv):
@@ -118,9 +150,10 @@ def _block(pts, uv):
     return np.ascontiguousarray(pts, dtype=np.float64), uv
 
 
-def _parts(points, uv, params):
+def _parts(points, uv, params, chunk_points):
     """One part per chunk or tile, in a fixed order: a Delayed ``(points, uv)`` per
-    chunk of a Dask array, a ``_Tile`` (read by the task that sums it) per file."""
+    chunk of a Dask array, a ``_Tile`` (read by the task that sums it, a chunk of
+    ``chunk_points`` rows at a time) per file."""
     import dask.array as da
     from dask import delayed
 
@@ -132,7 +165,7 @@ def _parts(points, uv, params):
                 "uv= goes with a Dask array of points; tiles carry their parameters as u and v "
                 "columns (params='uv')"
             )
-        return [_Tile(str(p), params == "uv") for p in points]
+        return [_Tile(str(p), params == "uv", int(chunk_points)) for p in points]
     if not isinstance(points, da.Array):
         raise ScanfitError(
             f"points must be a Dask array of shape (N, 3) or a list of point files; got {type(points).__name__}"
@@ -162,64 +195,127 @@ def _parts(points, uv, params):
 # ---- the tasks (run on the workers) --------------------------------------------
 
 
-def _bounds(part):
-    """Bounding box, count and first point of a part (``None`` when empty)."""
-    pts, _ = _load(part)
-    if len(pts) == 0:
-        return None
-    return pts.min(axis=0), pts.max(axis=0), len(pts), pts[0].copy()
+def _bounds(part, sample=False):
+    """Bounding box, first point and count of a part (``None`` when empty),
+    the counts per part, and with ``sample`` an evenly spaced sample (``_Sample``)."""
+    lo = hi = first = None
+    n = 0
+    picked = _Sample() if sample else None
+    for pts, _ in _blocks(part):
+        if len(pts) == 0:
+            continue
+        if first is None:
+            lo, hi, first = pts.min(axis=0), pts.max(axis=0), pts[0].copy()
+        else:
+            lo, hi = np.minimum(lo, pts.min(axis=0)), np.maximum(hi, pts.max(axis=0))
+        if picked is not None:
+            picked.add(pts)
+        n += len(pts)
+    if first is None:
+        return None, [0]
+    return (lo, hi, n, first, picked), [n]
 
 
 def _merge_bounds(*bs):
-    """Merged in part order: the first point is the first part's."""
-    bs = [b for b in bs if b is not None]
+    """Merged in part order: the first point is the first part's, the counts
+    per part follow one another."""
+    counts = [c for b in bs for c in b[1]]
+    bs = [b[0] for b in bs if b[0] is not None]
     if not bs:
-        return None
+        return None, counts
     lo = np.min([b[0] for b in bs], axis=0)
     hi = np.max([b[1] for b in bs], axis=0)
-    return lo, hi, sum(b[2] for b in bs), bs[0][3]
+    picked = None if bs[0][4] is None else _Sample.merged([b[4] for b in bs])
+    return (lo, hi, sum(b[2] for b in bs), bs[0][3], picked), counts
 
 
-def _frame(part, centring):
+#: most points of the sample ``up="auto"`` decides from (as ``scanfit mba --chunk-points``)
+UP_SAMPLE = 1 << 16
+
+
+class _Sample:
+    """Every ``stride``-th point of a part (``stride`` a power of two, the
+    smallest that keeps at most ``UP_SAMPLE`` points), as the streamed CLI
+    samples its input for the automatic up axis."""
+
+    def __init__(self):
+        self.points, self.stride, self.seen = np.empty((0, 3)), 1, 0
+
+    def add(self, pts):
+        first = (-self.seen) % self.stride  # the next index that is a multiple of stride
+        self.points = np.concatenate([self.points, pts[first :: self.stride]])
+        self.seen += len(pts)
+        while len(self.points) > UP_SAMPLE:
+            self.points, self.stride = self.points[::2], 2 * self.stride
+
+    @staticmethod
+    def merged(samples):
+        """One sample of parts that follow one another: every part thinned to
+        the largest stride (so each keeps every ``stride``-th of its points)."""
+        out = _Sample()
+        out.stride = max(s.stride for s in samples)
+        out.points = np.concatenate([s.points[:: out.stride // s.stride] for s in samples])
+        while len(out.points) > UP_SAMPLE:
+            out.points, out.stride = out.points[::2], 2 * out.stride
+        return out
+
+
+def _frame(part, centring, up="z"):
     f = FrameSums()
-    f.add(_load(part)[0], centring)
+    for pts, _ in _blocks(part, up):
+        f.add(pts, centring)
     return f
 
 
-def _level(part, state):
-    acc = state.accumulator()
-    stats = acc.add(state, _load(part)[0])
-    return acc, stats
+def _level(part, state, up="z"):
+    acc, sums = state.accumulator(), PassSums()
+    for pts, _ in _blocks(part, up):
+        sums.merge(acc.add(state, pts))
+    return acc, sums
 
 
-def _vertical(part, state):
-    return state.residuals(_load(part)[0])
+def _vertical(part, state, up="z"):
+    stats = ResidualSums()
+    for pts, _ in _blocks(part, up):
+        stats.merge(state.residuals(pts))
+    return stats
+
+
+def _start_pass(part, state, up="z"):
+    """The pass sums of a part without a level (the fitted start of the last)."""
+    sums = PassSums()
+    for pts, _ in _blocks(part, up):
+        sums.merge(state.pass_sums(pts))
+    return sums
 
 
 def _plane(part, stage):
     sums = stage.accumulator()
-    sums.add(stage, _load(part)[0])
+    for pts, _ in _blocks(part):
+        sums.add(stage, pts)
     return sums
 
 
 def _ranks(part, param, query):
-    pts, uv = _load(part)
     counts = query.counts()
-    counts.add(query, param.uv(pts, uv))
+    for pts, uv in _blocks(part):
+        counts.add(query, param.uv(pts, uv))
     return counts
 
 
 def _equations(part, param, empty):
-    pts, uv = _load(part)
     eq = empty.copy()
-    if len(pts):
-        eq.add(pts, param.uv(pts, uv))
+    for pts, uv in _blocks(part):
+        if len(pts):
+            eq.add(pts, param.uv(pts, uv))
     return eq
 
 
 def _errors(part, param):
-    pts, uv = _load(part)
-    return param.errors(pts, uv)
+    stats = ResidualSums()
+    for pts, uv in _blocks(part):
+        stats.merge(param.errors(pts, uv))
+    return stats
 
 
 def _merge(*xs):
@@ -255,20 +351,91 @@ def _pass(client, parts, task, *args, merge=_merge):
     return client.compute(items[0]).result()
 
 
-def _centring(client, parts, domain):
-    """The centring, the point count and the first point (these two when a
-    pass ran) from a bounding-box pass or the given domain."""
+def _survey(client, parts, sample=False):
+    """The bounding-box pass: ``(lo, hi, count, first point, sample)`` in world
+    axes (the sample, a ``_Sample``, with ``sample``) and the counts per part."""
+    box, counts = _pass(client, parts, _bounds, sample, merge=_merge_bounds)
+    if box is None:
+        raise ScanfitError("the points are empty: no chunk or tile holds a point")
+    return box, counts
+
+
+def _centring(box, domain, up="z"):
+    """The centring from the surveyed box (turned into the z-up frame of
+    ``up``) or from the given domain (in that frame's x and y)."""
     if domain is not None:
         x0, y0, x1, y1 = (float(v) for v in domain)
-        return Centring((x0, y0, 0.0), (x1, y1, 0.0)), None, None
-    b = _pass(client, parts, _bounds, merge=_merge_bounds)
-    if b is None:
-        raise ScanfitError("the points are empty: no chunk or tile holds a point")
-    lo, hi, n, first = b
-    return Centring(tuple(map(float, lo)), tuple(map(float, hi))), n, first
+        return Centring((x0, y0, 0.0), (x1, y1, 0.0))
+    corners = _to_frame(np.array([box[0], box[1]], dtype=np.float64), up)
+    lo, hi = corners.min(axis=0), corners.max(axis=0)
+    return Centring(tuple(map(float, lo)), tuple(map(float, hi)))
+
+
+def _split(parts, counts, task_points):
+    """Tiles of more than ``task_points`` rows as several tasks of at most that
+    many rows each (in file order); other parts as they are."""
+    if task_points is None:
+        return parts
+    out = []
+    for part, n in zip(parts, counts):
+        if isinstance(part, _Tile) and n > task_points:
+            out.extend(part.part(a, min(a + task_points, n)) for a in range(0, n, task_points))
+        else:
+            out.append(part)
+    return out
+
+
+def _check_reading(chunk_points, task_points):
+    """Refuses chunk and task sizes that are not positive integers."""
+    for name, value in (("chunk_points", chunk_points), ("task_points", task_points)):
+        if value is None and name == "task_points":
+            continue
+        if not isinstance(value, (int, np.integer)) or isinstance(value, bool) or value < 1:
+            raise ScanfitError(
+                f"{name} must be a positive number of rows; got {value!r}"
+            )
+
+
+def _check_up(up):
+    """``up`` as given, refused unless it is one of ``scanfit.mba``'s choices."""
+    if up not in ("auto", "x", "y", "z"):
+        raise ScanfitError(f'up = {up!r} is not one of "auto", "x", "y", "z"')
+    return up
+
+
+def _mba_survey(client, parts, domain, up, task_points):
+    """The bounding-box pass of ``mba`` when it is needed (no domain, the
+    automatic up axis, or tiles to split): the parts (split), the up axis
+    (decided), the box (``None`` without the pass) and the passes made."""
+    tiles = any(isinstance(p, _Tile) for p in parts)
+    if domain is not None and up != "auto" and not (tiles and task_points is not None):
+        return parts, up, None, 0
+    box, counts = _survey(client, parts, sample=up == "auto")
+    if up == "auto":
+        up = up_axis(box[4].points)
+    return _split(parts, counts, task_points), up, box, 1
 
 
 # ---- the fits (run on the client) ----------------------------------------------
+
+
+def _mba_start(start):
+    """The distributed MBA's start of level 0 (``None``: ``"fitted"``)."""
+    if start is None:
+        return "fitted"
+    if start not in ("mean", "fitted"):
+        raise ScanfitError(f"start must be 'mean' or 'fitted'; got {start!r}")
+    return start
+
+
+def _last_start(client, parts, run, up="z"):
+    """The fitted start of the last level: one more pass while ``run`` needs it.
+    Returns the passes made (0 for the mean start)."""
+    passes = 0
+    while run.needs_pass:
+        run.record(_pass(client, parts, _start_pass, _shared(run.state()), up))
+        passes += 1
+    return passes
 
 
 def mba(
@@ -281,31 +448,53 @@ def mba(
     alpha=1.49,
     weight="moon",
     adjust_steps=5,
-    start="mean",
+    start=None,
+    up="auto",
     *,
     domain=None,
+    chunk_points=1_000_000,
+    task_points=None,
     client=None,
 ):
     """Multilevel B-spline approximation ``z = f(x, y)`` on the current Dask client.
 
     The keywords are ``scanfit.mba``'s (``levels``, ``base``, ``tolerance``,
-    ``hjelle``, ``start``); ``adjust=True`` is refused (the projection adjustment
-    finds the nearest points of the whole cloud per knot; ``alpha``, ``weight``
-    and ``adjust_steps`` belong to it), and so is ``start="fitted"`` (it runs the
-    constant through the levels beside the heights, in memory only).
+    ``hjelle``, ``start``: ``"fitted"``, the default, or ``"mean"``; ``up``);
+    ``adjust=True`` is refused (the projection adjustment finds the nearest points
+    of the whole cloud per knot; ``alpha``, ``weight`` and ``adjust_steps`` belong
+    to it).
 
     Parameters:
         points: a Dask array ``(N, 3)`` chunked by rows, or a list of point files.
-        domain: ``(x0, y0, x1, y1)`` in data units: the rectangle the lattice
+        up: the height axis, as ``scanfit.mba``'s: ``"x"``, ``"y"``, ``"z"``, or
+            ``"auto"`` (the default: the thin axis of a sheet, else z), decided as
+            ``scanfit mba --chunk-points`` decides it, from an evenly spaced
+            sample of at most 2^16 points of the bounding-box pass (every
+            ``2^k``-th point of each chunk or tile). The fit runs in that axis's
+            z-up frame (y up: ``y = f(x, -z)``; x up: ``x = f(y, z)``) and the
+            surface is turned back, as ``scanfit.mba`` does.
+        domain: ``(x0, y0, x1, y1)`` in data units (the horizontal coordinates
+            of the up frame: x, y when z is up): the rectangle the lattice
             covers (points outside are clamped to its border), instead of a first
             pass for the data's bounding box. Tiles of one survey then share it
             whatever each holds. Without it the result equals ``scanfit.mba``'s.
+            With ``up="auto"`` the pass still runs, for the sample.
+        chunk_points: rows a task reads from a tile at a time: a worker's memory
+            is bounded by it (about 50 bytes per row), not by the tile's size.
+        task_points: split tiles of more rows into tasks of at most this many
+            rows (from the bounding-box pass's counts, which then always runs),
+            so one big tile is summed by several workers. The readers cannot
+            seek, so a task reads and drops the rows before its own: a tile in
+            ``k`` tasks costs about ``(k + 1) / 2`` reads of it per pass.
         client: a ``distributed.Client`` (default: the current one).
 
-    Passes over the points: bounding box (unless ``domain``), frame, one per
-    level, one to measure the final vertical residuals.
+    Passes over the points: bounding box (unless ``domain`` with an ``up``
+    axis given and tiles not split), frame, one per level, with the fitted
+    start one for the last level's start, one to measure the final vertical
+    residuals.
 
-    Returns a dict: ``surface`` (a ``Surface``), ``cells``, ``levels`` (per level:
+    Returns a dict: ``surface`` (a ``Surface``), ``up`` (the axis used),
+    ``tasks`` (tasks per pass), ``cells``, ``levels`` (per level:
     ``level``, ``control_points``, ``vertical`` statistics of ``|z - f|`` after
     it, ``seconds``), ``vertical`` (the final statistics: ``count``, ``mean``,
     ``max``, ``max_index``, ``rmse``), ``points``, ``passes``, ``seconds`` and
@@ -321,44 +510,47 @@ def mba(
             "adjust=True projects the knot grid onto the whole cloud (nearest points along z) "
             "and needs all points at once; leave it out on Dask (scanfit.mba has it)"
         )
-    if start != "mean":
-        if start != "fitted":
-            raise ScanfitError(f"start must be 'mean' or 'fitted'; got {start!r}")
-        raise ScanfitError(
-            "start='fitted' runs the constant 1 through the levels beside the heights in memory "
-            "(scanfit.mba has it); on Dask the level loop starts from the mean: leave start out"
-        )
+    start = _mba_start(start)
     del alpha, weight, adjust_steps  # the adjustment's settings
     t0 = time.perf_counter()
+    _check_up(up)
+    _check_reading(chunk_points, task_points)
     client = _client(client)
-    parts = _parts(points, None, None)
-    centring, _, _ = _centring(client, parts, domain)
-    frame = _pass(client, parts, _frame, centring)
+    parts = _parts(points, None, None, chunk_points)
+    parts, up, box, passes = _mba_survey(client, parts, domain, up, task_points)
+    centring = _centring(box, domain, up)
+    frame = _pass(client, parts, _frame, centring, up)
     run = MbaLevels(
-        frame, centring, levels=levels, base=base, tolerance=tolerance, hjelle=hjelle, domain=domain
+        frame,
+        centring,
+        levels=levels,
+        base=base,
+        tolerance=tolerance,
+        hjelle=hjelle,
+        domain=domain,
+        start=start,
     )
-    passes = (1 if domain is None else 0) + 1
+    passes += 1
     sent = []
-    recorded = True
     while not run.done:
         state = run.state()
         sent.append(len(state.to_bytes()))
         shared = _shared(state)
-        acc, stats = _pass(client, parts, _level, shared)
+        acc, sums = _pass(client, parts, _level, shared, up)
         passes += 1
-        if state.levels > 0:
-            recorded = True
-            if run.record_residual(stats):
-                break
+        if run.record(sums):
+            break
         run.push(acc)
-        recorded = False
+    passes += _last_start(client, parts, run, up)
     state = run.state()
     shared = _shared(state)
-    vertical = _pass(client, parts, _vertical, shared)
+    vertical = _pass(client, parts, _vertical, shared, up)
     passes += 1
-    if not recorded:
-        run.record_residual(vertical)
+    run.record_last(vertical)
     r = run.finish()
+    r["surface"] = _surface_from_frame(r["surface"], up)
+    r["up"] = up
+    r["tasks"] = len(parts)
     r["vertical"] = vertical.stats()
     r["points"] = vertical.count
     r["passes"] = passes
@@ -378,6 +570,8 @@ def fit_surface(
     periodic_u=False,
     correct=0,
     *,
+    chunk_points=1_000_000,
+    task_points=None,
     client=None,
 ):
     """Least-squares B-spline surface on the current Dask client.
@@ -398,7 +592,12 @@ def fit_surface(
     surfaces of the ``r`` accepted rounds before, in turn (no parameter is
     stored between passes), so its passes cost ``r`` projections per point.
 
+    ``chunk_points`` and ``task_points`` are ``scanfit.dask.mba``'s: the rows
+    a task reads from a tile at a time, and the most rows of a tile one task
+    sums (bigger tiles are split into several tasks).
+
     Returns a dict: ``surface``, ``smoothing`` (the weight used), ``points``,
+    ``tasks`` (tasks per pass),
     ``errors`` (statistics of ``|p - S(u, v)|`` at the final parameters:
     ``count``, ``mean``, ``max``, ``max_index``, ``rmse``), ``rounds`` (per
     fit: ``round``, ``rmse``, ``max``; as ``scanfit.fit_surface``'s, empty
@@ -417,8 +616,11 @@ def fit_surface(
     # the keywords checked before any pass (the count only sizes the net)
     FitSetup(1 << 20, Centring((0, 0, 0), (1, 1, 1)), ctrl, degree, given, knots, smooth,
              periodic_u, correct)
-    parts = _parts(points, uv, given)
-    centring, count, first = _centring(client, parts, None)
+    _check_reading(chunk_points, task_points)
+    parts = _parts(points, uv, given, chunk_points)
+    box, counts = _survey(client, parts)
+    parts = _split(parts, counts, task_points)
+    centring, count, first = _centring(box, None), box[2], box[3]
     setup = FitSetup(count, centring, ctrl, degree, given, knots, smooth, periodic_u, correct)
     passes = 1
     if setup.plane:
@@ -473,6 +675,7 @@ def fit_surface(
         "errors": errors.stats(),
         "rounds": rounds,
         "passes": passes,
+        "tasks": len(parts),
         "seconds": time.perf_counter() - t0,
         "equation_bytes": eq.nbytes,
     }

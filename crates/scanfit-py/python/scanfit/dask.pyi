@@ -8,6 +8,7 @@ Pair = Union[int, Tuple[int, int]]
 PointsArg = Union[Any, Sequence[Union[str, PathLike]]]
 
 FAN_IN: int
+UP_SAMPLE: int
 
 def mba(
     points: PointsArg,
@@ -19,15 +20,18 @@ def mba(
     alpha: float = 1.49,
     weight: Literal["moon", "aza04", "as05", "axis4"] = "moon",
     adjust_steps: int = 5,
-    start: Literal["mean", "fitted"] = "mean",
+    start: Optional[Literal["fitted", "mean"]] = None,
+    up: Literal["auto", "x", "y", "z"] = "auto",
     *,
     domain: Optional[Tuple[float, float, float, float]] = None,
+    chunk_points: int = 1_000_000,
+    task_points: Optional[int] = None,
     client: Optional[Any] = None,
 ) -> dict[str, Any]:
     """scanfit.mba's surface, computed by the workers' partial sums.
 
-    Returns ``surface``, ``cells``, ``levels``, ``vertical``, ``points``,
-    ``passes``, ``seconds``, ``broadcast_bytes``.
+    Returns ``surface``, ``up``, ``tasks``, ``cells``, ``levels``, ``vertical``,
+    ``points``, ``passes``, ``seconds``, ``broadcast_bytes``.
     """
 
 def fit_surface(
@@ -41,10 +45,12 @@ def fit_surface(
     periodic_u: bool = False,
     correct: int = 0,
     *,
+    chunk_points: int = 1_000_000,
+    task_points: Optional[int] = None,
     client: Optional[Any] = None,
 ) -> dict[str, Any]:
     """scanfit.fit_surface's surface, computed by the workers' partial sums.
 
-    Returns ``surface``, ``smoothing``, ``points``, ``errors``, ``rounds``,
-    ``passes``, ``seconds``, ``equation_bytes``.
+    Returns ``surface``, ``smoothing``, ``points``, ``tasks``, ``errors``,
+    ``rounds``, ``passes``, ``seconds``, ``equation_bytes``.
     """

@@ -12,11 +12,15 @@ additions (about 1e-15 relative).
   to (the bounding box's centre where it is far from the origin).
 - ``FrameSums``: the MBA frame (bounding box in x, y; mean height).
 - ``MbaLevels(frame, centring, levels=6, base=None, tolerance=None, hjelle=False,
-  domain=None)``: the level loop on the client; ``state()`` is broadcast per level
-  (``MbaState``), ``accumulator()`` gives the level's empty ``BaSums``,
-  ``push(sums)`` finishes the level, ``finish()`` the surface.
-- ``BaSums``: one level's sums; ``add(state, points)`` returns the residual
-  statistics of the level before (``ResidualSums``).
+  domain=None, start="fitted")``: the level loop on the client; ``state()`` is
+  broadcast per level (``MbaState``), ``accumulator()`` gives the level's empty
+  ``BaSums``, ``record(pass_sums)`` takes what the pass measured (and says whether
+  the tolerance is met), ``push(sums)`` finishes the level; with the fitted start
+  one more pass of ``MbaState.pass_sums`` while ``needs_pass``; ``finish()`` the
+  surface.
+- ``BaSums``: one level's sums (the heights' and, for the fitted start, the
+  constant 1's values); ``add(state, points)`` returns the pass's ``PassSums``
+  (the residual statistics of a level before, the fitted start's sums).
 - ``FitSetup(count, centring, ...)``: ``fit_surface``'s keywords resolved for
   ``count`` points; ``knot_search()`` (``KnotSearch``: the exact order statistics
   behind the distribution knots, NURBS Book eq. 9.69, in rounds of ``RankQuery``
@@ -38,9 +42,11 @@ Example (two "workers" by hand)::
     >>> run = S.MbaLevels(f, c, levels=4)
     >>> while not run.done:
     ...     state, a, b = run.state(), run.accumulator(), run.accumulator()
-    ...     _ = a.add(state, pts[:7000]); _ = b.add(state, pts[7000:])
+    ...     s = a.add(state, pts[:7000]); s.merge(b.add(state, pts[7000:]))
     ...     a.merge(S.BaSums.from_bytes(b.to_bytes()))
-    ...     run.push(a)
+    ...     _ = run.record(s); run.push(a)
+    >>> while run.needs_pass:
+    ...     _ = run.record(run.state().pass_sums(pts))
     >>> run.finish()["cells"]
     (8, 8)
 """
@@ -55,6 +61,7 @@ from ._scanfit import (
     MbaState,
     NormalEquations,
     Parameterization,
+    PassSums,
     PlanePasses,
     PlaneStage,
     PlaneSums,
@@ -74,6 +81,7 @@ __all__ = [
     "MbaState",
     "NormalEquations",
     "Parameterization",
+    "PassSums",
     "PlanePasses",
     "PlaneStage",
     "PlaneSums",
@@ -90,6 +98,7 @@ _KINDS = {
     "MbaState": MbaState,
     "NormalEquations": NormalEquations,
     "Parameterization": Parameterization,
+    "PassSums": PassSums,
     "PlaneStage": PlaneStage,
     "PlaneSums": PlaneSums,
     "RankCounts": RankCounts,

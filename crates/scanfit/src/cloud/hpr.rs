@@ -10,6 +10,9 @@
 //!    `p' = p + 2 (R - |p|) p / |p|` (Katz et al. eq. 1).
 //! 2. *Convex hull*: a point is marked visible when its flipped image is a
 //!    vertex of the convex hull of the flipped points together with `C`.
+//!    From 50 000 points on, the flipped points certainly inside the hull of
+//!    a sample are dropped first (exact predicates, `hpr_filter`): the hull
+//!    of the rest has the same vertices, at a fraction of the cost.
 //!
 //! The radius follows the authors' reference implementation,
 //! `R = max|p - C| * 10^gamma`: the larger `gamma`, the more points near
@@ -34,6 +37,7 @@
 
 use std::collections::HashSet;
 
+use super::hpr_filter::{hull_candidates, MIN_POINTS};
 use super::hull::hull_of_coordinates;
 use crate::{validate_points, Error, Point3, Result};
 
@@ -76,6 +80,18 @@ pub fn hidden_point_removal(
     viewpoint: &Point3,
     config: &HprConfig,
 ) -> Result<Vec<usize>> {
+    hpr_filtered_above(points, viewpoint, config, MIN_POINTS)
+}
+
+/// [`hidden_point_removal`] with the interior filter
+/// ([`super::hpr_filter`]) applied from `min_filtered` points on
+/// (`usize::MAX`: never, the plain hull of all flipped points).
+pub(crate) fn hpr_filtered_above(
+    points: &[Point3],
+    viewpoint: &Point3,
+    config: &HprConfig,
+    min_filtered: usize,
+) -> Result<Vec<usize>> {
     validate_points(points)?;
     validate_points(std::slice::from_ref(viewpoint)).map_err(|e| {
         Error::InvalidInput(format!("hidden point removal: invalid viewpoint: {e}"))
@@ -111,14 +127,37 @@ pub fn hidden_point_removal(
         let v = (p - viewpoint) * (2.0 * radius / d - 1.0);
         [v.x, v.y, v.z]
     }));
-    flipped.push([0.0; 3]);
     drop(norms);
     // the points and the viewpoint are finite (checked above), so are the
-    // flipped points (|p'| < 2R)
-    let hull = hull_of_coordinates(flipped)
-        .map_err(|e| Error::InvalidInput(format!("hidden point removal: {e}")))?;
+    // flipped points (|p'| < 2R); scaled by a power of two (exact) so that
+    // the orientation predicates' products cannot overflow
+    let max_abs = flipped.iter().flatten().fold(0.0f64, |m, c| m.max(c.abs()));
+    if max_abs > 0.0 {
+        let scale = 2f64.powi(-(max_abs.log2().ceil() as i32));
+        flipped.iter_mut().for_each(|q| *q = q.map(|c| c * scale));
+    }
     let n = points.len();
-    let mut visible: Vec<usize> = hull.vertices.into_iter().filter(|&i| i < n).collect();
+    let hull_error = |e: Error| Error::InvalidInput(format!("hidden point removal: {e}"));
+    let mut visible: Vec<usize> = match hull_candidates(&flipped, min_filtered) {
+        // the hull of the points not certainly inside (with the viewpoint,
+        // last) has the same vertices as the hull of all
+        Some(keep) => {
+            let mut sub: Vec<[f64; 3]> = keep.iter().map(|&i| flipped[i as usize]).collect();
+            drop(flipped);
+            sub.push([0.0; 3]);
+            let hull = hull_of_coordinates(sub).map_err(hull_error)?;
+            hull.vertices
+                .into_iter()
+                .filter(|&i| i < keep.len())
+                .map(|i| keep[i] as usize)
+                .collect()
+        }
+        None => {
+            flipped.push([0.0; 3]);
+            let hull = hull_of_coordinates(flipped).map_err(hull_error)?;
+            hull.vertices.into_iter().filter(|&i| i < n).collect()
+        }
+    };
     // the hull keeps one of several identical points: the others are visible too
     let key = |p: &Point3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
     let seen: HashSet<[u64; 3]> = visible.iter().map(|&i| key(&points[i])).collect();
@@ -267,6 +306,59 @@ mod tests {
             "{exp_vis} of {}",
             exp.len()
         );
+    }
+
+    /// A bumpy, noisy closed surface: `r(d) = 1 + 0.15 sin(5x) cos(4y) + 0.1 z^2`.
+    fn bumpy_blob(n: usize, seed: u64) -> Vec<Point3> {
+        let mut rng = Rng::new(seed);
+        (0..n)
+            .map(|_| {
+                let d = rng.unit_vector();
+                let r = 1.0 + 0.15 * (5.0 * d.x).sin() * (4.0 * d.y).cos() + 0.1 * d.z * d.z;
+                Point3::from(d * (r + 2e-3 * (rng.uniform() - 0.5)))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_interior_filter_keeps_the_visible_set_exactly() {
+        // the filtered hull against the plain hull of all flipped points
+        let clouds = [sphere(30_000, 21), bumpy_blob(40_000, 22)];
+        let eyes = [
+            Point3::new(0.0, 0.0, 3.0),
+            Point3::new(2.5, -1.0, 0.7),
+            Point3::new(0.3, 4.0, -6.0),
+            Point3::new(0.0, 1.3, 0.0),
+            // inside the cloud: the directions fill the sphere, no filter
+            Point3::new(0.1, 0.0, 0.05),
+        ];
+        for (c, p) in clouds.iter().enumerate() {
+            for eye in &eyes {
+                for gamma in [0.5, 2.0, 4.0] {
+                    let cfg = HprConfig { gamma };
+                    let plain = hpr_filtered_above(p, eye, &cfg, usize::MAX).unwrap();
+                    let filtered = hpr_filtered_above(p, eye, &cfg, 0).unwrap();
+                    assert_eq!(plain, filtered, "cloud {c}, eye {eye}, gamma {gamma}");
+                }
+            }
+        }
+        // the box's face grids (many coplanar and collinear points before flipping)
+        let mut p = Vec::new();
+        for i in 0..=120 {
+            for j in 0..=120 {
+                let (s, t) = (i as f64 / 120.0, j as f64 / 120.0);
+                p.push(Point3::new(2.0 * s, t, 0.0));
+                p.push(Point3::new(2.0 * s, t, 1.0));
+                p.push(Point3::new(2.0 * s, 0.0, t));
+                p.push(Point3::new(0.0, s, t));
+            }
+        }
+        for eye in [Point3::new(1.0, 0.5, 5.0), Point3::new(6.0, 5.0, 5.0)] {
+            let cfg = HprConfig::default();
+            let plain = hpr_filtered_above(&p, &eye, &cfg, usize::MAX).unwrap();
+            let filtered = hpr_filtered_above(&p, &eye, &cfg, 0).unwrap();
+            assert_eq!(plain, filtered, "box grid, eye {eye}");
+        }
     }
 
     #[test]

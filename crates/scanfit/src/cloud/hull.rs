@@ -110,7 +110,7 @@ struct Hull<'a> {
     next: Vec<u32>,
 }
 
-fn c3(p: &[f64; 3]) -> Coord3D<f64> {
+pub(super) fn c3(p: &[f64; 3]) -> Coord3D<f64> {
     Coord3D {
         x: p[0],
         y: p[1],
@@ -122,7 +122,7 @@ fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
-fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+pub(super) fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -130,7 +130,7 @@ fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
     ]
 }
 
-fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+pub(super) fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 

@@ -27,6 +27,7 @@ pub mod clean;
 pub mod corners;
 pub(crate) mod forest;
 pub mod hpr;
+mod hpr_filter;
 pub mod hull;
 pub mod neighbours;
 pub mod normals;

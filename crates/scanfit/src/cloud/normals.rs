@@ -107,22 +107,23 @@ pub struct Normals {
 }
 
 /// Estimates oriented normals of `cloud` (see the module documentation).
+///
+/// The neighbour search and the PCA run in one pass over the KD-tree's
+/// order ([`crate::spatial::KdTree::graph_in_tree_order`]): each
+/// neighbourhood's covariance is summed while its points are in the cache.
+/// The neighbours and the sums are those of [`estimate_normals_on`] over
+/// `cloud.knn_graph(k)`, so the normals are the same bit for bit.
 pub fn estimate_normals(cloud: &PointCloud, config: &NormalsConfig) -> Result<Normals> {
-    if config.k < 2 {
-        return Err(Error::InvalidInput(format!(
-            "normals need k >= 2 neighbours (got {}); 16 is a good default",
-            config.k
-        )));
-    }
-    if cloud.len() < 3 {
-        return Err(Error::TooFewPoints {
-            got: cloud.len(),
-            needed: 3,
-            what: "normal estimation".into(),
-        });
-    }
-    let graph = cloud.knn_graph_indices(config.k)?;
-    estimate_normals_on(cloud, &graph, config)
+    check(cloud, config)?;
+    let tree = cloud.tree()?;
+    let pts = tree.points_in_order();
+    let flat_below = flat_below(cloud);
+    let (rows, per_point) = tree.graph_in_tree_order(config.k, |t, row| {
+        let hood = std::iter::once(t).chain(row.iter().map(|&s| s as usize));
+        pca_normal(hood.map(|s| Vector3::from(pts[s])), flat_below)
+    });
+    let k = rows.len() / cloud.len();
+    finish(cloud, per_point, Rows::Tree { rows, k }, config)
 }
 
 /// [`estimate_normals`] over a neighbour graph already built
@@ -152,122 +153,292 @@ pub fn estimate_normals_on(
             got: graph.len(),
         });
     }
-    let points = cloud.points();
-    let n = points.len();
-    let scale = cloud.diagonal();
+    check_hint(config)?;
+    let n = cloud.len();
     // the work runs in the tree's order on the tree's copy of the points: a
     // point's neighbours lie close to it there (in the input they may lie
     // anywhere), and `at` (4 bytes a point) maps an input index to its place
     let tree = cloud.tree()?;
     let order = tree.spatial_order();
     let pts = tree.points_in_order();
-    let mut at = vec![0u32; n];
-    for (t, &i) in order.iter().enumerate() {
-        at[i as usize] = t as u32;
-    }
-    let coords = |t: usize| Vector3::from(pts[t]);
-    let flat_below = 1e-24 * scale * scale;
-    let per_point: Vec<(Vector3, f64, bool)> = (0..n)
+    let at = positions(order);
+    let flat_below = flat_below(cloud);
+    let per_point: Vec<PerPoint> = (0..n)
         .into_par_iter()
         .with_min_len(1024)
         .map(|t| {
             let nb = graph.indices_of(order[t] as usize);
-            let hood = std::iter::once(coords(t))
-                .chain(nb.iter().map(|&j| coords(at[j as usize] as usize)));
-            let Some((centroid, cov)) = covariance(hood) else {
-                return (Vector3::z(), 0.0, true);
-            };
-            // the closed form where the smallest eigenvalue stands apart
-            // (nearly every neighbourhood of a surface), else the iterative solver
-            if let Some(e) = smallest_eigen(&cov).filter(|e| e.values[1] > flat_below) {
-                return (e.vector, surface_variation(&e.values), false);
-            }
-            let p = pca_of(centroid, &cov);
-            let flat = p.values[1] <= flat_below;
-            let n = if flat {
-                // collinear neighbourhood: any perpendicular of the line
-                p.axes[0].cross(&least_aligned_axis(&p.axes[0])).normalize()
-            } else {
-                p.axes[2]
-            };
-            (n, p.variation(), flat)
+            let hood = std::iter::once(t).chain(nb.iter().map(|&j| at[j as usize] as usize));
+            pca_normal(hood.map(|s| Vector3::from(pts[s])), flat_below)
         })
         .collect();
-    // back to the input order
-    let mut normals = vec![Vector3::zeros(); n];
-    let mut variation = vec![0.0; n];
-    let mut flat = vec![false; n];
-    for (&i, r) in order.iter().zip(&per_point) {
-        let i = i as usize;
-        (normals[i], variation[i], flat[i]) = *r;
+    finish(cloud, per_point, Rows::Input { graph, at }, config)
+}
+
+/// The settings and the cloud checked before any work.
+fn check(cloud: &PointCloud, config: &NormalsConfig) -> Result<()> {
+    if config.k < 2 {
+        return Err(Error::InvalidInput(format!(
+            "normals need k >= 2 neighbours (got {}); 16 is a good default",
+            config.k
+        )));
     }
-    drop(per_point);
-    let degenerate = (0..n).filter(|&i| flat[i]).collect();
-    let mut components = 0;
+    if cloud.len() < 3 {
+        return Err(Error::TooFewPoints {
+            got: cloud.len(),
+            needed: 3,
+            what: "normal estimation".into(),
+        });
+    }
+    check_hint(config)
+}
+
+fn check_hint(config: &NormalsConfig) -> Result<()> {
+    match config.orientation {
+        Orientation::SpanningTree { hint }
+            if !(hint.iter().all(|c| c.is_finite()) && hint.norm() > 0.0) =>
+        {
+            Err(Error::InvalidInput(
+                "the orientation hint must be a finite non-zero vector".into(),
+            ))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// The second smallest eigenvalue at or below which a neighbourhood spans
+/// no plane (relative to the cloud's size).
+fn flat_below(cloud: &PointCloud) -> f64 {
+    let scale = cloud.diagonal();
+    1e-24 * scale * scale
+}
+
+/// What the PCA gives one point.
+#[derive(Debug, Clone, Copy)]
+struct PerPoint {
+    normal: Vector3,
+    variation: f64,
+    /// No plane: the neighbourhood is collinear or coincident.
+    flat: bool,
+}
+
+impl Default for PerPoint {
+    fn default() -> Self {
+        Self {
+            normal: Vector3::z(),
+            variation: 0.0,
+            flat: true,
+        }
+    }
+}
+
+/// The PCA normal of one neighbourhood (the point first, then its
+/// neighbours): the closed form of [`crate::eigen3`] where the smallest
+/// eigenvalue stands apart (nearly every neighbourhood of a surface), else
+/// the iterative solver; a collinear neighbourhood gets a perpendicular of
+/// its line and is marked flat.
+fn pca_normal(hood: impl Iterator<Item = Vector3>, flat_below: f64) -> PerPoint {
+    let Some((centroid, cov)) = covariance(hood) else {
+        return PerPoint::default();
+    };
+    if let Some(e) = smallest_eigen(&cov).filter(|e| e.values[1] > flat_below) {
+        return PerPoint {
+            normal: e.vector,
+            variation: surface_variation(&e.values),
+            flat: false,
+        };
+    }
+    let p = pca_of(centroid, &cov);
+    let flat = p.values[1] <= flat_below;
+    let normal = if flat {
+        // collinear neighbourhood: any perpendicular of the line
+        p.axes[0].cross(&least_aligned_axis(&p.axes[0])).normalize()
+    } else {
+        p.axes[2]
+    };
+    PerPoint {
+        normal,
+        variation: p.variation(),
+        flat,
+    }
+}
+
+/// The neighbour graph the normals were estimated over.
+enum Rows<'a> {
+    /// `k` tree positions per tree position
+    /// ([`crate::spatial::KdTree::graph_in_tree_order`]).
+    Tree { rows: Vec<u32>, k: usize },
+    /// A graph in input order, and the tree position of each input index.
+    Input {
+        graph: &'a Neighbourhoods,
+        at: Vec<u32>,
+    },
+}
+
+/// Orients the normals in the tree's order (`per_point`), counts the
+/// components, measures the disagreement and returns it all in input order.
+fn finish(
+    cloud: &PointCloud,
+    mut per_point: Vec<PerPoint>,
+    rows: Rows<'_>,
+    config: &NormalsConfig,
+) -> Result<Normals> {
+    let tree = cloud.tree()?;
+    let order = tree.spatial_order();
+    let pts = tree.points_in_order();
     match config.orientation {
         Orientation::None => {}
         Orientation::Viewpoint(v) => {
-            for (n, p) in normals.iter_mut().zip(points) {
-                if n.dot(&(v - p)) < 0.0 {
-                    *n = -*n;
+            // the tree's copy of the points is the input's, bit for bit
+            per_point.par_iter_mut().zip(pts).for_each(|(r, p)| {
+                if r.normal.dot(&(v - Point3::from(*p))) < 0.0 {
+                    r.normal = -r.normal;
                 }
-            }
+            });
         }
         Orientation::SpanningTree { hint } => {
-            if !(hint.iter().all(|c| c.is_finite()) && hint.norm() > 0.0) {
-                return Err(Error::InvalidInput(
-                    "the orientation hint must be a finite non-zero vector".into(),
-                ));
-            }
-            let adj = Adjacency::of(graph);
-            components = orient_by_spanning_tree(points, &adj, &mut normals, &hint);
+            return finish_spanning_tree(cloud, per_point, rows, &hint);
         }
     }
-    if components == 0 {
-        components = count_components(graph);
-    }
-    let disagreement = match config.orientation {
-        Orientation::None => None,
-        _ => {
-            let in_order: Vec<Vector3> = order.iter().map(|&i| normals[i as usize]).collect();
-            disagreement(pts, &at, graph, &in_order, order)
+    let (flat_rows, k) = match &rows {
+        Rows::Tree { rows, k } => (&rows[..], *k),
+        Rows::Input { graph, .. } => (&graph.indices[..], graph.k),
+    };
+    let components = count_components(flat_rows, k, cloud.len());
+    let normal = |t: usize| per_point[t].normal;
+    let disagreement = match (config.orientation, &rows) {
+        (Orientation::None, _) => None,
+        (_, Rows::Tree { rows, k }) => disagreement(pts, normal, |t| {
+            rows[t * k..(t + 1) * k].iter().map(|&s| s as usize)
+        }),
+        (_, Rows::Input { graph, at }) => disagreement(pts, normal, |t| {
+            let nb = graph.indices_of(order[t] as usize);
+            nb.iter().map(|&j| at[j as usize] as usize)
+        }),
+    };
+    drop(rows);
+    let parts = into_input_order(&per_point, order);
+    Ok(Normals::from_parts(parts, components, disagreement))
+}
+
+/// [`finish`] with the spanning-tree orientation: Prim's tree runs in input
+/// order (its ties by input index) over the graph in input order, on the
+/// normals already in input order (the tree-order results are dropped
+/// before the adjacency, the largest thing the normals hold, is built).
+fn finish_spanning_tree(
+    cloud: &PointCloud,
+    per_point: Vec<PerPoint>,
+    rows: Rows<'_>,
+    hint: &Vector3,
+) -> Result<Normals> {
+    let tree = cloud.tree()?;
+    let order = tree.spatial_order();
+    let built: Neighbourhoods;
+    let (graph, at) = match rows {
+        Rows::Input { graph, at } => (graph, at),
+        Rows::Tree { rows, k } => {
+            built = input_graph(&rows, k, order);
+            drop(rows);
+            (&built, positions(order))
         }
     };
-    Ok(Normals {
-        normals,
-        variation,
-        degenerate,
-        components,
-        disagreement,
-    })
+    let (mut normals, variation, degenerate) = into_input_order(&per_point, order);
+    drop(per_point);
+    let adj = Adjacency::of(graph);
+    let components = orient_by_spanning_tree(cloud.points(), &adj, &mut normals, hint);
+    drop(adj);
+    let normal = |t: usize| normals[order[t] as usize];
+    let disagreement = disagreement(tree.points_in_order(), normal, |t| {
+        let nb = graph.indices_of(order[t] as usize);
+        nb.iter().map(|&j| at[j as usize] as usize)
+    });
+    let parts = (normals, variation, degenerate);
+    Ok(Normals::from_parts(parts, components, disagreement))
+}
+
+/// Normals, variations and degenerate points (ascending), in input order.
+type Parts = (Vec<Vector3>, Vec<f64>, Vec<usize>);
+
+impl Normals {
+    fn from_parts(parts: Parts, components: usize, disagreement: Option<f64>) -> Self {
+        let (normals, variation, degenerate) = parts;
+        Self {
+            normals,
+            variation,
+            degenerate,
+            components,
+            disagreement,
+        }
+    }
+}
+
+/// The [`Parts`] of the results in the tree's order.
+fn into_input_order(per_point: &[PerPoint], order: &[u32]) -> Parts {
+    let n = per_point.len();
+    let mut normals = vec![Vector3::zeros(); n];
+    let mut variation = vec![0.0; n];
+    let mut degenerate = Vec::new();
+    for (&i, r) in order.iter().zip(per_point) {
+        normals[i as usize] = r.normal;
+        variation[i as usize] = r.variation;
+        if r.flat {
+            degenerate.push(i as usize);
+        }
+    }
+    degenerate.sort_unstable();
+    (normals, variation, degenerate)
+}
+
+/// The tree position of each input index (`order` inverted).
+fn positions(order: &[u32]) -> Vec<u32> {
+    let mut at = vec![0u32; order.len()];
+    for (t, &i) in order.iter().enumerate() {
+        at[i as usize] = t as u32;
+    }
+    at
+}
+
+/// The rows of [`Rows::Tree`] as a graph in input order (what
+/// `knn_graph_indices(k)` gives).
+fn input_graph(rows: &[u32], k: usize, order: &[u32]) -> Neighbourhoods {
+    let mut indices = vec![0u32; rows.len()];
+    for (t, row) in rows.chunks_exact(k).enumerate() {
+        let i = order[t] as usize;
+        for (x, &s) in indices[i * k..(i + 1) * k].iter_mut().zip(row) {
+            *x = order[s as usize];
+        }
+    }
+    Neighbourhoods {
+        k,
+        indices,
+        distances: Vec::new(),
+    }
 }
 
 /// The share of same-sheet neighbour pairs whose normals disagree (see
-/// [`Normals::disagreement`]), over the points and normals in the tree's
-/// order (`pts[t]`, `normals[t]` of the input point `order[t]`; `at` maps
-/// an input index to its place).
-fn disagreement(
-    pts: &[[f64; 3]],
-    at: &[u32],
-    graph: &super::neighbours::Neighbourhoods,
-    normals: &[Vector3],
-    order: &[u32],
-) -> Option<f64> {
+/// [`Normals::disagreement`]), over the points in the tree's order
+/// (`pts[t]`), `normal(t)` the normal of the point at tree position `t` and
+/// `neighbours(t)` the tree positions of its neighbours.
+fn disagreement<I, N, F>(pts: &[[f64; 3]], normal: N, neighbours: F) -> Option<f64>
+where
+    I: Iterator<Item = usize>,
+    N: Fn(usize) -> Vector3 + Sync,
+    F: Fn(usize) -> I + Sync,
+{
     let (pairs, bad) = (0..pts.len())
         .into_par_iter()
         .with_min_len(1024)
         .map(|t| {
             let (mut pairs, mut bad) = (0usize, 0usize);
             let p = Vector3::from(pts[t]);
-            for &j in graph.indices_of(order[t] as usize) {
-                let s = at[j as usize] as usize;
+            for s in neighbours(t) {
                 let d = Vector3::from(pts[s]) - p;
                 let len = d.norm();
                 if len == 0.0 {
                     continue;
                 }
                 let d = d / len;
-                let (a, b) = (normals[t], normals[s]);
+                let (a, b) = (normal(t), normal(s));
                 if a.dot(&d).abs() < 0.5 && b.dot(&d).abs() < 0.5 && a.dot(&b).abs() > 0.5 {
                     pairs += 1;
                     bad += usize::from(a.dot(&b) < 0.0);
@@ -318,14 +489,14 @@ impl Adjacency {
     }
 }
 
-/// Connected components of the (undirected) neighbour graph, by union-find
-/// over its edges (no adjacency lists needed).
-fn count_components(graph: &Neighbourhoods) -> usize {
-    let n = graph.len();
+/// Connected components of the (undirected) neighbour graph given as `k`
+/// neighbours per point for `n` points (in any numbering: the count does not
+/// depend on it), by union-find over its edges (no adjacency lists needed).
+fn count_components(rows: &[u32], k: usize, n: usize) -> usize {
     let mut forest = Forest::new(n);
     let mut count = n;
-    for i in 0..n {
-        for &j in graph.indices_of(i) {
+    for (i, row) in rows.chunks_exact(k).enumerate() {
+        for &j in row {
             count -= usize::from(forest.join(i as u32, j));
         }
     }
@@ -548,6 +719,45 @@ mod tests {
             let dis = r.disagreement.unwrap();
             assert!(share > 0.99, "neck {neck} k {k}: {share}");
             assert!(dis < 0.01, "neck {neck} k {k}: {dis}");
+        }
+    }
+
+    /// The one pass (neighbours and PCA together in the tree's order) gives
+    /// what the graph built first and then summed over gives
+    /// (`knn_graph_indices` + [`estimate_normals_on`], the path before the
+    /// one pass), bit for bit, for each orientation: on a noisy bent sheet
+    /// given in random order, a grid (tied distances everywhere, collinear
+    /// rows) and the bust (two components' worth of thin neck).
+    #[test]
+    fn one_pass_equals_the_graph_path_bit_for_bit() {
+        let mut rng = crate::testdata::Lcg::new(31);
+        let mut rnd = || rng.next_f64();
+        let sheet: Vec<Point3> = (0..6000)
+            .map(|_| {
+                let (u, v) = (rnd(), rnd());
+                let z = 0.3 * (3.0 * u).sin() * v + 1e-3 * rnd();
+                Point3::new(100.0 * u + 1e6, 70.0 * v - 5e5, 20.0 * z)
+            })
+            .collect();
+        let grid: Vec<Point3> = (0..1200)
+            .map(|i| Point3::new((i % 20) as f64, (i / 20 % 20) as f64, (i / 400) as f64))
+            .collect();
+        let orientations = [
+            Orientation::None,
+            Orientation::Viewpoint(Point3::new(50.0, 35.0, 1000.0)),
+            Orientation::SpanningTree {
+                hint: Vector3::new(0.1, 0.2, 1.0),
+            },
+        ];
+        for (pts, k) in [(sheet, 20), (grid, 8), (bust(0.05).0, 16)] {
+            let c = PointCloud::new(pts).unwrap();
+            let graph = c.knn_graph_indices(k).unwrap();
+            for orientation in orientations {
+                let cfg = NormalsConfig { k, orientation };
+                let one = estimate_normals(&c, &cfg).unwrap();
+                let two = estimate_normals_on(&c, &graph, &cfg).unwrap();
+                assert_eq!(one, two, "k {k}, {orientation:?}");
+            }
         }
     }
 

@@ -26,7 +26,7 @@ use crate::project::{project_directed_batch, DirectedConfig};
 use crate::{Error, Point3, Result, Vector3};
 
 use super::lattice::Lattice;
-use super::{Frame, Mba, MbaConfig, MbaLevels};
+use super::{Frame, Mba, MbaConfig, MbaLevels, Start};
 
 /// Settings of the projection adjustment.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -279,7 +279,8 @@ pub struct AdjustedMba {
     pub steps: Vec<AdjustStep>,
 }
 
-/// MBA with the projection adjustment ([MBA18] Fig. 3): at each level the
+/// MBA with the projection adjustment ([MBA18] Fig. 3), started from the
+/// mean whatever `config.start` says: at each level the
 /// combined lattice is adjusted; if the eq. 17 RMSE is at most
 /// `config.tolerance` the loop stops, otherwise the next level fits the
 /// residuals of the adjusted surface on a refined lattice.
@@ -294,11 +295,14 @@ pub fn mba_adjusted(
     let unit: Vec<[f64; 2]> = points.iter().map(|p| frame.unit(p)).collect();
     let mut residual: Vec<f64> = points.iter().map(|p| p.z - frame.z0).collect();
     // the level loop's own tolerance is on the vertical residual; here the
-    // paper's eq. 17 decides, after adjusting
+    // paper's eq. 17 decides, after adjusting; the adjustment changes the
+    // lattices between levels, so it starts from the mean (the constant's
+    // levels would no longer give the fitted start)
     let mut run = MbaLevels::new(
         frame,
         &MbaConfig {
             tolerance: None,
+            start: Start::Mean,
             ..*config
         },
     )?;

@@ -33,7 +33,7 @@ use std::ops::Range;
 use rayon::prelude::*;
 
 use super::lattice::{ControlFormula, Lattice};
-use super::sums::{ratio_lattice, ResidualSums, BA_BLOCK};
+use super::sums::{ratio_lattice, PassSums, ResidualSums, BA_BLOCK};
 use super::{Frame, Mba, MbaLevels};
 use crate::metrics::ErrorStats;
 use crate::{Error, Point3, Result};
@@ -266,14 +266,16 @@ impl Measured {
 
 /// The least-squares start `sum r c / sum c^2` and the RMSE it leaves.
 fn fitted(quad: [f64; 3], count: usize) -> (f64, f64) {
-    let [rr, rc, cc] = quad;
-    let delta = if cc > 0.0 { rc / cc } else { 0.0 };
-    let ss = (rr - 2.0 * delta * rc + delta * delta * cc).max(0.0);
-    (delta, (ss / count.max(1) as f64).sqrt())
+    let sums = PassSums {
+        count: count as u64,
+        quad,
+        ..Default::default()
+    };
+    (sums.start(), sums.start_rmse())
 }
 
-/// The level loop with the fitted start over `sorted` (see the module
-/// documentation); `run` is fresh.
+/// The level loop over `sorted` (see the module documentation); `run` is
+/// fresh.
 pub(super) fn level_loop(mut run: MbaLevels, mut sorted: Sorted) -> Result<Mba> {
     let count = sorted.unit.len();
     let mut ones: Vec<Lattice> = Vec::new();
@@ -322,49 +324,21 @@ pub(super) fn level_loop(mut run: MbaLevels, mut sorted: Sorted) -> Result<Mba> 
         let Some(t) = target else {
             break;
         };
-        ones.push(ratio_lattice(t.m, t.n, &m.num[1], &m.den));
-        run.push_lattice(ratio_lattice(t.m, t.n, &m.num[0], &m.den))?;
+        // the constant's level (zero for the mean start, whose loop keeps
+        // it here only)
+        let one = ratio_lattice(t.m, t.n, &m.num[1], &m.den);
+        ones.push(one.clone());
+        run.push_lattices(ratio_lattice(t.m, t.n, &m.num[0], &m.den), Some(one))?;
     }
-    let mut r = combine(run, &ones, &deltas, &rows)?;
-    super::fused::pass_seconds(&mut r, &seconds);
-    Ok(r)
-}
-
-/// The fit started from `z0 + delta` (the last level's delta) from the
-/// levels of the heights and of the constant: level `k` becomes
-/// `Z_k - delta C_k`, the start `delta` goes into level 0 (a constant
-/// lattice is the constant function), and the reports get the rows.
-fn combine(run: MbaLevels, ones: &[Lattice], deltas: &[f64], rows: &[ErrorStats]) -> Result<Mba> {
-    let delta = deltas.last().copied().unwrap_or(0.0);
-    let mut r = run.finish();
-    let kept = deltas.len().min(r.levels.len());
-    r.levels.truncate(kept);
-    r.reports.truncate(kept);
-    for (k, (z, c)) in r.levels.iter_mut().zip(ones).enumerate() {
-        for (a, b) in z.phi.iter_mut().zip(&c.phi) {
-            *a -= delta * b;
-        }
-        if k == 0 {
-            z.phi.iter_mut().for_each(|a| *a += delta);
-        }
-    }
-    let mut total: Option<Lattice> = None;
-    for l in &r.levels {
-        total = Some(match total {
-            None => l.clone(),
-            Some(t) => {
-                let mut t = t.refine()?;
-                t.add(l)?;
-                t
-            }
-        });
-    }
-    if let Some(t) = total {
-        r.lattice = t;
-    }
-    for (rep, stats) in r.reports.iter_mut().zip(rows) {
+    // the fitted start of the last level (`MbaLevels::finish` applies it)
+    // and the rows
+    run.deltas = deltas;
+    for (rep, stats) in run.reports.iter_mut().zip(&rows) {
         rep.residual = *stats;
     }
+    run.rows = rows.len();
+    let mut r = run.finish();
+    super::fused::pass_seconds(&mut r, &seconds);
     Ok(r)
 }
 

@@ -21,7 +21,7 @@ use crate::{Point3, Result};
 /// (see the module documentation).
 pub(crate) fn mba(points: &[Point3], config: &MbaConfig) -> Result<Mba> {
     let frame = frame(points)?;
-    let run = MbaLevels::in_memory(frame, config)?;
+    let run = MbaLevels::new(frame, config)?;
     let c = match config.start {
         Start::Mean => 0.0,
         Start::Fitted => 1.0,
@@ -87,7 +87,6 @@ mod tests {
     use super::*;
     use crate::mba::{ControlFormula, Lattice};
     use crate::testdata::{franke, scattered};
-    use crate::Error;
 
     /// The level loop one level at a time (three passes per level), as the
     /// in-memory loop ran before the passes were fused.
@@ -130,6 +129,7 @@ mod tests {
                 max_levels: 7,
                 formula,
                 tolerance,
+                start: Start::Mean,
                 ..Default::default()
             };
             let (a, b) = (mba(&p, &config).unwrap(), level_at_a_time(&p, &config));
@@ -216,25 +216,5 @@ mod tests {
         let stopped = mba(&p, &tol).unwrap();
         assert_eq!(stopped.reports.len(), 3);
         assert!((rmse(&stopped, &p) - fit.reports[2].residual.rmse).abs() <= 1e-9 * ef);
-    }
-
-    #[test]
-    fn the_chunked_level_loop_refuses_the_fitted_start() {
-        let p = scattered(100, 1, [0.0, 0.0, 1.0, 1.0], franke);
-        let config = MbaConfig {
-            start: Start::Fitted,
-            ..Default::default()
-        };
-        let e = MbaLevels::new(Frame::of(&p).unwrap(), &config).unwrap_err();
-        assert!(
-            matches!(
-                e,
-                Error::InvalidSetting {
-                    setting: "start",
-                    ..
-                }
-            ),
-            "{e}"
-        );
     }
 }

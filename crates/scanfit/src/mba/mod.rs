@@ -31,7 +31,7 @@ use crate::metrics::ErrorStats;
 use crate::{Error, Point3, Result};
 
 pub use lattice::{ControlFormula, Lattice};
-pub use sums::{BaAccumulator, FrameSums, ResidualSums};
+pub use sums::{BaAccumulator, FrameSums, LevelInputs, PassSums, ResidualSums};
 
 /// When the level loop stops.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -47,7 +47,7 @@ pub struct MbaConfig {
     pub tolerance: Option<f64>,
     /// Control-value formula (default Lee, Wolberg & Shin's eq. 4).
     pub formula: ControlFormula,
-    /// The function level 0 starts from (default [`Start::Mean`]).
+    /// The function level 0 starts from (default [`Start::Fitted`]).
     pub start: Start,
 }
 
@@ -55,7 +55,7 @@ pub struct MbaConfig {
 /// it. BA does not reproduce constants (a lattice fitted to constant data
 /// is not that constant), so the start shows in the final fit: measured on
 /// Franke's function (10^6 points, 131 x 131 values, BENCHMARKS.md), the
-/// held-out RMSE is 8.14e-5 from the mean, 6.41e-5 fitted, 7.25e-5 from zero (ddemidov/mba's
+/// held-out RMSE is 6.41e-5 fitted, 8.14e-5 from the mean, 7.25e-5 from zero (ddemidov/mba's
 /// default, [LWS97]'s level 0 on the raw heights) and 1.10e-4 from a
 /// least-squares plane; from zero it also depends on where the heights'
 /// origin lies (4.6 times worse with the data raised by 10), so zero is no
@@ -63,17 +63,21 @@ pub struct MbaConfig {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Start {
     /// The mean height (the frame's `z0`): independent of the heights'
-    /// origin, and the only start of the streamed and distributed level
-    /// loop ([`MbaLevels`]), whose sums carry the heights alone.
-    #[default]
+    /// origin; the level loop carries the heights alone.
     Mean,
-    /// The constant of least squares: the level loop also runs the constant
-    /// 1 through the same levels (MBA is linear in the heights), and the
-    /// start `z0 + delta` with `delta = sum r c / sum c^2` (`r`, `c` the
-    /// final residuals of the heights and of the constant) leaves the
-    /// smallest residual at the points among all constant starts. In memory
-    /// only ([`mba`]), at the CPU time of [`Start::Mean`] (the in-memory
-    /// loop carries the second value set for both starts).
+    /// The constant of least squares (default): the level loop also runs
+    /// the constant 1 through the same levels (MBA is linear in the
+    /// heights), and the start `z0 + delta` with `delta = sum r c / sum c^2`
+    /// (`r`, `c` the final residuals of the heights and of the constant)
+    /// leaves the smallest residual at the points among all constant
+    /// starts. In memory at the CPU time of [`Start::Mean`] (the in-memory
+    /// loop carries the second value set for both starts); streamed and
+    /// distributed ([`MbaLevels`]) the sums carry a second numerator per
+    /// control value and one more pass follows the last level (for its
+    /// `delta`). The adjustment ([`adjust::mba_adjusted`]) starts from the
+    /// mean: it changes the lattices between levels, so the constant's
+    /// levels no longer predict the start.
+    #[default]
     Fitted,
 }
 
@@ -84,7 +88,7 @@ impl Default for MbaConfig {
             max_levels: 6,
             tolerance: None,
             formula: ControlFormula::LeeWolbergShin,
-            start: Start::Mean,
+            start: Start::Fitted,
         }
     }
 }
@@ -181,17 +185,20 @@ pub fn mba(points: &[Point3], config: &MbaConfig) -> Result<Mba> {
 ///
 /// Per level: [`accumulator`](Self::accumulator) gives the level's empty BA
 /// sums ([`BaAccumulator`], lattice of `2^k` times the base cells); the
-/// points go in with [`BaAccumulator::add_residuals`] given
-/// [`frame`](Self::frame) and [`levels`](Self::levels) (what a driver
-/// broadcasts), in any number of accumulators merged afterwards; then
+/// points go in with [`BaAccumulator::add_levels`] given
+/// [`inputs`](Self::inputs) (what a driver broadcasts: the frame, the
+/// lattices so far and the row to measure), in any number of accumulators
+/// merged afterwards, and each returns its [`PassSums`]; the merged
+/// `PassSums` are [`record`](Self::record)ed (the row of a level before,
+/// the fitted start so far, and whether the tolerance is met), then
 /// [`push`](Self::push) finishes the level and adds it to the combined
-/// lattice (refined, [LWS97] section 5). The residual statistics of a level,
-/// which only a pass over the points after it can measure, are recorded
-/// with [`record_residual`](Self::record_residual) (the next level's
-/// `add_residuals` returns them).
+/// lattice (refined, [LWS97] section 5). With the fitted start the start of
+/// the last level needs one more pass ([`needs_pass`](Self::needs_pass),
+/// [`sums::pass_sums`]). The last row, which only a pass over the final
+/// surface measures, is recorded with [`record_last`](Self::record_last).
 ///
 /// ```
-/// use scanfit::mba::{mba, FrameSums, MbaConfig, MbaLevels};
+/// use scanfit::mba::{mba, sums::pass_sums, FrameSums, MbaConfig, MbaLevels, PassSums};
 /// use scanfit::Point3;
 ///
 /// let p: Vec<Point3> = (0..3000)
@@ -205,13 +212,19 @@ pub fn mba(points: &[Point3], config: &MbaConfig) -> Result<Mba> {
 /// let mut f = FrameSums::default();
 /// f.add(&p)?;
 /// let mut run = MbaLevels::new(f.finish()?, &config)?;
-/// for _ in 0..4 {
+/// while !run.done() {
 ///     let mut a = run.accumulator()?;
 ///     let mut b = run.accumulator()?;
-///     a.add_residuals(&run.frame(), run.levels(), &p[..1000])?;
-///     b.add_residuals(&run.frame(), run.levels(), &p[1000..])?;
+///     let mut sums = a.add_levels(&run.inputs(), &p[..1000])?;
+///     sums.merge(&b.add_levels(&run.inputs(), &p[1000..])?);
 ///     a.merge(b)?;
+///     run.record(&sums)?;
 ///     run.push(a)?;
+/// }
+/// // the fitted start (the default) of the last level: one more pass
+/// while run.needs_pass() {
+///     let sums = pass_sums(&run.inputs(), &p)?;
+///     run.record(&sums)?;
 /// }
 /// let tiles = run.finish();
 /// let once = mba(&p, &config)?;
@@ -226,8 +239,15 @@ pub struct MbaLevels {
     formula: ControlFormula,
     tolerance: Option<f64>,
     max_levels: usize,
+    start: Start,
     total: Option<Lattice>,
     levels: Vec<Lattice>,
+    /// The fitted start's constant: its level lattices.
+    ones: Vec<Lattice>,
+    /// `deltas[k]`: the fitted start of levels `0..=k`.
+    deltas: Vec<f64>,
+    /// Rows recorded (from the first).
+    rows: usize,
     reports: Vec<LevelReport>,
     started: Instant,
 }
@@ -237,18 +257,6 @@ impl MbaLevels {
     /// errors for a zero base lattice, a bad tolerance, or a last level
     /// beyond [`lattice::MAX_LATTICE_VALUES`].
     pub fn new(frame: Frame, config: &MbaConfig) -> Result<Self> {
-        if config.start != Start::Mean {
-            return Err(Error::InvalidSetting {
-                setting: "start",
-                value: format!("{:?}", config.start),
-                hint: "the fitted start runs a second value set through every level and needs all points in memory; a level loop fed in chunks (streamed, distributed, or with the adjustment) starts from the mean".into(),
-            });
-        }
-        Self::in_memory(frame, config)
-    }
-
-    /// [`new`](Self::new) for the in-memory loop, which carries any start.
-    fn in_memory(frame: Frame, config: &MbaConfig) -> Result<Self> {
         let base = config.base.unwrap_or_else(|| frame.default_base());
         if base.0 == 0 || base.1 == 0 {
             return Err(Error::InvalidSetting {
@@ -285,8 +293,12 @@ impl MbaLevels {
             formula: config.formula,
             tolerance: config.tolerance,
             max_levels: config.max_levels.max(1),
+            start: config.start,
             total: None,
             levels: Vec::new(),
+            ones: Vec::new(),
+            deltas: Vec::new(),
+            rows: 0,
             reports: Vec::new(),
             started: Instant::now(),
         })
@@ -297,10 +309,39 @@ impl MbaLevels {
         self.frame
     }
 
+    /// The start of level 0.
+    pub fn start(&self) -> Start {
+        self.start
+    }
+
     /// The lattices of the levels so far (level `k` has `2^k` times the
     /// base cells): what the residuals of the next level subtract.
     pub fn levels(&self) -> &[Lattice] {
         &self.levels
+    }
+
+    /// The constant's lattices of the levels so far (the fitted start;
+    /// empty for the mean).
+    pub fn constant_levels(&self) -> &[Lattice] {
+        &self.ones
+    }
+
+    /// What the next pass over the points needs: the frame, the lattices so
+    /// far and the row it measures (the mean start: the last level's; the
+    /// fitted start: the last level whose start is known, which the pass
+    /// after it found).
+    pub fn inputs(&self) -> LevelInputs<'_> {
+        let row = match self.start {
+            Start::Mean => (!self.levels.is_empty()).then_some((self.levels.len(), 0.0)),
+            Start::Fitted => self.deltas.last().map(|&d| (self.deltas.len(), d)),
+        };
+        LevelInputs {
+            frame: self.frame,
+            heights: &self.levels,
+            constant: &self.ones,
+            start: self.start,
+            row,
+        }
     }
 
     /// Cells `(m, n)` of the next level's lattice.
@@ -314,38 +355,89 @@ impl MbaLevels {
         self.levels.len() >= self.max_levels
     }
 
+    /// Whether the fitted start of the last level is still unknown: one
+    /// more pass ([`sums::pass_sums`], then [`record`](Self::record))
+    /// finds it before [`finish`](Self::finish).
+    pub fn needs_pass(&self) -> bool {
+        self.start == Start::Fitted && self.deltas.len() < self.levels.len()
+    }
+
     /// Empty BA sums of the next level.
     pub fn accumulator(&self) -> Result<BaAccumulator> {
         let (m, n) = self.next_cells();
-        BaAccumulator::new(m, n, self.formula)
+        BaAccumulator::for_start(m, n, self.formula, self.start)
+    }
+
+    /// Records what a pass over all points measured (its merged
+    /// [`PassSums`], from the [`inputs`](Self::inputs) of now): the row it
+    /// measured and, for the fitted start, the start of the levels so far.
+    /// Returns whether the tolerance is met (the RMSE at the points after
+    /// the levels so far, with their fitted start), i.e. whether the loop
+    /// should stop before pushing another level. Call it once per pass;
+    /// the pass of level 0 records nothing.
+    pub fn record(&mut self, sums: &PassSums) -> Result<bool> {
+        if self.levels.is_empty() {
+            return Ok(false);
+        }
+        match self.start {
+            Start::Mean => Ok(self.record_residual(sums.row.stats())),
+            Start::Fitted => {
+                if !self.needs_pass() {
+                    return Err(Error::InvalidInput(format!(
+                        "the start of the {} levels so far is recorded already; record each pass's sums once",
+                        self.levels.len()
+                    )));
+                }
+                let j = self.deltas.len();
+                if j > 0 {
+                    self.reports[j - 1].residual = sums.row.stats();
+                    self.rows = j;
+                }
+                self.deltas.push(sums.start());
+                if let Some(r) = self.reports.last_mut() {
+                    r.seconds += self.started.elapsed().as_secs_f64();
+                }
+                self.started = Instant::now();
+                Ok(self.tolerance.is_some_and(|t| sums.start_rmse() <= t))
+            }
+        }
     }
 
     /// Finishes the next level from its (merged) sums and adds it to the
-    /// combined lattice; its report has no residual statistics until
-    /// [`record_residual`](Self::record_residual).
+    /// combined lattice; its report has no residual statistics until a
+    /// later pass records them.
     pub fn push(&mut self, sums: BaAccumulator) -> Result<()> {
-        if sums.cells() != self.next_cells() {
+        if sums.cells() != self.next_cells() || sums.start() != self.start {
             let (m, n) = sums.cells();
             let (nm, nn) = self.next_cells();
             return Err(Error::InvalidInput(format!(
-                "the sums are of a {m} x {n} lattice, but level {} has {nm} x {nn} cells",
+                "the sums are of a {m} x {n} lattice for the {:?} start, but level {} has {nm} x {nn} cells and the {:?} start",
+                sums.start(),
+                self.levels.len(),
+                self.start
+            )));
+        }
+        if self.needs_pass() {
+            return Err(Error::InvalidInput(format!(
+                "the pass of level {} was not recorded; record its sums before pushing the level",
                 self.levels.len()
             )));
         }
-        self.push_lattice(sums.finish())
+        let mut sets = sums.finish_sets().into_iter();
+        match (sets.next(), sets.next()) {
+            (Some(z), c) => self.push_lattices(z, c),
+            (None, _) => Err(Error::InvalidInput("BA sums without a value set".into())),
+        }
     }
 
-    /// Adds the finished lattice of the next level (of
-    /// [`next_cells`](Self::next_cells)) to the combined lattice.
-    fn push_lattice(&mut self, phi: Lattice) -> Result<()> {
-        self.total = Some(match self.total.take() {
-            None => phi.clone(),
-            Some(t) => {
-                let mut t = t.refine()?;
-                t.add(&phi)?;
-                t
-            }
-        });
+    /// Adds the finished lattices of the next level (of
+    /// [`next_cells`](Self::next_cells)), the heights' and (fitted start)
+    /// the constant's, to the combined lattices.
+    fn push_lattices(&mut self, phi: Lattice, one: Option<Lattice>) -> Result<()> {
+        self.total = Some(add_refined(self.total.take(), &phi)?);
+        if let Some(c) = one.filter(|_| self.start == Start::Fitted) {
+            self.ones.push(c);
+        }
         self.reports.push(LevelReport {
             level: self.levels.len(),
             cells: (phi.m, phi.n),
@@ -359,25 +451,35 @@ impl MbaLevels {
 
     /// Records the statistics of the residuals after the last level pushed
     /// (and the time spent measuring them); returns whether they meet the
-    /// tolerance, i.e. whether the loop should stop.
+    /// tolerance, i.e. whether the loop should stop (the mean start's
+    /// [`record`](Self::record)).
     pub fn record_residual(&mut self, stats: ErrorStats) -> bool {
         if let Some(r) = self.reports.last_mut() {
             r.residual = stats;
             r.seconds += self.started.elapsed().as_secs_f64();
+            self.rows = self.reports.len();
         }
         self.started = Instant::now();
         self.tolerance.is_some_and(|t| stats.rmse <= t)
     }
 
+    /// Records the statistics of the last row if no pass recorded it: the
+    /// vertical residuals of the finished surface, from a measuring pass.
+    pub fn record_last(&mut self, stats: ErrorStats) {
+        if self.rows < self.reports.len() {
+            self.record_residual(stats);
+        }
+    }
+
     /// Fits the next level to `residual` at the unit coordinates `unit`
-    /// (residuals updated in place, the points in memory); returns whether
-    /// the tolerance is met.
+    /// (residuals updated in place, the points in memory, the mean start);
+    /// returns whether the tolerance is met.
     pub(crate) fn level(&mut self, unit: &[[f64; 2]], residual: &mut [f64]) -> Result<bool> {
         let (m, n) = self.next_cells();
         let cells = to_cells(unit, m, n);
-        let mut sums = self.accumulator()?;
+        let mut sums = BaAccumulator::new(m, n, self.formula)?;
         sums.add(&cells, residual)?;
-        self.push(sums)?;
+        self.push_lattices(sums.finish(), None)?;
         let phi = &self.levels[self.levels.len() - 1];
         residual
             .par_iter_mut()
@@ -393,19 +495,52 @@ impl MbaLevels {
     }
 
     /// The approximation: the combined lattice (zero when no level was
-    /// pushed), the level lattices and their reports.
+    /// pushed), the level lattices and their reports. With the fitted start
+    /// `z0 + d` (`d` the start of the last level, [`needs_pass`](Self::needs_pass)
+    /// false; else the last start known) level `k` is `Z_k - d C_k` (the
+    /// constant's level `C_k`), with `d` added to level 0 (a constant lattice
+    /// is the constant function), and the combined lattice likewise.
     pub fn finish(self) -> Mba {
+        let zero = || Lattice {
+            m: self.base.0,
+            n: self.base.1,
+            phi: vec![0.0; (self.base.0 + 3) * (self.base.1 + 3)],
+        };
+        let mut levels = self.levels;
+        let mut total = self.total;
+        if self.start == Start::Fitted {
+            let d = self.deltas.last().copied().unwrap_or(0.0);
+            total = None;
+            for (k, (z, c)) in levels.iter_mut().zip(&self.ones).enumerate() {
+                for (a, b) in z.phi.iter_mut().zip(&c.phi) {
+                    *a -= d * b;
+                }
+                if k == 0 {
+                    z.phi.iter_mut().for_each(|a| *a += d);
+                }
+                // the sizes were refined and added once already in push
+                total = add_refined(total.take(), z).ok();
+            }
+        }
         Mba {
             frame: self.frame,
-            lattice: self.total.unwrap_or(Lattice {
-                m: self.base.0,
-                n: self.base.1,
-                phi: vec![0.0; (self.base.0 + 3) * (self.base.1 + 3)],
-            }),
-            levels: self.levels,
+            lattice: total.unwrap_or_else(zero),
+            levels,
             reports: self.reports,
         }
     }
+}
+
+/// `total` refined to the cells of `phi`, plus `phi` (`phi` alone first).
+fn add_refined(total: Option<Lattice>, phi: &Lattice) -> Result<Lattice> {
+    Ok(match total {
+        None => phi.clone(),
+        Some(t) => {
+            let mut t = t.refine()?;
+            t.add(phi)?;
+            t
+        }
+    })
 }
 
 /// Control values of the last level's lattice of `levels` levels on a

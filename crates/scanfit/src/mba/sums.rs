@@ -3,15 +3,20 @@
 //! other machines) and merged: the data's frame ([`FrameSums`]: bounding
 //! box and mean height), the BA step of one level ([`BaAccumulator`]: the
 //! numerator and denominator of [LWS97] eq. 4, [MBA18] eqs. 3-4, per control
-//! value) and the statistics of the residuals ([`ResidualSums`]).
+//! value, for the heights and, with the fitted start, the constant 1), what
+//! a pass measures besides ([`PassSums`]: a row's residual statistics and
+//! the fitted start's sums) and the statistics of the residuals
+//! ([`ResidualSums`]).
 //!
 //! A distributed level loop ([`super::MbaLevels`]) runs, per level: the
 //! driver sends the frame and the level lattices so far to every worker;
 //! each worker creates the level's accumulator
 //! ([`super::MbaLevels::accumulator`]), adds its points
-//! ([`BaAccumulator::add_residuals`], which evaluates the levels so far at
-//! the points) and returns it; the driver merges them and finishes the
-//! level ([`super::MbaLevels::push`]). Only lattices travel, never points.
+//! ([`BaAccumulator::add_levels`] given [`super::MbaLevels::inputs`], which
+//! evaluates the levels so far at the points) and returns it with the
+//! pass's [`PassSums`]; the driver merges them, records the sums
+//! ([`super::MbaLevels::record`]) and finishes the level
+//! ([`super::MbaLevels::push`]). Only lattices travel, never points.
 //!
 //! Points are summed in blocks counted from the first point added (of at
 //! least 16384 points, and at least as many as the lattice has control
@@ -27,13 +32,16 @@ use crate::wire::{read_pair_sums, write_pair_sums, Reader, Writer};
 use crate::{validate_points, Error, Point3, Result};
 
 use super::lattice::{locate, uniform_cubic_basis, ControlFormula, Lattice};
-use super::Frame;
+use super::{Frame, Start};
 
 /// Fewest points per block of the BA sums.
 pub(super) const BA_BLOCK: usize = 16_384;
 
-/// Tags of the byte records ([`crate::wire`]).
-const BA_TAG: &[u8; 8] = b"SFBASUM1";
+/// Tags of the byte records ([`crate::wire`]). Version 2 of the BA sums
+/// carries the number of value sets (the constant's, for the fitted
+/// start); version 1 bytes are refused as of another version.
+const BA_TAG: &[u8; 8] = b"SFBASUM2";
+const PASS_TAG: &[u8; 8] = b"SFPASSM1";
 const FRAME_TAG: &[u8; 8] = b"SFFRAME1";
 const RESIDUAL_TAG: &[u8; 8] = b"SFRESID1";
 
@@ -46,6 +54,10 @@ pub(super) const PARTIAL_BUDGET: usize = 256 << 20;
 /// `w_c` instead of `w_c^2` for [`ControlFormula::Hjelle`]), with the
 /// candidate `phi_c = w_c z_c / sum_ab w_ab^2` of eq. 3.
 /// [`finish`](Self::finish) divides them into the lattice.
+///
+/// For the fitted start ([`Start::Fitted`]) the sums carry a second value
+/// set, the constant 1's residuals (a second numerator per control value;
+/// the denominator depends on the points' positions only and is shared).
 ///
 /// ```
 /// use scanfit::mba::{BaAccumulator, ControlFormula, Lattice};
@@ -66,6 +78,10 @@ pub struct BaAccumulator {
     m: usize,
     n: usize,
     formula: ControlFormula,
+    /// Value sets: 1 (the heights) or 2 (and the constant).
+    sets: usize,
+    /// The numerators of all sets, one lattice after the other, and the
+    /// shared denominators.
     sums: BlockSum<(Vec<f64>, Vec<f64>)>,
 }
 
@@ -73,13 +89,33 @@ impl BaAccumulator {
     /// Empty sums for a lattice of `m x n` cells (control net `(m + 3) x
     /// (n + 3)`); errors like [`Lattice::zeros`].
     pub fn new(m: usize, n: usize, formula: ControlFormula) -> Result<Self> {
+        Self::with_sets(m, n, formula, 1)
+    }
+
+    /// Empty sums of the level loop that starts from `start`: the heights'
+    /// values, and the constant's too for [`Start::Fitted`].
+    pub fn for_start(m: usize, n: usize, formula: ControlFormula, start: Start) -> Result<Self> {
+        Self::with_sets(m, n, formula, sets_of(start))
+    }
+
+    fn with_sets(m: usize, n: usize, formula: ControlFormula, sets: usize) -> Result<Self> {
         let len = Lattice::zeros(m, n)?.phi.len();
         Ok(Self {
             m,
             n,
             formula,
-            sums: BlockSum::new((vec![0.0; len], vec![0.0; len]), BA_BLOCK.max(len)),
+            sets,
+            sums: BlockSum::new((vec![0.0; sets * len], vec![0.0; len]), BA_BLOCK.max(len)),
         })
+    }
+
+    /// The start whose value sets these sums carry.
+    pub fn start(&self) -> Start {
+        if self.sets == 2 {
+            Start::Fitted
+        } else {
+            Start::Mean
+        }
     }
 
     /// Cells `(m, n)` of the lattice.
@@ -92,14 +128,14 @@ impl BaAccumulator {
         self.sums.items()
     }
 
-    /// Bytes of one set of sums (numerator and denominator per control value).
+    /// Bytes of one set of sums (numerators and denominator per control value).
     pub fn bytes(&self) -> usize {
-        2 * (self.m + 3) * (self.n + 3) * std::mem::size_of::<f64>()
+        (self.sets + 1) * (self.m + 3) * (self.n + 3) * std::mem::size_of::<f64>()
     }
 
     /// Adds the values `z` at lattice coordinates `xy` (in `[0, m] x [0, n]`;
-    /// points outside are clamped to it). Errors when the lengths differ or
-    /// a value is not finite.
+    /// points outside are clamped to it). Errors when the lengths differ,
+    /// a value is not finite, or the sums carry two value sets.
     pub fn add(&mut self, xy: &[[f64; 2]], z: &[f64]) -> Result<()> {
         if xy.len() != z.len() {
             return Err(Error::LengthMismatch {
@@ -108,14 +144,25 @@ impl BaAccumulator {
                 got: z.len(),
             });
         }
-        if let Some(i) = (0..z.len())
-            .find(|&i| !(z[i].is_finite() && xy[i][0].is_finite() && xy[i][1].is_finite()))
-        {
+        if self.sets != 1 {
+            return Err(Error::InvalidInput(
+                "these BA sums carry the constant's values beside the heights (the fitted start); add the points with add_levels".into(),
+            ));
+        }
+        let values: Vec<[f64; 1]> = z.iter().map(|&v| [v]).collect();
+        self.add_sets(xy, &values)
+    }
+
+    /// [`add`](Self::add) of `K` values per point (`K` the sets).
+    fn add_sets<const K: usize>(&mut self, xy: &[[f64; 2]], z: &[[f64; K]]) -> Result<()> {
+        if let Some(i) = (0..z.len()).find(|&i| {
+            !(z[i].iter().all(|v| v.is_finite()) && xy[i][0].is_finite() && xy[i][1].is_finite())
+        }) {
             return Err(Error::BadPoint {
                 index: i,
                 problem: format!(
                     "has lattice coordinates ({}, {}) and value {}; all must be finite",
-                    xy[i][0], xy[i][1], z[i]
+                    xy[i][0], xy[i][1], z[i][0]
                 ),
             });
         }
@@ -125,10 +172,15 @@ impl BaAccumulator {
         self.sums.add(
             xy.len(),
             partials,
-            || (vec![0.0; len], vec![0.0; len]),
+            || (vec![0.0; K * len], vec![0.0; len]),
             |(num, den), range| {
-                for (p, &zc) in xy[range.clone()].iter().zip(&z[range]) {
-                    add_point(num, den, m, n, formula, *p, zc);
+                let mut sets = num.chunks_exact_mut(len);
+                let mut num: [&mut [f64]; K] = std::array::from_fn(|_| match sets.next() {
+                    Some(s) => s,
+                    None => unreachable!("the numerators hold K lattices"),
+                });
+                for (p, zc) in xy[range.clone()].iter().zip(&z[range]) {
+                    add_point_values(&mut num, den, m, n, formula, *p, *zc);
                 }
             },
             merge_sums,
@@ -141,34 +193,64 @@ impl BaAccumulator {
     /// unit coordinates in `frame`, subtracted in level order exactly as the
     /// in-memory level loop does), and returns their statistics (the
     /// residuals of the previous level, for its report). Point indices in
-    /// the statistics count from 0 within `points`.
+    /// the statistics count from 0 within `points`. For the mean start
+    /// ([`add_levels`](Self::add_levels) for either).
     pub fn add_residuals(
         &mut self,
         frame: &Frame,
         levels: &[Lattice],
         points: &[Point3],
     ) -> Result<ResidualSums> {
-        validate_points(points)?;
-        let mut stats = ResidualSums::default();
-        let mut xy = Vec::with_capacity(points.len());
-        let mut z = Vec::with_capacity(points.len());
-        for p in points {
-            let u = frame.unit(p);
-            let r = residual(frame, levels, p, u);
-            stats.push(r.abs());
-            xy.push([u[0] * self.m as f64, u[1] * self.n as f64]);
-            z.push(r);
+        let inputs = LevelInputs {
+            frame: *frame,
+            heights: levels,
+            constant: &[],
+            start: Start::Mean,
+            row: (!levels.is_empty()).then_some((levels.len(), 0.0)),
+        };
+        Ok(self.add_levels(&inputs, points)?.row)
+    }
+
+    /// Adds the residuals of `points` after the levels of `inputs` (from
+    /// [`super::MbaLevels::inputs`]): the heights' `z - z0 - sum_k Z_k(x, y)`
+    /// and, for the fitted start, the constant's `1 - sum_k C_k(x, y)`, each
+    /// level evaluated at the point's unit coordinates and subtracted in
+    /// level order as the in-memory level loop does. Returns what the pass
+    /// measures ([`PassSums`], point indices counted from 0 within
+    /// `points`). Errors when the sums' value sets are not the start's.
+    pub fn add_levels(&mut self, inputs: &LevelInputs<'_>, points: &[Point3]) -> Result<PassSums> {
+        if self.sets != sets_of(inputs.start) {
+            return Err(Error::InvalidInput(format!(
+                "these BA sums carry {} value set(s), but a level loop with the {:?} start needs {}; make them with the loop's accumulator()",
+                self.sets,
+                inputs.start,
+                sets_of(inputs.start)
+            )));
         }
-        self.add(&xy, &z)?;
-        Ok(stats)
+        let (m, n) = (self.m as f64, self.n as f64);
+        let mut xy = Vec::with_capacity(points.len());
+        let mut rc = Vec::with_capacity(points.len());
+        let sums = walk_levels(inputs, points, |u, v| {
+            xy.push([u[0] * m, u[1] * n]);
+            rc.push(v);
+        })?;
+        if self.sets == 1 {
+            let z: Vec<[f64; 1]> = rc.iter().map(|v| [v[0]]).collect();
+            self.add_sets(&xy, &z)?;
+        } else {
+            self.add_sets(&xy, &rc)?;
+        }
+        Ok(sums)
     }
 
     /// Adds the sums of another accumulator of the same lattice (points
     /// summed separately).
     pub fn merge(&mut self, other: Self) -> Result<()> {
-        if (self.m, self.n, self.formula) != (other.m, other.n, other.formula) {
+        if (self.m, self.n, self.formula, self.sets)
+            != (other.m, other.n, other.formula, other.sets)
+        {
             return Err(Error::InvalidInput(format!(
-                "cannot merge the BA sums of a {} x {} lattice into those of a {} x {} lattice (or of another control formula); every chunk of a level must use that level's lattice",
+                "cannot merge the BA sums of a {} x {} lattice into those of a {} x {} lattice (or of another control formula or start); every chunk of a level must use that level's accumulator",
                 other.m, other.n, self.m, self.n
             )));
         }
@@ -194,6 +276,7 @@ impl BaAccumulator {
         w.usize(self.m);
         w.usize(self.n);
         w.u64(u64::from(self.formula == ControlFormula::Hjelle));
+        w.usize(self.sets);
         write_pair_sums(&mut w, &self.sums);
         w.finish()
     }
@@ -208,18 +291,33 @@ impl BaAccumulator {
             1 => ControlFormula::Hjelle,
             x => return Err(r.corrupt(&format!("control formula {x}"))),
         };
-        let mut acc = Self::new(m, n, formula)?;
+        let sets = r.usize()?;
+        if !(1..=2).contains(&sets) {
+            return Err(r.corrupt(&format!("{sets} value sets")));
+        }
+        let mut acc = Self::with_sets(m, n, formula, sets)?;
         let len = (m + 3) * (n + 3);
-        acc.sums = read_pair_sums(&mut r, (len, len), BA_BLOCK.max(len))?;
+        acc.sums = read_pair_sums(&mut r, (sets * len, len), BA_BLOCK.max(len))?;
         r.end()?;
         Ok(acc)
     }
 
     /// The lattice: each control value the ratio of its sums (eq. 4), 0
-    /// where no point reached it.
+    /// where no point reached it (the heights' lattice when the sums carry
+    /// two value sets).
     pub fn finish(self) -> Lattice {
+        let mut l = self.finish_sets();
+        l.swap_remove(0)
+    }
+
+    /// The lattice of each value set: the heights' and, for the fitted
+    /// start, the constant's.
+    pub fn finish_sets(self) -> Vec<Lattice> {
+        let (m, n) = (self.m, self.n);
         let (num, den) = self.sums.finish(merge_sums);
-        ratio_lattice(self.m, self.n, &num, &den)
+        num.chunks_exact(den.len())
+            .map(|num| ratio_lattice(m, n, num, &den))
+            .collect()
     }
 
     /// The number of partial sums alive at a time while a chunk is summed
@@ -238,6 +336,216 @@ pub(super) fn ratio_lattice(m: usize, n: usize, num: &[f64], den: &[f64]) -> Lat
         .map(|(nu, de)| if *de > 0.0 { nu / de } else { 0.0 })
         .collect();
     Lattice { m, n, phi }
+}
+
+/// Value sets of the level loop that starts from `start`.
+fn sets_of(start: Start) -> usize {
+    match start {
+        Start::Mean => 1,
+        Start::Fitted => 2,
+    }
+}
+
+/// What a pass over the points needs (broadcast to every chunk or worker):
+/// made by [`super::MbaLevels::inputs`].
+#[derive(Debug, Clone, Copy)]
+pub struct LevelInputs<'a> {
+    /// The map between data and lattice coordinates.
+    pub frame: Frame,
+    /// The heights' level lattices so far.
+    pub heights: &'a [Lattice],
+    /// The constant's level lattices so far (the fitted start; empty for
+    /// the mean), of the sizes of `heights`.
+    pub constant: &'a [Lattice],
+    /// The start of the level loop.
+    pub start: Start,
+    /// The row this pass measures, `(j, d)`: the statistics of
+    /// `|r_j - d c_j|`, `r_j` and `c_j` the heights' and the constant's
+    /// residuals after the first `j` levels and `d` the fitted start of
+    /// those `j` levels (0 for the mean start).
+    pub row: Option<(usize, f64)>,
+}
+
+/// Walks `points` through the levels of `inputs`: for each point its unit
+/// coordinates and its residuals `[r, c]` after all levels (`c` = 0 for the
+/// mean start), and the pass's [`PassSums`].
+fn walk_levels(
+    inputs: &LevelInputs<'_>,
+    points: &[Point3],
+    mut each: impl FnMut([f64; 2], [f64; 2]),
+) -> Result<PassSums> {
+    validate_points(points)?;
+    let (heights, constant) = (inputs.heights, inputs.constant);
+    let fitted = inputs.start == Start::Fitted;
+    let want = if fitted { heights.len() } else { 0 };
+    let sizes_match = heights
+        .iter()
+        .zip(constant)
+        .all(|(a, b)| (a.m, a.n, a.phi.len()) == (b.m, b.n, b.phi.len()));
+    if constant.len() != want || !sizes_match {
+        return Err(Error::InvalidInput(format!(
+            "{} height lattices and {} constant lattices: the fitted start needs one constant lattice of the same size per level, the mean start none",
+            heights.len(),
+            constant.len()
+        )));
+    }
+    if inputs.row.is_some_and(|(j, _)| j > heights.len()) {
+        return Err(Error::InvalidInput(format!(
+            "the row to measure is after {} levels, but only {} are given",
+            inputs.row.map_or(0, |r| r.0),
+            heights.len()
+        )));
+    }
+    let frame = &inputs.frame;
+    let mut sums = PassSums::default();
+    for p in points {
+        let u = frame.unit(p);
+        let mut v = [p.z - frame.z0, if fitted { 1.0 } else { 0.0 }];
+        for (j, z) in heights.iter().enumerate() {
+            if let Some((_, d)) = inputs.row.filter(|r| r.0 == j) {
+                sums.row.push((v[0] - d * v[1]).abs());
+            }
+            let b = z.basis(u[0] * z.m as f64, u[1] * z.n as f64);
+            v[0] -= z.eval_at(&b);
+            if let Some(c) = constant.get(j) {
+                v[1] -= c.eval_at(&b);
+            }
+        }
+        if let Some((_, d)) = inputs.row.filter(|r| r.0 == heights.len()) {
+            sums.row.push((v[0] - d * v[1]).abs());
+        }
+        sums.count += 1;
+        sums.quad[0] += v[0] * v[0];
+        sums.quad[1] += v[0] * v[1];
+        sums.quad[2] += v[1] * v[1];
+        each(u, v);
+    }
+    Ok(sums)
+}
+
+/// The [`PassSums`] of `points` after the levels of `inputs` without
+/// summing a level: the pass after the last level of the fitted start,
+/// which finds that level's start ([`super::MbaLevels::needs_pass`]).
+///
+/// ```
+/// use scanfit::mba::{sums::pass_sums, FrameSums, MbaConfig, MbaLevels, Start};
+/// use scanfit::Point3;
+/// let p: Vec<Point3> = (0..500).map(|k| Point3::new((k % 25) as f64, (k / 25) as f64, ((k * 7) % 11) as f64)).collect();
+/// let mut f = FrameSums::default();
+/// f.add(&p)?;
+/// let config = MbaConfig { max_levels: 2, start: Start::Fitted, ..Default::default() };
+/// let mut run = MbaLevels::new(f.finish()?, &config)?;
+/// while !run.done() {
+///     let mut acc = run.accumulator()?;
+///     let sums = acc.add_levels(&run.inputs(), &p)?;
+///     run.record(&sums)?;
+///     run.push(acc)?;
+/// }
+/// assert!(run.needs_pass());
+/// let sums = pass_sums(&run.inputs(), &p)?;
+/// run.record(&sums)?;
+/// assert!(!run.needs_pass());
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+pub fn pass_sums(inputs: &LevelInputs<'_>, points: &[Point3]) -> Result<PassSums> {
+    walk_levels(inputs, points, |_, _| {})
+}
+
+/// What a pass over the points measures besides a level's BA sums: the
+/// statistics of the row it measures ([`LevelInputs::row`]) and the sums
+/// `sum r^2, sum r c, sum c^2` of the residuals after all its levels, from
+/// which the fitted start of those levels is the least-squares ratio
+/// `d = sum r c / sum c^2` ([`start`](Self::start)). Mergeable in point
+/// order like [`ResidualSums`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PassSums {
+    /// Statistics of the row measured (empty when the pass measures none).
+    pub row: ResidualSums,
+    /// Points of the pass.
+    pub count: u64,
+    /// `sum r^2, sum r c, sum c^2` after all the pass's levels.
+    pub quad: [f64; 3],
+}
+
+impl PassSums {
+    /// Adds the sums of the points after these.
+    pub fn merge(&mut self, other: &Self) {
+        self.row.merge(&other.row);
+        self.count += other.count;
+        for (a, b) in self.quad.iter_mut().zip(other.quad) {
+            *a += b;
+        }
+    }
+
+    /// The fitted start `sum r c / sum c^2` (0 when the constant's
+    /// residuals vanish, as for the mean start).
+    pub fn start(&self) -> f64 {
+        let [_, rc, cc] = self.quad;
+        if cc > 0.0 {
+            rc / cc
+        } else {
+            0.0
+        }
+    }
+
+    /// The RMSE of `r - d c` with `d` the fitted [`start`](Self::start)
+    /// (of `r` for the mean start).
+    pub fn start_rmse(&self) -> f64 {
+        let [rr, rc, cc] = self.quad;
+        let d = self.start();
+        let ss = (rr - 2.0 * d * rc + d * d * cc).max(0.0);
+        (ss / self.count.max(1) as f64).sqrt()
+    }
+
+    /// The sums as bytes ([`crate::wire`], exact).
+    ///
+    /// ```
+    /// use scanfit::mba::PassSums;
+    /// let mut a = PassSums::default();
+    /// a.row.push(0.5);
+    /// a.quad = [1.0, 0.5, 2.0];
+    /// assert_eq!(PassSums::from_bytes(&a.to_bytes())?, a);
+    /// # Ok::<(), scanfit::Error>(())
+    /// ```
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut w = Writer::new(PASS_TAG);
+        write_residual_sums(&mut w, &self.row);
+        w.u64(self.count);
+        for x in self.quad {
+            w.f64(x);
+        }
+        w.finish()
+    }
+
+    /// Reads what [`to_bytes`](Self::to_bytes) wrote.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
+        let mut r = Reader::new(bytes, PASS_TAG, "the sums of an MBA pass")?;
+        let row = read_residual_sums(&mut r)?;
+        let count = r.u64()?;
+        let quad = [r.f64()?, r.f64()?, r.f64()?];
+        r.end()?;
+        Ok(Self { row, count, quad })
+    }
+}
+
+/// Writes the fields of [`ResidualSums`].
+fn write_residual_sums(w: &mut Writer, s: &ResidualSums) {
+    w.u64(s.count);
+    w.f64(s.sum);
+    w.f64(s.sum2);
+    w.f64(s.max);
+    w.u64(s.max_index);
+}
+
+/// Reads what [`write_residual_sums`] wrote.
+fn read_residual_sums(r: &mut Reader<'_>) -> Result<ResidualSums> {
+    Ok(ResidualSums {
+        count: r.u64()?,
+        sum: r.f64()?,
+        sum2: r.f64()?,
+        max: r.f64()?,
+        max_index: r.u64()?,
+    })
 }
 
 /// The statistics of the absolute residuals `|z - z0 - sum_k f_k(x, y)|`
@@ -271,20 +579,6 @@ pub(crate) fn residual(frame: &Frame, levels: &[Lattice], p: &Point3, u: [f64; 2
         r -= l.eval(u[0] * l.m as f64, u[1] * l.n as f64);
     }
     r
-}
-
-/// Eqs. 3-4 for one point: its candidates and weights added to the sums.
-#[inline]
-pub(super) fn add_point(
-    num: &mut [f64],
-    den: &mut [f64],
-    m: usize,
-    n: usize,
-    formula: ControlFormula,
-    p: [f64; 2],
-    zc: f64,
-) {
-    add_point_values(&mut [num], den, m, n, formula, p, [zc]);
 }
 
 /// Eqs. 3-4 of one point in factored form. With `w_kl = B_k(s) B_l(t)`,
@@ -338,7 +632,8 @@ impl BaFactors {
     }
 }
 
-/// [`add_point`] for `K` value sets at once (one numerator each, the
+/// Eqs. 3-4 for one point with `K` value sets at once: its candidates and
+/// weights added to the sums (one numerator each, the
 /// denominator shared: it depends on the point's position only).
 #[inline]
 pub(super) fn add_point_values<const K: usize>(
@@ -440,24 +735,14 @@ impl ResidualSums {
     /// ```
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut w = Writer::new(RESIDUAL_TAG);
-        w.u64(self.count);
-        w.f64(self.sum);
-        w.f64(self.sum2);
-        w.f64(self.max);
-        w.u64(self.max_index);
+        write_residual_sums(&mut w, self);
         w.finish()
     }
 
     /// Reads what [`to_bytes`](Self::to_bytes) wrote.
     pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
         let mut r = Reader::new(bytes, RESIDUAL_TAG, "residual statistics")?;
-        let s = Self {
-            count: r.u64()?,
-            sum: r.f64()?,
-            sum2: r.f64()?,
-            max: r.f64()?,
-            max_index: r.u64()?,
-        };
+        let s = read_residual_sums(&mut r)?;
         r.end()?;
         Ok(s)
     }
@@ -642,6 +927,35 @@ mod tests {
         // a record of another type is named as such
         let f = FrameSums::default().to_bytes();
         assert!(BaAccumulator::from_bytes(&f).is_err());
+        // version 1 (the heights' sums alone, before the fitted start's
+        // second set) is refused as such, not misread
+        let mut old = bytes.clone();
+        old[7] = b'1';
+        let e = BaAccumulator::from_bytes(&old).unwrap_err().to_string();
+        assert!(e.contains("version 1") && e.contains("version 2"), "{e}");
+        // the fitted start's two value sets continue bit for bit too
+        let run = MbaLevels::new(frame, &MbaConfig::default())?;
+        let inputs = run.inputs();
+        let mut once = run.accumulator()?;
+        let whole = once.add_levels(&inputs, &p)?;
+        let mut a = run.accumulator()?;
+        let mut part = a.add_levels(&inputs, &p[..20_000])?;
+        let mut b = BaAccumulator::from_bytes(&a.to_bytes())?;
+        assert_eq!(b.start(), Start::Fitted);
+        part.merge(&PassSums::from_bytes(
+            &b.add_levels(&inputs, &p[20_000..])?.to_bytes(),
+        )?);
+        // the BA sums bit for bit (blocks counted from the first point); the
+        // pass sums to the rounding of the chunks' partial sums
+        assert_eq!((part.count, part.row), (whole.count, whole.row));
+        // (at level 0 the start is ~0: compared to the heights' RMS)
+        let rms = (whole.quad[0] / whole.count as f64).sqrt();
+        assert!((part.start() - whole.start()).abs() <= 1e-12 * rms);
+        assert!((part.quad[0] - whole.quad[0]).abs() <= 1e-14 * whole.quad[0]);
+        assert_eq!(b.finish_sets(), once.finish_sets());
+        // sums of one start are not added with the other's inputs
+        let mut mean = BaAccumulator::new(1, 1, ControlFormula::LeeWolbergShin)?;
+        assert!(mean.add_levels(&inputs, &p[..10]).is_err());
         let mut fs = FrameSums::default();
         fs.add(&p[..10])?;
         assert_eq!(
@@ -662,7 +976,8 @@ mod tests {
     }
 
     /// The MBA of `points` run the distributed way: a frame pass, then per
-    /// level the chunks' accumulators, merged by `tree`.
+    /// level the chunks' accumulators and pass sums, merged by `tree` (the
+    /// pass sums in chunk order), and the fitted start's last pass.
     fn chunked_mba(
         points: &[Point3],
         config: &MbaConfig,
@@ -674,18 +989,44 @@ mod tests {
             fs.add(c).unwrap();
         }
         let mut run = MbaLevels::new(fs.finish().unwrap(), config).unwrap();
-        for _ in 0..config.max_levels {
+        let pass = |run: &MbaLevels| {
+            let mut sums = PassSums::default();
+            for c in points.chunks(chunk) {
+                sums.merge(&pass_sums(&run.inputs(), c).unwrap());
+            }
+            sums
+        };
+        while !run.done() {
+            let mut sums = PassSums::default();
             let parts: Vec<BaAccumulator> = points
                 .chunks(chunk)
                 .map(|c| {
                     let mut a = run.accumulator().unwrap();
-                    a.add_residuals(&run.frame(), run.levels(), c).unwrap();
+                    sums.merge(&a.add_levels(&run.inputs(), c).unwrap());
                     a
                 })
                 .collect();
+            if run.record(&sums).unwrap() {
+                break;
+            }
             run.push(tree(parts)).unwrap();
         }
-        run.finish()
+        while run.needs_pass() {
+            let sums = pass(&run);
+            run.record(&sums).unwrap();
+        }
+        let last = pass(&run);
+        let mut r = run.finish();
+        // the last row: what the finished surface leaves (a measuring pass)
+        if let Some(rep) = r.reports.last_mut().filter(|x| x.residual.count == 0) {
+            let mut stats = ResidualSums::default();
+            for p in points {
+                stats.push(residual(&r.frame, &r.levels, p, r.frame.unit(p)).abs());
+            }
+            rep.residual = stats.stats();
+        }
+        assert!(last.count as usize == points.len());
+        r
     }
 
     fn left_fold(parts: Vec<BaAccumulator>) -> BaAccumulator {
@@ -723,80 +1064,152 @@ mod tests {
     }
 
     #[test]
-    fn streamed_chunks_in_order_give_the_one_call_lattice_bit_for_bit() {
+    fn streamed_chunks_in_order_give_the_one_call_lattice() {
         let p = cloud(40_000);
-        let config = MbaConfig {
-            max_levels: 6,
-            ..Default::default()
-        };
-        let streamed = |chunk: usize| {
-            let mut fs = FrameSums::default();
-            for c in p.chunks(chunk) {
-                fs.add(c).unwrap();
-            }
-            let mut run = MbaLevels::new(fs.finish().unwrap(), &config).unwrap();
-            for _ in 0..config.max_levels {
-                // one accumulator fed chunk after chunk (a file read in chunks)
-                let mut a = run.accumulator().unwrap();
-                for c in p.chunks(chunk) {
-                    a.add_residuals(&run.frame(), run.levels(), c).unwrap();
+        for start in [Start::Mean, Start::Fitted] {
+            let config = MbaConfig {
+                max_levels: 6,
+                start,
+                ..Default::default()
+            };
+            // one accumulator fed chunk after chunk (a file read in chunks)
+            let whole = chunked_mba(&p, &config, p.len(), left_fold);
+            for chunk in [1, 777, 16_384, 25_000] {
+                let streamed = |p: &[Point3]| {
+                    let mut fs = FrameSums::default();
+                    for c in p.chunks(chunk) {
+                        fs.add(c).unwrap();
+                    }
+                    let mut run = MbaLevels::new(fs.finish().unwrap(), &config).unwrap();
+                    while !run.done() {
+                        let mut a = run.accumulator().unwrap();
+                        let mut sums = PassSums::default();
+                        for c in p.chunks(chunk) {
+                            sums.merge(&a.add_levels(&run.inputs(), c).unwrap());
+                        }
+                        run.record(&sums).unwrap();
+                        run.push(a).unwrap();
+                    }
+                    while run.needs_pass() {
+                        let mut sums = PassSums::default();
+                        for c in p.chunks(chunk) {
+                            sums.merge(&pass_sums(&run.inputs(), c).unwrap());
+                        }
+                        run.record(&sums).unwrap();
+                    }
+                    run.finish()
+                };
+                let got = streamed(&p);
+                assert_eq!(got.frame, whole.frame, "chunk {chunk}");
+                if start == Start::Mean {
+                    assert_eq!(got.lattice, whole.lattice, "chunk {chunk}");
+                } else {
+                    // the BA sums bit for bit; the start `sum r c / sum c^2`
+                    // to the rounding of the chunks' partial sums
+                    let scale = whole.lattice.phi.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+                    let worst = got
+                        .lattice
+                        .phi
+                        .iter()
+                        .zip(&whole.lattice.phi)
+                        .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+                    assert!(worst <= 1e-14 * scale, "chunk {chunk}: {worst:e}");
                 }
-                run.push(a).unwrap();
             }
-            run.finish()
-        };
-        let whole = streamed(p.len());
-        for chunk in [1, 777, 16_384, 25_000] {
-            let got = streamed(chunk);
-            assert_eq!(got.frame, whole.frame, "chunk {chunk}");
-            assert_eq!(got.lattice, whole.lattice, "chunk {chunk}");
+            // the in-memory loop sums in cell order: the same lattice up to
+            // the rounding of the sums' order, and the same rows
+            let once = mba(&p, &config).unwrap();
+            let f = (once.frame, whole.frame);
+            assert_eq!(
+                (f.0.x0, f.0.y0, f.0.width, f.0.height),
+                (f.1.x0, f.1.y0, f.1.width, f.1.height)
+            );
+            assert!((f.0.z0 - f.1.z0).abs() <= 1e-14 * f.1.z0.abs().max(1.0));
+            let scale = whole.lattice.phi.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            let worst = once
+                .lattice
+                .phi
+                .iter()
+                .zip(&whole.lattice.phi)
+                .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+            assert!(worst <= 1e-12 * scale, "{start:?}: {worst:e} of {scale}");
+            assert_eq!(once.reports.len(), whole.reports.len());
+            for (a, b) in once.reports.iter().zip(&whole.reports) {
+                let (a, b) = (a.residual, b.residual);
+                assert_eq!((a.count, a.max_index), (b.count, b.max_index));
+                assert!((a.rmse - b.rmse).abs() <= 1e-10 * b.rmse, "{a:?} {b:?}");
+                assert!((a.max - b.max).abs() <= 1e-10 * b.max, "{a:?} {b:?}");
+            }
         }
-        // the in-memory loop sums in cell order: the same lattice up to the
-        // rounding of the sums' order
-        let once = mba(&p, &config).unwrap();
-        let f = (once.frame, whole.frame);
-        assert_eq!(
-            (f.0.x0, f.0.y0, f.0.width, f.0.height),
-            (f.1.x0, f.1.y0, f.1.width, f.1.height)
-        );
-        assert!((f.0.z0 - f.1.z0).abs() <= 1e-14 * f.1.z0.abs().max(1.0));
-        let scale = whole.lattice.phi.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        let worst = once
-            .lattice
-            .phi
-            .iter()
-            .zip(&whole.lattice.phi)
-            .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
-        assert!(worst <= 1e-12 * scale, "{worst:e} of {scale}");
     }
 
     #[test]
     fn merged_trees_give_the_one_call_lattice_to_1e12() {
         let p = cloud(30_000);
-        let config = MbaConfig {
+        let five = |start| MbaConfig {
             max_levels: 5,
+            start,
             ..Default::default()
         };
-        let once = mba(&p, &config).unwrap();
-        let scale = once.lattice.phi.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        assert!(scale > 1.0);
-        for chunk in [997, 5000, 16_384] {
-            for tree in [left_fold, balanced, right_fold] {
-                let got = chunked_mba(&p, &config, chunk, tree);
-                let worst = got
-                    .lattice
-                    .phi
-                    .iter()
-                    .zip(&once.lattice.phi)
-                    .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
-                assert!(
-                    worst <= 1e-12 * scale,
-                    "chunk {chunk}: {worst:e} of {scale}"
-                );
-                // and the levels too
-                assert_eq!(got.levels.len(), once.levels.len());
+        // a tolerance met after 3 levels of the fitted start
+        let full = mba(&p, &five(Start::Fitted)).unwrap();
+        let third = full.reports[2].residual.rmse * 1.0001;
+        for (start, tolerance) in [
+            (Start::Mean, None),
+            (Start::Fitted, None),
+            (Start::Fitted, Some(third)),
+        ] {
+            let config = MbaConfig {
+                max_levels: 5,
+                start,
+                tolerance,
+                ..Default::default()
+            };
+            let once = mba(&p, &config).unwrap();
+            let scale = once.lattice.phi.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            assert!(scale > 1.0);
+            if tolerance.is_some() {
+                assert_eq!(once.levels.len(), 3);
+            }
+            for chunk in [997, 5000, 16_384] {
+                for tree in [left_fold, balanced, right_fold] {
+                    let got = chunked_mba(&p, &config, chunk, tree);
+                    let worst = got
+                        .lattice
+                        .phi
+                        .iter()
+                        .zip(&once.lattice.phi)
+                        .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+                    assert!(
+                        worst <= 1e-12 * scale,
+                        "{start:?} chunk {chunk}: {worst:e} of {scale}"
+                    );
+                    // and the levels too
+                    assert_eq!(got.levels.len(), once.levels.len());
+                }
             }
         }
+    }
+
+    #[test]
+    fn the_pass_protocol_is_checked() {
+        let p = cloud(2000);
+        let mut run = MbaLevels::new(Frame::of(&p).unwrap(), &MbaConfig::default()).unwrap();
+        let mut a = run.accumulator().unwrap();
+        let s0 = a.add_levels(&run.inputs(), &p).unwrap();
+        run.record(&s0).unwrap();
+        run.push(a).unwrap();
+        // level 1 cannot be pushed before its pass is recorded
+        let mut b = run.accumulator().unwrap();
+        let s1 = b.add_levels(&run.inputs(), &p).unwrap();
+        assert!(run.push(b.clone()).is_err());
+        run.record(&s1).unwrap();
+        // nor recorded twice
+        assert!(run.record(&s1).is_err());
+        // sums of the mean start are not a fitted level
+        let mean = BaAccumulator::new(2, 2, ControlFormula::LeeWolbergShin).unwrap();
+        assert!(run.push(mean).is_err());
+        run.push(b).unwrap();
     }
 
     #[test]

@@ -942,7 +942,7 @@ pub(crate) fn bounding_box(points: &[Point3]) -> Option<(Point3, Point3)> {
 /// Fold-overs and stretch of the parameters as `config` asks (all zero
 /// when not measured), and the size of the sample they were taken on
 /// (`None` when over every point).
-fn parameterization(
+pub(crate) fn parameterization(
     surface: &Surface,
     points: &[Point3],
     uv: &[[f64; 2]],

@@ -18,7 +18,7 @@ use crate::bspline::Surface;
 use crate::mba::adjust::{knot_grid, lattice_grid_rmse, mba_adjusted, AdjustConfig};
 use crate::mba::{lattice_surface, mba, Frame, Lattice, MbaConfig};
 use crate::metrics::ErrorStats;
-use crate::pipeline::assess::{assess_cloud_eq17, AssessConfig, Assessment};
+use crate::pipeline::assess::{assess_cloud_eq17, AssessConfig, Assessment, Measure};
 use crate::progress::Progress;
 use crate::up_axis::UpAxis;
 use crate::{Error, PointCloud, Result};
@@ -67,7 +67,9 @@ pub struct LevelRow {
     /// Vertical residuals `|z - f(x, y)|` at the data points after the level
     /// (before any adjustment).
     pub vertical: ErrorStats,
-    /// Eq. 17 RMSE of the level's combined surface (before any adjustment).
+    /// Eq. 17 RMSE of the level's combined surface (before any adjustment;
+    /// 0, not measured, with [`crate::pipeline::assess::Measure::None`]
+    /// and no adjustment).
     pub grid_rmse: f64,
     /// The adjustment at this level, when it ran.
     pub adjusted: Option<AdjustedRow>,
@@ -211,7 +213,10 @@ fn run_centred(
         }
         None => {
             let r = mba(pts, &config.mba)?;
-            let rows = plain_rows(cloud, &r)?;
+            // eq. 17 per level needs a KD-tree of all points, which only the
+            // measuring builds anyway (at 10^7 points the tree costs more than
+            // the levels): not with `Measure::None`
+            let rows = plain_rows(cloud, &r, config.assess.measure != Measure::None)?;
             (r, rows)
         }
     };
@@ -242,8 +247,8 @@ fn run_centred(
 }
 
 /// The rows of a run without adjustment: eq. 17 of each level's combined
-/// lattice (the sum refined level by level).
-fn plain_rows(cloud: &PointCloud, r: &crate::mba::Mba) -> Result<Vec<LevelRow>> {
+/// lattice (the sum refined level by level; 0, not measured, without `eq17`).
+fn plain_rows(cloud: &PointCloud, r: &crate::mba::Mba, eq17: bool) -> Result<Vec<LevelRow>> {
     let mut rows = Vec::new();
     let mut total: Option<Lattice> = None;
     for (lat, rep) in r.levels.iter().zip(&r.reports) {
@@ -258,7 +263,11 @@ fn plain_rows(cloud: &PointCloud, r: &crate::mba::Mba) -> Result<Vec<LevelRow>> 
             level: rep.level,
             control_points: (rep.cells.0 + 3, rep.cells.1 + 3),
             vertical: rep.residual,
-            grid_rmse: lattice_grid_rmse(cloud, &r.frame, &t)?,
+            grid_rmse: if eq17 {
+                lattice_grid_rmse(cloud, &r.frame, &t)?
+            } else {
+                0.0
+            },
             adjusted: None,
             seconds: rep.seconds,
         });

@@ -8,8 +8,12 @@
 //!   attribute or the first of [`LABEL_NAMES`], negative and ignored ids out)
 //!   when it has one; a label that no patch of the model carries leaves its
 //!   points out (counted). Without a label attribute each point goes to the
-//!   patch nearest to it (nearest vertex of a 32 x 32 tessellation of every
-//!   patch).
+//!   patch at the smallest orthogonal distance among its candidates (as the
+//!   reconstruction measures a patch's points): the patches owning one of
+//!   the point's [`CANDIDATE_SAMPLES`] nearest samples of a 33 x 33 grid
+//!   over every face. The nearest sample alone would send a point near a
+//!   shared edge to the patch whose grid happens to be closer, not to the
+//!   surface it lies on, and overstate that patch's error.
 //! * **Per patch**: the PDE paper's eq. 15 errors `|P_i - S(u_i, v_i)|` at
 //!   the closest-point parameters on the Coons patch of the face's boundary
 //!   (§4.4, as the reconstruction computes them), and the orthogonal
@@ -26,12 +30,13 @@
 use rayon::prelude::*;
 
 use crate::base::CoonsPatch;
-use crate::bspline::{tessellate, Curve};
-use crate::metrics::{nearest_points, ErrorStats};
+use crate::bspline::Curve;
+use crate::metrics::ErrorStats;
 use crate::network::{coons_uv, read_labels, LabelConfig, LABEL_NAMES};
 use crate::pipeline::assess::{assess_projected, assess_surface, AssessConfig};
 use crate::pipeline::reconstruct::pooled;
 use crate::progress::Progress;
+use crate::project::{InversionConfig, InversionWorkspace, SurfaceInverter};
 use crate::topology::{Face, PatchComplex};
 use crate::{Error, Point3, PointCloud, Result};
 
@@ -65,7 +70,8 @@ impl Default for ModelMeasureConfig {
 pub enum Assignment {
     /// By the label attribute of this name.
     Labels(String),
-    /// Each point to its nearest patch (the cloud has no label).
+    /// Each point to the nearby patch at the smallest orthogonal distance
+    /// (the cloud has no label; see the module documentation).
     Nearest,
 }
 
@@ -167,24 +173,88 @@ fn assign(
         }
         return Ok((out, Assignment::Labels(l.attribute), left_out));
     }
-    let mut verts = Vec::new();
-    let mut face_of = Vec::new();
-    for (k, f) in model.faces.iter().enumerate() {
-        let m = tessellate(&f.surface, 32, 32);
-        face_of.extend(std::iter::repeat_n(k, m.vertices.len()));
-        verts.extend(m.vertices);
-    }
-    for (i, (v, _)) in nearest_points(&verts, cloud.points())?
+    for (i, k) in nearest_surface(model, cloud.points())?
         .into_iter()
         .enumerate()
     {
-        out[face_of[v]].push(i);
+        out[k].push(i);
     }
     Ok((out, Assignment::Nearest, 0))
 }
 
 /// The Coons patch of a face's boundary in the reconstruction's layout
 /// (domain `[0, 1]^2`, at most side 3 collapsed), or `None`.
+/// Nearest samples of a point whose faces are its candidates in
+/// [`nearest_surface`]: a point within a grid cell of a shared edge has
+/// samples of both faces among them (the edge's samples coincide).
+pub const CANDIDATE_SAMPLES: usize = 8;
+
+/// Intervals per direction of each face's sample grid in [`nearest_surface`].
+const SAMPLE_GRID: usize = 32;
+
+/// For each of `points`, the index of the face of `model` at the smallest
+/// orthogonal distance among its candidates (the faces owning one of its
+/// [`CANDIDATE_SAMPLES`] nearest samples on a grid over every face), each
+/// inverted from its nearest sample of that face.
+fn nearest_surface(model: &PatchComplex, points: &[Point3]) -> Result<Vec<usize>> {
+    let mut samples = Vec::new();
+    let mut at: Vec<(usize, [f64; 2])> = Vec::new();
+    for (k, f) in model.faces.iter().enumerate() {
+        let ((u0, u1), (v0, v1)) = f.surface.domain();
+        for i in 0..=SAMPLE_GRID {
+            for j in 0..=SAMPLE_GRID {
+                let t = i as f64 / SAMPLE_GRID as f64;
+                let uv = [
+                    u0 + (u1 - u0) * t,
+                    v0 + (v1 - v0) * j as f64 / SAMPLE_GRID as f64,
+                ];
+                samples.push(f.surface.point(uv[0], uv[1]));
+                at.push((k, uv));
+            }
+        }
+    }
+    let near = PointCloud::new(samples)?.knn_batch(points, CANDIDATE_SAMPLES)?;
+    let inverters: Vec<SurfaceInverter> = model
+        .faces
+        .iter()
+        .map(|f| SurfaceInverter::new(&f.surface, InversionConfig::default()))
+        .collect::<Result<_>>()?;
+    Ok(points
+        .par_iter()
+        .enumerate()
+        .map_init(
+            || -> Vec<InversionWorkspace<_>> {
+                model
+                    .faces
+                    .iter()
+                    .map(|f| InversionWorkspace::new(&f.surface))
+                    .collect()
+            },
+            |ws, (i, p)| {
+                // the candidates in order of their nearest sample, each once
+                let mut first: Vec<(usize, [f64; 2])> = Vec::with_capacity(near.k);
+                for &s in &near.indices[i * near.k..(i + 1) * near.k] {
+                    let (k, uv) = at[s as usize];
+                    if !first.iter().any(|c| c.0 == k) {
+                        first.push((k, uv));
+                    }
+                }
+                if first.len() == 1 {
+                    return first[0].0;
+                }
+                first
+                    .iter()
+                    .map(|&(k, uv)| (k, inverters[k].invert_near(p, uv, &mut ws[k]).distance))
+                    .fold(
+                        (first[0].0, f64::INFINITY),
+                        |b, c| if c.1 < b.1 { c } else { b },
+                    )
+                    .0
+            },
+        )
+        .collect())
+}
+
 fn coons_of(f: &Face) -> Result<Option<CoonsPatch>> {
     let ((u0, u1), (v0, v1)) = f.surface.domain();
     if (u0, u1, v0, v1) != (0.0, 1.0, 0.0, 1.0) || (0..3).any(|k| f.sides[k].is_empty()) {

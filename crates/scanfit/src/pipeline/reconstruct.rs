@@ -23,6 +23,7 @@ use crate::network::{
     build_network, fit_face, group_sides, side_curve, side_ranges, FaceConfig, FaceFit,
     FaceSurface, NetUse, Network, NetworkConfig,
 };
+use crate::pipeline::assess::{bounding_box, extent_in_box, sample_grid, AssessConfig, Extent};
 use crate::progress::Progress;
 use crate::project::InversionConfig;
 use crate::topology::{self, PatchComplex};
@@ -58,6 +59,14 @@ pub struct ReconstructConfig {
     /// named (by label), e.g. a denser control net where the data carry more
     /// detail (default none).
     pub patch_fit: Vec<(i64, FaceFit)>,
+    /// Return the model even when a patch leaves its data (default `false`:
+    /// [`run`] fails with [`Error::LeavesData`] naming the first such patch).
+    /// Each patch's surface is sampled on the grid of
+    /// [`AssessConfig::samples`] and measured against the bounding box of
+    /// the patch's own points, with the single-patch commands' limit: the
+    /// larger of [`AssessConfig::leave_spacings`] point spacings and
+    /// [`AssessConfig::leave_diagonal`] x the patch's diagonal.
+    pub allow_extrapolation: bool,
 }
 
 impl Default for ReconstructConfig {
@@ -70,6 +79,7 @@ impl Default for ReconstructConfig {
             tolerance: None,
             edge_samples: 65,
             patch_fit: Vec::new(),
+            allow_extrapolation: false,
         }
     }
 }
@@ -95,6 +105,9 @@ pub struct PatchReport {
     pub conversion_deviation: f64,
     /// Points whose parameters fold over ([`crate::network::folds`]).
     pub fold_overs: usize,
+    /// How far its surface reaches outside the bounding box of its own
+    /// points (see [`ReconstructConfig::allow_extrapolation`]).
+    pub extent: Extent,
 }
 
 /// One edge of the result.
@@ -376,9 +389,18 @@ fn run_centred(
                 orthogonal: f.orthogonal,
                 conversion_deviation: f.conversion_deviation,
                 fold_overs: fold_overs(&pts, &f.uv, &f.surface)?,
+                extent: patch_extent(&f.surface, &pts, network.spacing)?,
             })
         })
         .collect::<Result<_>>()?;
+    if !cfg.allow_extrapolation {
+        if let Some(p) = patches.iter().find(|p| p.extent.leaves) {
+            return Err(Error::LeavesData {
+                patch: Some(p.id),
+                extent: p.extent,
+            });
+        }
+    }
     let totals = Totals {
         errors: pooled(patches.iter().map(|p| &p.errors)),
         orthogonal: pooled(patches.iter().map(|p| &p.orthogonal)),
@@ -418,6 +440,18 @@ fn run_centred(
         layout,
         complex,
     })
+}
+
+/// The [`Extent`] of one patch's `surface` against the bounding box of its
+/// own `points` (sampled and limited as a single-patch fit's, with the
+/// network's median `spacing`).
+fn patch_extent(surface: &Surface, points: &[Point3], spacing: f64) -> Result<Extent> {
+    let config = AssessConfig::default();
+    let Some(b) = bounding_box(points) else {
+        return Ok(Extent::default());
+    };
+    let (_, samples) = sample_grid(surface, &config)?;
+    Ok(extent_in_box(surface, b, &samples, spacing, &config))
 }
 
 /// The network and the faces as a [`PatchComplex`] (see

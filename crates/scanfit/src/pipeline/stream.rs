@@ -6,18 +6,20 @@
 //! chunks, always in the same order. The fits go through the same
 //! accumulators as the in-memory pipelines ([`crate::mba::BaAccumulator`],
 //! [`crate::fit::surface::NormalEquations`]), fed chunk after chunk in file order, so the surface
-//! is the in-memory one: `fit`'s **bit for bit**, `mba`'s to 1e-12 of the largest control value
+//! is the in-memory one: `fit`'s **bit for bit** with given parameters and uniform knots (to 1e-12
+//! with the plane, distribution knots or correction), `mba`'s to 1e-12 of the largest control value
 //! (the in-memory MBA sums the points in lattice-cell order, [`crate::mba::mba`]):
 //!
 //! * [`mba`]: one pass for the frame ([`FrameSums`]), one per level
-//!   (residuals after the levels so far, [LWS97] eqs. 3-4), one to measure.
-//! * [`fit`]: parameters per point from two attributes (`u`, `v`); one pass
-//!   for the normal equations ([NURBS97] eq. 9.63 with uniform knots), one to
-//!   measure. Settings that need all points at once are refused with the
-//!   reason: knots from the parameter distribution (eq. 9.69 sorts all
-//!   parameters), parameters from the best-fit plane (the plane's minimum-area
-//!   rectangle is not implemented as a streamed pass yet), parameter correction
-//!   (re-projects every point per round).
+//!   (residuals after the levels so far, [LWS97] eqs. 3-4), with the fitted
+//!   start ([`crate::mba::Start::Fitted`], the default) one for the last
+//!   level's start, one to measure (and eq. 17 of every level's surface).
+//! * [`fit`] (in `stream/fit.rs`): every setting of the in-memory fit as
+//!   passes of mergeable sums: the best-fit plane (covariance, convex hull,
+//!   extents), the distribution knots (eq. 9.69, rounds of histograms), the
+//!   normal equations ([NURBS97] eq. 9.63), the parameter correction (each
+//!   round re-projects the points onto the accepted surfaces in turn), one
+//!   pass to measure; the surface equals the in-memory one to 1e-12.
 //!
 //! The report is measured by streaming too ([`StreamAssessor`]): errors at
 //! the parameters and orthogonal distances over every point; [MBA18] eq. 17
@@ -33,21 +35,24 @@ use rayon::prelude::*;
 
 use crate::bspline::Surface;
 use crate::centring::Centring;
+use crate::mba::sums::{pass_sums, residual};
 use crate::mba::{
-    lattice_surface, sums::residual, FrameSums, Lattice, MbaConfig, MbaLevels, ResidualSums,
+    lattice_surface, FrameSums, Lattice, MbaConfig, MbaLevels, PassSums, ResidualSums,
 };
 use crate::metrics::ParamQuality;
 use crate::pipeline::assess::{
     per_point_sums, AssessConfig, Extent, Measure, SampleDistances, SurfaceQuality,
 };
 use crate::pipeline::mba::LevelRow;
-use crate::pipeline::surface_fit::{FitConfig, ParameterSource};
 use crate::progress::Progress;
 use crate::project::power_form::PowerForm;
 use crate::project::{InversionWorkspace, SurfaceInverter};
 use crate::spatial::KdTree;
 use crate::up_axis::UpAxis;
 use crate::{Error, Point3, PointCloud, Result};
+
+mod fit;
+pub use fit::{fit, StreamedFit};
 
 /// A chunk of points: positions and, when the source was asked for them,
 /// parameters.
@@ -215,7 +220,8 @@ pub struct StreamedMba {
 /// let worst = r.surface.control_points().iter().zip(want.control_points())
 ///     .map(|(a, b)| (a.z - b.z).abs()).fold(0.0, f64::max);
 /// assert!(worst < 1e-12);
-/// assert_eq!(r.passes, 7); // bounding box, frame, 4 levels, measures
+/// // bounding box, frame, 4 levels, the fitted start of the last, measures
+/// assert_eq!(r.passes, 8);
 /// # Ok::<(), scanfit::Error>(())
 /// ```
 pub fn mba(
@@ -241,9 +247,6 @@ pub fn mba(
     let frame = frame_sums.finish()?;
     let mut run = MbaLevels::new(frame, config)?;
     let mut passes = 2;
-    let mut grid_rmse = Vec::new();
-    // the residual statistics of a level come from the pass after it
-    let mut recorded = true;
     while !run.done() {
         progress.stage(
             &format!(
@@ -256,28 +259,29 @@ pub fn mba(
             None,
         );
         let mut acc = run.accumulator()?;
-        let mut stats = ResidualSums::default();
-        let mut grid = run
-            .levels()
-            .last()
-            .map(|_| NearestSums::new(level_grid(&run)));
+        let mut sums = PassSums::default();
+        let inputs = run.inputs();
         source.pass(&mut |c| {
-            stats.merge(&acc.add_residuals(&frame, run.levels(), c.points)?);
-            if let Some(g) = grid.as_mut() {
-                g.add(c.points)?;
-            }
+            sums.merge(&acc.add_levels(&inputs, c.points)?);
             Ok(())
         })?;
         passes += 1;
-        if let Some(g) = grid {
-            grid_rmse.push(g.rmse());
-            recorded = true;
-            if run.record_residual(stats.stats()) {
-                break;
-            }
+        if run.record(&sums)? {
+            break;
         }
         run.push(acc)?;
-        recorded = false;
+    }
+    // the fitted start of the last level: one more pass
+    while run.needs_pass() {
+        progress.stage(&format!("pass {}: the start", passes + 1), None);
+        let mut sums = PassSums::default();
+        let inputs = run.inputs();
+        source.pass(&mut |c| {
+            sums.merge(&pass_sums(&inputs, c.points)?);
+            Ok(())
+        })?;
+        passes += 1;
+        run.record(&sums)?;
     }
     let result = run.finish();
     let surface = lattice_surface(&result.frame, &result.lattice)?;
@@ -286,7 +290,9 @@ pub fn mba(
     let mut assessor = StreamAssessor::new(&surface, assess)?;
     let mut vertical = ResidualSums::default();
     let mut last = ResidualSums::default();
-    let mut grid = NearestSums::new(crate::mba::adjust::knot_grid(&frame, &result.lattice));
+    // eq. 17 of every level's combined lattice (the last: the surface's)
+    let (queries, ends) = level_grids(&result)?;
+    let mut grid = NearestSums::new(queries);
     source.pass(&mut |c| {
         let uv: Vec<[f64; 2]> = c.points.par_iter().map(|p| frame.unit(p)).collect();
         let (v, l) = vertical_sums(&surface, &frame, &result.levels, c.points, &uv);
@@ -297,16 +303,21 @@ pub fn mba(
         assessor.add_tree(&tree, &uv)
     })?;
     passes += 1;
+    let grid_rmse: Vec<f64> = ends
+        .iter()
+        .scan(0, |start, &end| {
+            let d = &grid.distances()[*start..end];
+            *start = end;
+            Some((d.iter().map(|x| x * x).sum::<f64>() / d.len().max(1) as f64).sqrt())
+        })
+        .collect();
     let mut reports = result.reports;
-    if !recorded {
-        if let Some(r) = reports.last_mut() {
-            r.residual = last.stats();
-        }
-        grid_rmse.push(grid.rmse());
+    if let Some(r) = reports.last_mut().filter(|r| r.residual.count == 0) {
+        r.residual = last.stats();
     }
     let mut quality = assessor.finish();
     quality.at_parameters = vertical.stats();
-    quality.grid_rmse = grid.rmse();
+    quality.grid_rmse = grid_rmse.last().copied().unwrap_or(0.0);
     let levels = reports
         .iter()
         .zip(&grid_rmse)
@@ -336,137 +347,25 @@ pub fn mba(
     })
 }
 
-/// The knot grid of the combined lattice of the levels of `run` so far.
-fn level_grid(run: &MbaLevels) -> Vec<Point3> {
+/// The knot grids of the combined lattice of each level of `r` (the sum of
+/// its levels so far, refined), one after the other, and where each ends.
+fn level_grids(r: &crate::mba::Mba) -> Result<(Vec<Point3>, Vec<usize>)> {
+    let (mut queries, mut ends) = (Vec::new(), Vec::new());
     let mut total: Option<Lattice> = None;
-    for l in run.levels() {
-        total = Some(match total {
+    for l in &r.levels {
+        let t = match total.take() {
             None => l.clone(),
             Some(t) => {
-                let mut t = t.refine().unwrap_or_else(|_| l.clone());
-                if t.add(l).is_err() {
-                    t = l.clone();
-                }
+                let mut t = t.refine()?;
+                t.add(l)?;
                 t
             }
-        });
+        };
+        queries.extend(crate::mba::adjust::knot_grid(&r.frame, &t));
+        ends.push(queries.len());
+        total = Some(t);
     }
-    total.map_or_else(Vec::new, |t| {
-        crate::mba::adjust::knot_grid(&run.frame(), &t)
-    })
-}
-
-/// What [`fit`] returns.
-#[derive(Debug, Clone, PartialEq)]
-#[non_exhaustive]
-pub struct StreamedFit {
-    /// The fitted surface (as the in-memory pipeline's).
-    pub surface: Surface,
-    /// Passes made over the points.
-    pub passes: usize,
-    /// The thin-plate weight used (after the pipeline's scaling rule).
-    pub smoothing: f64,
-    /// The streamed measures (see the module documentation).
-    pub quality: SurfaceQuality,
-}
-
-/// The least-squares surface of the points of `source` (parameters from
-/// attributes, uniform knots; see the module documentation for what is
-/// refused); the surface equals [`crate::pipeline::surface_fit::run`]'s.
-///
-/// ```
-/// use scanfit::fit::surface::KnotPlacement;
-/// use scanfit::pipeline::stream::{fit, SliceSource};
-/// use scanfit::pipeline::surface_fit::{FitConfig, ParameterSource};
-/// use scanfit::progress::NoProgress;
-/// use scanfit::Point3;
-///
-/// let (mut p, mut uv) = (Vec::new(), Vec::new());
-/// for k in 0..3000 {
-///     let (u, v) = ((k % 60) as f64 / 59.0, (k / 60) as f64 / 49.0);
-///     p.push(Point3::new(u, v, (2.0 * u).sin() * v));
-///     uv.push([u, v]);
-/// }
-/// let mut cfg = FitConfig::bare((8, 8));
-/// cfg.params = ParameterSource::uv_attributes();
-/// cfg.fit.knots = KnotPlacement::Uniform;
-/// let mut source = SliceSource { points: &p, uv: Some(&uv), chunk: 1000 };
-/// let r = fit(&mut source, &cfg, &NoProgress)?;
-/// let once = scanfit::fit::surface::fit_surface(&p, &uv, &cfg.fit)?;
-/// assert_eq!(r.surface, once);
-/// assert!(r.quality.at_parameters.max < 1e-3);
-/// # Ok::<(), scanfit::Error>(())
-/// ```
-pub fn fit(
-    source: &mut dyn PointSource,
-    config: &FitConfig,
-    progress: &dyn Progress,
-) -> Result<StreamedFit> {
-    check_fit(config)?;
-    let (centring, count) = centring_pass(source, None)?;
-    let source = &mut Centred {
-        source,
-        centring,
-        up: UpAxis::Z,
-    };
-    let fit_config = config.resolved_fit(count);
-    let mut eq = fit_config.uniform_equations()?;
-    let (cu, cv) = fit_config.ctrl;
-    progress.stage(
-        &format!("pass 1: normal equations of {cu} x {cv} control points"),
-        None,
-    );
-    source.pass(&mut |c| {
-        let uv = chunk_uv(&c)?;
-        eq.add(c.points, uv, None)
-    })?;
-    let surface = eq.finish(fit_config.smoothing)?;
-    progress.stage("pass 2: measuring", None);
-    let mut assessor = StreamAssessor::new(&surface, &config.assess)?;
-    source.pass(&mut |c| assessor.add(c.points, chunk_uv(&c)?))?;
-    Ok(StreamedFit {
-        quality: assessor.finish(),
-        surface: centring.restore(surface),
-        passes: 3,
-        smoothing: fit_config.smoothing,
-    })
-}
-
-/// Refuses the settings of `config` that need all points at once (with the
-/// reason): parameters from the best-fit plane and parameter correction.
-/// Knots from the parameter distribution are refused when the equations
-/// are made ([`crate::fit::surface::SurfaceFitConfig::uniform_equations`]).
-/// Drivers of their own (a cluster) call it before the first pass.
-///
-/// ```
-/// use scanfit::pipeline::stream::check_fit;
-/// use scanfit::pipeline::surface_fit::{FitConfig, ParameterSource};
-/// let mut cfg = FitConfig::default();
-/// assert!(check_fit(&cfg).is_err()); // the plane needs the whole cloud
-/// cfg.params = ParameterSource::uv_attributes();
-/// assert!(check_fit(&cfg).is_ok());
-/// ```
-pub fn check_fit(config: &FitConfig) -> Result<()> {
-    let refuse = |setting: &'static str, value: String, why: &str| Error::InvalidSetting {
-        setting,
-        value,
-        hint: format!("{why}; points read in chunks need settings computable per point"),
-    };
-    if config.params == ParameterSource::Plane {
-        return Err(refuse(
-            "params",
-            "plane".into(),
-            "parameters from the best-fit plane need the whole cloud (its minimum-area rectangle); give the parameters as u and v columns",
-        ));
-    }
-    if config.correction_rounds > 0 {
-        return Err(refuse(
-            "correction_rounds",
-            config.correction_rounds.to_string(),
-            "parameter correction re-projects every point in each round and keeps their parameters; leave it out",
-        ));
-    }
-    Ok(())
+    Ok((queries, ends))
 }
 
 /// The parameters of a chunk, an error when the source gave none.
@@ -785,7 +684,8 @@ mod tests {
                 assert_eq!((a.x, a.y), (b.x, b.y), "chunk {chunk}");
                 assert!((a.z - b.z).abs() <= 1e-12 * scale, "chunk {chunk}");
             }
-            assert_eq!(r.passes, 8);
+            // bounding box, frame, 5 levels, the last start (fitted), measures
+            assert_eq!(r.passes, 9);
             let (a, b) = (r.quality, once.assessment.quality);
             let close = |x: f64, y: f64| (x - y).abs() <= 1e-10 * y.abs().max(1e-300);
             assert!(
@@ -859,7 +759,8 @@ mod tests {
     }
 
     #[test]
-    fn streamed_fit_equals_the_in_memory_pipeline_and_refuses_what_needs_all_points() {
+    fn streamed_fit_equals_the_in_memory_pipeline_with_every_setting() {
+        use crate::pipeline::surface_fit::{FitConfig, ParameterSource};
         let p = terrain(12_000);
         let uv: Vec<[f64; 2]> = p
             .iter()
@@ -886,32 +787,74 @@ mod tests {
             chunk: 5000,
         };
         let r = fit(&mut s, &cfg, &NoProgress).unwrap();
+        // given parameters and uniform knots: the same sums in the same order
         assert_eq!(r.surface, once.surface);
+        assert_eq!(r.passes, 3);
         let (a, b) = (r.quality, once.assessment.quality);
         assert!(
             (a.at_parameters.rmse - b.at_parameters.rmse).abs() <= 1e-12 * b.at_parameters.rmse
         );
         assert_eq!(a.at_parameters.max, b.at_parameters.max);
         assert_eq!(a.grid_rmse, b.grid_rmse);
-        // refused, with the setting named
-        for bad in [
-            FitConfig {
-                params: ParameterSource::Plane,
-                ..cfg.clone()
-            },
-            FitConfig {
-                correction_rounds: 2,
-                ..cfg.clone()
-            },
+        // the plane, the distribution knots and the correction: more passes,
+        // the in-memory surface to the rounding of the sums
+        let close = |a: &Surface, b: &Surface| {
+            assert_eq!(a.knots_u().as_slice().len(), b.knots_u().as_slice().len());
+            for (x, y) in [(a.knots_u(), b.knots_u()), (a.knots_v(), b.knots_v())] {
+                for (s, t) in x.as_slice().iter().zip(y.as_slice()) {
+                    assert!((s - t).abs() <= 1e-12, "knots {s} {t}");
+                }
+            }
+            let scale = b
+                .control_points()
+                .iter()
+                .fold(0.0f64, |m, q| m.max(q.coords.abs().max()));
+            for (x, y) in a.control_points().iter().zip(b.control_points()) {
+                assert!((x - y).norm() <= 1e-12 * scale, "{x} {y}");
+            }
+        };
+        for (params, knots, rounds, passes) in [
+            // bounding box, plane x3, knots x2, equations, measure
+            (ParameterSource::Plane, KnotPlacement::Distribution, 0, 8),
+            (
+                ParameterSource::uv_attributes(),
+                KnotPlacement::Distribution,
+                0,
+                5,
+            ),
+            // plus the errors pass per fit, and a fit per round
+            (
+                ParameterSource::uv_attributes(),
+                KnotPlacement::Uniform,
+                2,
+                0,
+            ),
+            (ParameterSource::Plane, KnotPlacement::Distribution, 2, 0),
         ] {
-            assert!(matches!(
-                fit(&mut s, &bad, &NoProgress).unwrap_err(),
-                Error::InvalidSetting { .. }
-            ));
+            let mut c = cfg.clone();
+            c.params = params;
+            c.fit.knots = knots;
+            c.correction_rounds = rounds;
+            let once = surface_fit::run(&cloud, &c, &NoProgress).unwrap();
+            let r = fit(&mut s, &c, &NoProgress).unwrap();
+            close(&r.surface, &once.surface);
+            assert_eq!(r.rounds.len(), once.rounds.len());
+            for (x, y) in r.rounds.iter().zip(&once.rounds) {
+                assert!((x.errors.rmse - y.errors.rmse).abs() <= 1e-12 * y.errors.rmse);
+            }
+            if passes > 0 {
+                assert_eq!(r.passes, passes);
+            } else {
+                assert!(r.rounds.len() >= 2, "{:?}", r.rounds);
+            }
         }
+        // a plane cannot close around u
         let mut bad = cfg.clone();
-        bad.fit.knots = KnotPlacement::Distribution;
-        let e = fit(&mut s, &bad, &NoProgress).unwrap_err().to_string();
-        assert!(e.contains("9.69"), "{e}");
+        bad.params = ParameterSource::Plane;
+        bad.fit.periodic_u = true;
+        assert!(matches!(
+            fit(&mut s, &bad, &NoProgress).unwrap_err(),
+            Error::InvalidSetting { .. }
+        ));
     }
 }

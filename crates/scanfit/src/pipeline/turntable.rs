@@ -63,7 +63,9 @@ pub struct TurntableConfig {
     pub turntable: crate::base::turntable::TurntableConfig,
     /// Compare the weight factors on the same layer curves (default: no).
     pub compare_weights: Option<WeightComparison>,
-    /// The assessment of the fitted surface.
+    /// The assessment of the fitted surface; its `measure`, `sample_points`
+    /// and `seed` also decide how the turntable measures the fold-overs and
+    /// stretch of the parameters (replacing `turntable.quality`).
     pub assess: AssessConfig,
 }
 
@@ -182,7 +184,12 @@ fn run_centred(
             });
         }
     }
-    let cfg = &config.turntable;
+    // the turntable measures the fold-overs and stretch of the parameters
+    // as the assessment asks (sampled, full or not at all)
+    let cfg = &crate::base::turntable::TurntableConfig {
+        quality: config.assess,
+        ..config.turntable.clone()
+    };
     let t = turntable(cloud, cfg, &mut |i| {
         progress.stage(STAGES.get(i).copied().unwrap_or("turntable"), None);
         progress.advance(1);
@@ -213,6 +220,9 @@ fn run_centred(
         },
     )?;
     assessment.quality.parameterization = t.quality;
+    if let (Some(s), Some(count)) = (assessment.sample.as_mut(), t.quality_sample) {
+        s.parameterization_points = count;
+    }
     if fp.len() < cloud.len() {
         // eq. 17 (surface to points) over the whole cloud, as the points
         // beyond the end layers are data the surface's end rows approach
@@ -307,5 +317,45 @@ mod tests {
         assert!(cmp
             .iter()
             .all(|w| w.rmse.len() == 3 && w.rmse[0] == cmp[0].rmse[0]));
+    }
+
+    #[test]
+    fn the_fold_over_measures_follow_the_assessments_measure() {
+        use crate::metrics::parameterization_quality;
+        use crate::pipeline::assess::Measure;
+        let cloud = cup();
+        let mut cfg = TurntableConfig::default();
+        cfg.turntable.fit.ctrl = (16, 10);
+        cfg.turntable.layers.layers = 16;
+        cfg.assess.measure = Measure::Full;
+        let full = run(&cloud, &cfg, &NoProgress).unwrap();
+        let t = &full.turntable;
+        assert_eq!(t.quality_sample, None);
+        // over every fitted point: the Delaunay measure of all their parameters
+        let (fp, fuv) = full.fitted_points(&cloud);
+        assert_eq!(
+            t.quality,
+            parameterization_quality(&t.surface, &fp, &fuv).unwrap()
+        );
+        assert!(t.quality.triangles > fp.len());
+        // above `sample_points` fitted points: a cluster sample, reported
+        cfg.assess.measure = Measure::Sample;
+        cfg.assess.sample_points = 1000;
+        let sampled = run(&cloud, &cfg, &NoProgress).unwrap();
+        let s = &sampled.turntable;
+        let count = s.quality_sample.unwrap();
+        assert!(count > 100 && count < fp.len(), "{count}");
+        assert_eq!(
+            sampled.assessment.sample.unwrap().parameterization_points,
+            count
+        );
+        assert!(s.quality.triangles > 0 && s.quality.triangles < t.quality.triangles);
+        // the surface and the parameters do not depend on what is measured
+        assert_eq!(s.surface, t.surface);
+        assert_eq!(s.uv, t.uv);
+        cfg.assess.measure = Measure::None;
+        let none = run(&cloud, &cfg, &NoProgress).unwrap();
+        assert_eq!(none.turntable.quality.triangles, 0);
+        assert_eq!(none.turntable.surface, t.surface);
     }
 }

@@ -34,7 +34,8 @@ pub use views::{layer_polygon, turntable_views, View, ViewConfig};
 use crate::bspline::Surface;
 use crate::cloud::PointCloud;
 use crate::fit::surface::{fit_surface, SurfaceFitConfig};
-use crate::metrics::{parameterization_quality, ErrorStats, ParamQuality};
+use crate::metrics::{ErrorStats, ParamQuality};
+use crate::pipeline::assess::{parameterization, AssessConfig};
 use crate::project::{InversionConfig, SurfaceInverter};
 use crate::{Error, Point3, Result};
 
@@ -60,6 +61,15 @@ pub struct TurntableConfig {
     /// applies), [`ends::end_shapes`] (default true); false: the margin at
     /// both ends.
     pub detect_open_ends: bool,
+    /// How the fold-overs and stretch of the parameters are measured: the
+    /// `parameterization`, `measure`, `sample_points` and `seed` of
+    /// [`AssessConfig`] (default: on a cluster sample above
+    /// [`DEFAULT_SAMPLE_POINTS`](crate::pipeline::assess::DEFAULT_SAMPLE_POINTS)
+    /// points, as every surface command; [`Measure::Full`](crate::pipeline::assess::Measure::Full):
+    /// a Delaunay triangulation of all parameters).
+    /// [`pipeline::turntable`](crate::pipeline::turntable) sets it from its
+    /// `assess`.
+    pub quality: AssessConfig,
 }
 
 /// The points beyond the first and last layer (the ends of the cloud: the
@@ -96,6 +106,7 @@ impl Default for TurntableConfig {
             inversion: InversionConfig::default(),
             ends: Ends::Exclude,
             detect_open_ends: true,
+            quality: AssessConfig::default(),
         }
     }
 }
@@ -185,6 +196,9 @@ pub struct Turntable {
     /// of 56 000 triangles, depending on the layer count). On the fitted
     /// surface itself they cannot (0 in every case measured).
     pub quality_fitted: ParamQuality,
+    /// Points of the cluster sample the fold-overs and stretch were measured
+    /// on (`None`: on every point), [`TurntableConfig::quality`].
+    pub quality_sample: Option<usize>,
 }
 
 /// Runs the whole pipeline; `stage(i)` is called as stage `i` of [`STAGES`] starts.
@@ -328,18 +342,17 @@ pub fn turntable(
         .filter(|(_, &m)| m)
         .map(|(t, _)| *t)
         .collect();
-    let (quality, quality_fitted) = rayon::join(
-        || parameterization_quality(&surface, &fp, &fuv),
-        || parameterization_quality(&surface, &fp, &fuv2),
+    let ((quality, quality_sample), (quality_fitted, _)) = rayon::join(
+        || parameterization(&surface, &fp, &fuv, &cfg.quality),
+        || parameterization(&surface, &fp, &fuv2, &cfg.quality),
     );
-    let (quality, quality_fitted) = (quality?, quality_fitted?);
     // with Ends::Exclude the fitted points are the inside ones: the same
     // measure on the same points (measured once)
     let quality_inside = if inside == fitted_points {
         quality
     } else {
         let (pin, uvin) = subset(&inside);
-        parameterization_quality(&surface, &pin, &uvin)?
+        parameterization(&surface, &pin, &uvin, &cfg.quality).0
     };
     Ok(Turntable {
         frame,
@@ -361,6 +374,7 @@ pub fn turntable(
         errors,
         errors_all,
         quality,
+        quality_sample,
         quality_inside,
         uv_fitted,
         quality_fitted,

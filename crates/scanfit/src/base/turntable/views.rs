@@ -26,7 +26,7 @@ use std::f64::consts::PI;
 use rayon::prelude::*;
 
 use crate::cloud::hpr::{hidden_point_removal, HprConfig};
-use crate::mba::{mba, Mba, MbaConfig};
+use crate::mba::{mba, Mba, MbaConfig, Start};
 use crate::{Error, Point3, Result, Vector3};
 
 use super::axis::CylinderFrame;
@@ -42,7 +42,7 @@ pub struct ViewConfig {
     /// Hidden point removal (default `gamma = 2`, see [`HprConfig`]).
     pub hpr: HprConfig,
     /// Multilevel B-splines on each view (default: 6 levels from the
-    /// aspect-ratio base lattice, eq. 4 of [LWS97]).
+    /// aspect-ratio base lattice, eq. 4 of [LWS97], from the mean height).
     pub mba: MbaConfig,
     /// Grid points per layer and view (`u` count; default 32). The base
     /// surface gets about `0.7 V` times as many samples around the axis;
@@ -59,7 +59,13 @@ impl Default for ViewConfig {
             views: 4,
             view_distance: 4.0,
             hpr: HprConfig::default(),
-            mba: MbaConfig::default(),
+            // the views' settings (grid, fold-overs) were measured with the
+            // mean start; the fitted start (MBA's default since issue 18) is
+            // not measured on the turntable yet
+            mba: MbaConfig {
+                start: Start::Mean,
+                ..MbaConfig::default()
+            },
             grid_u: 32,
         }
     }
