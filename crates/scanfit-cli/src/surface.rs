@@ -334,13 +334,16 @@ fn loops_of(projection: Option<&Projection>) -> Loops<'static> {
 /// smoothing (0.5%: noise at the borders stays below it).
 const FOLDED_SHARE: f64 = 0.005;
 
-/// What to change when the surface leaves the data: the parameters when
-/// they fold over, else the smoothing or the net.
+/// What to change when the surface leaves the data: the smoothing or the
+/// net, and, when the parameters fold over too, the parameters (a noisy
+/// scan's sparse outline can fold a few triangles and still be cured by the
+/// smoothing, so the smoothing advice stays).
 fn leaves_fix(q: &SurfaceQuality, projection: Option<&Projection>) -> String {
     let pq = &q.parameterization;
     let share = pq.fold_overs as f64 / pq.triangles.max(1) as f64;
+    let smoothing = "raise the smoothing (--smooth; by default it is scaled to the data) or use fewer control points (--ctrl)";
     if share <= FOLDED_SHARE {
-        return "raise the smoothing (--smooth; by default it is scaled to the data) or use fewer control points (--ctrl)".into();
+        return smoothing.into();
     }
     let tried = match projection {
         Some(p) => format!(
@@ -350,7 +353,7 @@ fn leaves_fix(q: &SurfaceQuality, projection: Option<&Projection>) -> String {
         None => String::new(),
     };
     format!(
-        "the parameters fold over: {} of {} triangles ({:.1}%){tried}, so no smoothing helps; give parameters that do not fold (--params uv-columns), or use `scanfit mba` for a height field, `scanfit coons` or `scanfit turntable` for a closed or overhanging shape",
+        "{smoothing}; the parameters also fold over in {} of {} triangles ({:.1}%){tried}: if that persists, give parameters that do not fold (--params uv-columns), or use `scanfit mba` for a height field, `scanfit coons` or `scanfit turntable` for a closed or overhanging shape",
         pq.fold_overs,
         pq.triangles,
         100.0 * share
