@@ -13,8 +13,7 @@ pub use coons::{
 pub use coons_cloud::{coons_from_cloud, CoonsFromCloud, CoonsFromCloudConfig};
 pub use coons_param::{coons_parameters, CoonsParamConfig, CoonsParameters, CoonsProjection};
 pub use plane::{
-    choose_projection, plane_frame, plane_parameters, FlatHull, PlaneAxes, PlaneExtents,
-    PlaneFrame, PlaneMap, PlaneParameterization, Projection, ProjectionAxis, FOLD_MARGIN,
-    FOLD_MIN_POINTS, FOLD_SAMPLE, FOLD_SEED,
+    plane_frame, plane_parameters, FlatHull, PlaneAxes, PlaneExtents, PlaneFrame, PlaneMap,
+    PlaneParameterization,
 };
 pub mod turntable;
