@@ -798,6 +798,8 @@ fn read_ascii(
 
 #[cfg(test)]
 mod tests {
+    /// Tests return errors instead of unwrapping them.
+    type TestResult = std::result::Result<(), Box<dyn std::error::Error>>;
     use super::*;
     use crate::table::NonFinite;
 
@@ -878,7 +880,7 @@ mod tests {
     }
 
     #[test]
-    fn binary_with_lists_before_and_in_the_vertex_element() {
+    fn binary_with_lists_before_and_in_the_vertex_element() -> TestResult {
         for big in [false, true] {
             let mut b = binary(big, "int8");
             let put = |b: &mut Vec<u8>, label: u8, x: f32, junk: &[i8], y: f64, z: f32| {
@@ -908,7 +910,7 @@ mod tests {
             };
             put(&mut b, 7, 1.5, &[1, 2, 3], -2.25, 1e-3);
             put(&mut b, 255, -0.5, &[], 1e300, 3.0);
-            let t = read(&b).unwrap();
+            let t = read(&b)?;
             assert_eq!(
                 t.points,
                 vec![
@@ -917,7 +919,7 @@ mod tests {
                 ]
             );
             assert_eq!(t.columns, vec!["x", "y", "z", "label"]);
-            assert_eq!(t.column("label").unwrap(), &[7.0, 255.0]);
+            assert_eq!(t.column("label").ok_or("no such column")?, &[7.0, 255.0]);
             // vertex 0 is 22 bytes, vertex 1 is 19
             let start = b.len() - 22 - 19;
             assert_eq!(
@@ -925,16 +927,21 @@ mod tests {
                 format!("t.ply: byte offset {} (vertex 1)", start + 22)
             );
             // every truncation of the body is an error, never a panic
-            let body = b.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+            let body = b
+                .windows(11)
+                .position(|w| w == b"end_header\n")
+                .ok_or("no end_header")?
+                + 11;
             for cut in 0..b.len() {
                 let e = read(&b[..cut]).unwrap_err().to_string();
                 assert!(cut < body || e.contains("truncated"), "{cut}: {e}");
             }
         }
+        Ok(())
     }
 
     #[test]
-    fn binary_fixed_records_and_counts() {
+    fn binary_fixed_records_and_counts() -> TestResult {
         let mut b = b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nend_header\n".to_vec();
         let h = b.len();
         for i in 0..3 {
@@ -956,12 +963,12 @@ mod tests {
             non_finite: NonFinite::Drop,
             ..Default::default()
         };
-        let t = parse(Path::new("t.ply"), &b, &opts).unwrap();
+        let t = parse(Path::new("t.ply"), &b, &opts)?;
         assert_eq!(
             t.points,
             vec![Point3::new(0., 0., 0.5), Point3::new(2., 4., 0.5)]
         );
-        assert_eq!(t.column("red").unwrap(), &[0.0, 20.0]);
+        assert_eq!(t.column("red").ok_or("no such column")?, &[0.0, 20.0]);
         assert_eq!(t.dropped_non_finite, 1);
         assert_eq!(
             t.locate(1),
@@ -984,17 +991,18 @@ mod tests {
             )) && e.contains("2 complete"),
             "{e}"
         );
+        Ok(())
     }
 
     #[test]
-    fn ascii_with_faces_before_and_after() {
+    fn ascii_with_faces_before_and_after() -> TestResult {
         let text = "ply\r\nformat ascii 1.0\r\nelement face 1\r\nproperty list uchar int vertex_indices\r\nelement vertex 2\r\nproperty double x\r\nproperty double y\r\nproperty double z\r\nproperty list uchar float tex\r\nproperty int label\r\nelement edge 1\r\nproperty int a\r\nend_header\r\n3 0 1 1\r\n1 2 3 2 0.5 0.5 -4\r\n\r\n-1e-5 0.1 7 0 9\r\n0 1\r\n";
-        let t = read(text.as_bytes()).unwrap();
+        let t = read(text.as_bytes())?;
         assert_eq!(
             t.points,
             vec![Point3::new(1., 2., 3.), Point3::new(-1e-5, 0.1, 7.)]
         );
-        assert_eq!(t.column("label").unwrap(), &[-4.0, 9.0]);
+        assert_eq!(t.column("label").ok_or("no such column")?, &[-4.0, 9.0]);
         assert_eq!(t.locate(1), "t.ply:17");
         let e = read(text.replace("0.1 7", "0.1 x7").as_bytes())
             .unwrap_err()
@@ -1029,10 +1037,11 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("t.ply:15"), "{e}");
+        Ok(())
     }
 
     #[test]
-    fn every_line_ending_in_ascii_files() {
+    fn every_line_ending_in_ascii_files() -> TestResult {
         for eol in ["\n", "\r\n", "\r"] {
             let text = [
                 "ply",
@@ -1047,7 +1056,7 @@ mod tests {
             ]
             .join(eol)
                 + eol;
-            let t = read(text.as_bytes()).unwrap();
+            let t = read(text.as_bytes())?;
             assert_eq!(
                 t.points,
                 vec![Point3::new(1., 2., 3.), Point3::new(4., 5., 6.)],
@@ -1056,13 +1065,14 @@ mod tests {
             assert_eq!(t.locate(1), "t.ply:9", "{eol:?}");
             assert!(t.warnings.is_empty(), "{eol:?}: {:?}", t.warnings);
         }
+        Ok(())
     }
 
     #[test]
-    fn counts_smaller_than_the_data_are_warnings() {
+    fn counts_smaller_than_the_data_are_warnings() -> TestResult {
         let head = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n";
         // ascii: a third vertex line the header does not declare
-        let t = read(format!("{head}end_header\n1 2 3\n4 5 6\n7 8 9\n").as_bytes()).unwrap();
+        let t = read(format!("{head}end_header\n1 2 3\n4 5 6\n7 8 9\n").as_bytes())?;
         assert_eq!(t.points.len(), 2);
         assert_eq!(
             t.warnings,
@@ -1073,7 +1083,7 @@ mod tests {
             "{head}element face 1\nproperty list uchar int vertex_indices\nend_header\n1 2 3\n4 5 6\n3 0 1 0\n"
         );
         // (its one face is degenerate: no normals, and a warning that says why)
-        let w = read(faces.as_bytes()).unwrap().warnings;
+        let w = read(faces.as_bytes())?.warnings;
         assert!(
             w.len() == 1 && w[0].contains("2 of 2 vertices lie on no triangle of non-zero area"),
             "{w:?}"
@@ -1085,7 +1095,7 @@ mod tests {
         for v in 0..9 {
             b.extend((v as f32).to_le_bytes());
         }
-        let t = read(&b).unwrap();
+        let t = read(&b)?;
         assert_eq!(t.points.len(), 2);
         assert_eq!(
             t.warnings,
@@ -1098,7 +1108,7 @@ mod tests {
         for v in 0..6 {
             f.extend((v as f32).to_le_bytes());
         }
-        let t = read(&f).unwrap();
+        let t = read(&f)?;
         assert_eq!(t.points.len(), 2);
         assert!(
             t.warnings.len() == 1
@@ -1111,6 +1121,7 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("the file ends after 1 of the 2 vertices"), "{e}");
+        Ok(())
     }
 
     #[test]
