@@ -37,7 +37,7 @@ use std::collections::BinaryHeap;
 
 use rayon::prelude::*;
 
-use super::forest::Forest;
+use super::forest::count_components;
 use super::neighbours::Neighbourhoods;
 use super::PointCloud;
 use crate::eigen3::{least_aligned_axis, smallest_eigen};
@@ -431,15 +431,20 @@ where
         .map(|t| {
             let (mut pairs, mut bad) = (0usize, 0usize);
             let p = Vector3::from(pts[t]);
+            let a = normal(t);
             for s in neighbours(t) {
+                // the normals' angle first: it needs no square root
+                let b = normal(s);
+                if a.dot(&b).abs() <= 0.5 {
+                    continue;
+                }
                 let d = Vector3::from(pts[s]) - p;
                 let len = d.norm();
                 if len == 0.0 {
                     continue;
                 }
                 let d = d / len;
-                let (a, b) = (normal(t), normal(s));
-                if a.dot(&d).abs() < 0.5 && b.dot(&d).abs() < 0.5 && a.dot(&b).abs() > 0.5 {
+                if a.dot(&d).abs() < 0.5 && b.dot(&d).abs() < 0.5 {
                     pairs += 1;
                     bad += usize::from(a.dot(&b) < 0.0);
                 }
@@ -487,20 +492,6 @@ impl Adjacency {
     fn of_point(&self, i: usize) -> &[u32] {
         &self.targets[self.offsets[i]..self.offsets[i + 1]]
     }
-}
-
-/// Connected components of the (undirected) neighbour graph given as `k`
-/// neighbours per point for `n` points (in any numbering: the count does not
-/// depend on it), by union-find over its edges (no adjacency lists needed).
-fn count_components(rows: &[u32], k: usize, n: usize) -> usize {
-    let mut forest = Forest::new(n);
-    let mut count = n;
-    for (i, row) in rows.chunks_exact(k).enumerate() {
-        for &j in row {
-            count -= usize::from(forest.join(i as u32, j));
-        }
-    }
-    count
 }
 
 /// The spanning-tree cost of the edge `i -> j` (see the module
