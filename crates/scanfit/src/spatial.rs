@@ -350,15 +350,24 @@ impl KdTree {
         let n = self.len();
         let mut indices = vec![0u32; n * k];
         let positions: Vec<u32> = (0..n as u32).collect();
-        let rows = |pos: usize, idx: &mut [u32], d: &mut [B]| {
-            let mut best = Best::new(k + 1);
-            for (j, (d2, id, _)) in self.own_row(pos, k, &mut best).enumerate() {
+        // one `Best` per chunk of consecutive positions: each query starts
+        // from the bound of the one before (see `own_row`)
+        let rows = |best: &mut Best, pos: usize, idx: &mut [u32], d: &mut [B]| {
+            for (j, (d2, id, _)) in self.own_row(pos, k, best).enumerate() {
                 idx[j] = id;
                 d[j] = dist(d2);
             }
         };
         // rows land at the input index of the tree position
-        fill_rows_at(&positions, &self.ids, k, &mut indices, distances, rows);
+        let scratch = || Best::new(k + 1);
+        fill_rows_with(
+            &positions,
+            &self.ids,
+            k,
+            (&mut indices, distances),
+            scratch,
+            rows,
+        );
         indices
     }
 
@@ -631,6 +640,27 @@ fn fill_rows_at<A, B, F>(
     B: Copy + Default + Send,
     F: Fn(usize, &mut [A], &mut [B]) + Sync,
 {
+    let no_scratch = || ();
+    fill_rows_with(work, place, width, (a, b), no_scratch, |_, i, x, y| {
+        fill(i, x, y)
+    });
+}
+
+/// [`fill_rows_at`] with scratch space made by `scratch` once per chunk of
+/// work items and handed to each `fill` of the chunk, in order.
+fn fill_rows_with<A, B, S, I, F>(
+    work: &[u32],
+    place: &[u32],
+    width: usize,
+    (a, b): (&mut [A], &mut [B]),
+    scratch: I,
+    fill: F,
+) where
+    A: Copy + Default + Send,
+    B: Copy + Default + Send,
+    I: Fn() -> S + Sync,
+    F: Fn(&mut S, usize, &mut [A], &mut [B]) + Sync,
+{
     if width == 0 {
         return;
     }
@@ -640,8 +670,9 @@ fn fill_rows_at<A, B, F>(
         .for_each(|(chunk, at)| {
             let mut ra = vec![A::default(); chunk.len() * width];
             let mut rb = vec![B::default(); chunk.len() * width];
+            let mut s = scratch();
             for ((x, y), &i) in ra.chunks_mut(width).zip(rb.chunks_mut(width)).zip(chunk) {
-                fill(i as usize, x, y);
+                fill(&mut s, i as usize, x, y);
             }
             let mut o = out.lock().unwrap_or_else(PoisonError::into_inner);
             for (k, &i) in at.iter().enumerate() {

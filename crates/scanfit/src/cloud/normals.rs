@@ -37,7 +37,7 @@ use std::collections::BinaryHeap;
 
 use rayon::prelude::*;
 
-use super::forest::count_components;
+use super::forest::Forest;
 use super::neighbours::Neighbourhoods;
 use super::PointCloud;
 use crate::eigen3::{least_aligned_axis, smallest_eigen};
@@ -492,6 +492,20 @@ impl Adjacency {
     fn of_point(&self, i: usize) -> &[u32] {
         &self.targets[self.offsets[i]..self.offsets[i + 1]]
     }
+}
+
+/// Connected components of the (undirected) neighbour graph given as `k`
+/// neighbours per point for `n` points (in any numbering: the count does not
+/// depend on it), by union-find over its edges (no adjacency lists needed).
+fn count_components(rows: &[u32], k: usize, n: usize) -> usize {
+    let mut forest = Forest::new(n);
+    let mut count = n;
+    for (i, row) in rows.chunks_exact(k).enumerate() {
+        for &j in row {
+            count -= usize::from(forest.join(i as u32, j));
+        }
+    }
+    count
 }
 
 /// The spanning-tree cost of the edge `i -> j` (see the module
