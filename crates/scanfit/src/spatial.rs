@@ -86,10 +86,15 @@ fn dist2(a: &[f64; 3], b: &[f64; 3]) -> f64 {
 /// instructions (callgrind), the same CPU time.
 type Candidate = (f64, u32, u32);
 
-/// The `k` best candidates so far, sorted by (squared distance, index).
+/// The `k` best candidates so far, sorted by (squared distance, index),
+/// among the points no farther (squared) than `cap`.
 struct Best {
     k: usize,
     items: Vec<Candidate>,
+    /// A squared distance known to be at least the `k`-th smallest
+    /// (`INFINITY` when none is known): until `k` candidates are found,
+    /// cells and points beyond it are skipped.
+    cap: f64,
 }
 
 impl Best {
@@ -97,13 +102,16 @@ impl Best {
         Self {
             k,
             items: Vec::with_capacity(k.min(1 << 12) + 1),
+            cap: f64::INFINITY,
         }
     }
 
-    /// Empties it for the next query (keeping its memory).
-    fn restart(&mut self, k: usize) {
+    /// Empties it for the next query (keeping its memory), with the bound
+    /// `cap` (see the field).
+    fn restart(&mut self, k: usize, cap: f64) {
         self.k = k;
         self.items.clear();
+        self.cap = cap;
     }
 
     fn offer(&mut self, d2: f64, id: u32, pos: u32) {
@@ -139,7 +147,7 @@ trait Visit {
 impl Visit for Best {
     fn bound(&self) -> f64 {
         if self.items.len() < self.k {
-            f64::INFINITY
+            self.cap
         } else {
             self.items[self.k - 1].0
         }
@@ -342,15 +350,24 @@ impl KdTree {
         let n = self.len();
         let mut indices = vec![0u32; n * k];
         let positions: Vec<u32> = (0..n as u32).collect();
-        let rows = |pos: usize, idx: &mut [u32], d: &mut [B]| {
-            let mut best = Best::new(k + 1);
-            for (j, (d2, id, _)) in self.own_row(pos, k, &mut best).enumerate() {
+        // one `Best` per chunk of consecutive positions: each query starts
+        // from the bound of the one before (see `own_row`)
+        let rows = |best: &mut Best, pos: usize, idx: &mut [u32], d: &mut [B]| {
+            for (j, (d2, id, _)) in self.own_row(pos, k, best).enumerate() {
                 idx[j] = id;
                 d[j] = dist(d2);
             }
         };
         // rows land at the input index of the tree position
-        fill_rows_at(&positions, &self.ids, k, &mut indices, distances, rows);
+        let scratch = || Best::new(k + 1);
+        fill_rows_with(
+            &positions,
+            &self.ids,
+            k,
+            (&mut indices, distances),
+            scratch,
+            rows,
+        );
         indices
     }
 
@@ -363,8 +380,24 @@ impl KdTree {
         k: usize,
         best: &'b mut Best,
     ) -> impl Iterator<Item = Candidate> + 'b {
-        best.restart((k + 1).min(self.len()));
-        self.descend(0, self.len(), &self.pts[pos], &mut [0.0; 3], best);
+        let q = &self.pts[pos];
+        let want = (k + 1).min(self.len());
+        // The previous query's `want` points (the queries run in tree
+        // order: mostly a neighbouring point's) are `want` distinct points,
+        // so the farthest of them from `q` bounds `q`'s `want`-th distance
+        // (Friedman, Bentley & Finkel's bound, known before the descent):
+        // cells and points beyond it hold no answer. It is the same sum
+        // `dist2` the bucket test compares, so no answer (nor tie) is lost.
+        let cap = if best.items.len() == want {
+            best.items
+                .iter()
+                .map(|c| dist2(&self.pts[c.2 as usize], q))
+                .fold(0.0, f64::max)
+        } else {
+            f64::INFINITY
+        };
+        best.restart(want, cap);
+        self.descend(0, self.len(), q, &mut [0.0; 3], best);
         let found = &best.items;
         let me = self.ids[pos];
         let skip = found
@@ -607,6 +640,27 @@ fn fill_rows_at<A, B, F>(
     B: Copy + Default + Send,
     F: Fn(usize, &mut [A], &mut [B]) + Sync,
 {
+    let no_scratch = || ();
+    fill_rows_with(work, place, width, (a, b), no_scratch, |_, i, x, y| {
+        fill(i, x, y)
+    });
+}
+
+/// [`fill_rows_at`] with scratch space made by `scratch` once per chunk of
+/// work items and handed to each `fill` of the chunk, in order.
+fn fill_rows_with<A, B, S, I, F>(
+    work: &[u32],
+    place: &[u32],
+    width: usize,
+    (a, b): (&mut [A], &mut [B]),
+    scratch: I,
+    fill: F,
+) where
+    A: Copy + Default + Send,
+    B: Copy + Default + Send,
+    I: Fn() -> S + Sync,
+    F: Fn(&mut S, usize, &mut [A], &mut [B]) + Sync,
+{
     if width == 0 {
         return;
     }
@@ -616,8 +670,9 @@ fn fill_rows_at<A, B, F>(
         .for_each(|(chunk, at)| {
             let mut ra = vec![A::default(); chunk.len() * width];
             let mut rb = vec![B::default(); chunk.len() * width];
+            let mut s = scratch();
             for ((x, y), &i) in ra.chunks_mut(width).zip(rb.chunks_mut(width)).zip(chunk) {
-                fill(i as usize, x, y);
+                fill(&mut s, i as usize, x, y);
             }
             let mut o = out.lock().unwrap_or_else(PoisonError::into_inner);
             for (k, &i) in at.iter().enumerate() {

@@ -431,15 +431,20 @@ where
         .map(|t| {
             let (mut pairs, mut bad) = (0usize, 0usize);
             let p = Vector3::from(pts[t]);
+            let a = normal(t);
             for s in neighbours(t) {
+                // the normals' angle first: it needs no square root
+                let b = normal(s);
+                if a.dot(&b).abs() <= 0.5 {
+                    continue;
+                }
                 let d = Vector3::from(pts[s]) - p;
                 let len = d.norm();
                 if len == 0.0 {
                     continue;
                 }
                 let d = d / len;
-                let (a, b) = (normal(t), normal(s));
-                if a.dot(&d).abs() < 0.5 && b.dot(&d).abs() < 0.5 && a.dot(&b).abs() > 0.5 {
+                if a.dot(&d).abs() < 0.5 && b.dot(&d).abs() < 0.5 {
                     pairs += 1;
                     bad += usize::from(a.dot(&b) < 0.0);
                 }
