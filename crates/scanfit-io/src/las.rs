@@ -562,6 +562,10 @@ fn column_names(gps_time: bool, color: bool, nir: bool) -> Vec<&'static str> {
     names
 }
 
+/// A column value of a decoded record, and whether a file's records have
+/// it.
+type Field<R> = (fn(&R) -> f64, bool);
+
 /// A LAZ file read by scanfit's own decoders ([`crate::laz14`], pointwise
 /// or layered): its chunks, how one is decoded, and the columns its
 /// records give.
@@ -585,7 +589,7 @@ trait OwnLaz: Sync {
     fn xyz(record: &Self::Record) -> [i32; 3];
     /// Every column value a record of this kind can give, in the order of
     /// [`column_names`], with whether this file's records have it.
-    fn fields(&self) -> Vec<(fn(&Self::Record) -> f64, bool)>;
+    fn fields(&self) -> Vec<Field<Self::Record>>;
 
     /// Appends decoded records: coordinates (scale times the stored
     /// integer plus offset, per axis of `transform`) to `points`, and the

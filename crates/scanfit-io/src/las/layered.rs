@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use super::{column_names, decode_in_order, vlr_bytes, Decoded, Layered, OwnLaz, Raw};
+use super::{column_names, decode_in_order, vlr_bytes, Decoded, Field, Layered, OwnLaz, Raw};
 use crate::laz14::{ChunkSpan, LayeredLaz, Laz14Error, Point14, ReadAt};
 use crate::Error;
 
@@ -70,9 +70,9 @@ impl OwnLaz for LayeredLaz {
     fn xyz(p: &Point14) -> [i32; 3] {
         [p.x, p.y, p.z]
     }
-    fn fields(&self) -> Vec<(fn(&Point14) -> f64, bool)> {
+    fn fields(&self) -> Vec<Field<Point14>> {
         let (rgb, nir) = (self.has_rgb(), self.has_nir());
-        let fields: [(fn(&Point14) -> f64, bool); 10] = [
+        let fields: [Field<Point14>; 10] = [
             (|p| f64::from(p.intensity), true),
             (|p| f64::from(p.return_number), true),
             (|p| f64::from(p.number_of_returns), true),

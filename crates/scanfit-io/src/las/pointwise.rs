@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use super::layered::binary;
-use super::{column_names, decode_in_order, Decoded, OwnLaz, Pointwise};
+use super::{column_names, decode_in_order, Decoded, Field, OwnLaz, Pointwise};
 use crate::laz14::{ChunkSpan, Laz14Error, PointwiseLaz, PointwiseRecord};
 use crate::{Error, Result};
 
@@ -51,9 +51,9 @@ impl OwnLaz for PointwiseLaz {
     fn xyz(r: &PointwiseRecord) -> [i32; 3] {
         [r.point.x, r.point.y, r.point.z]
     }
-    fn fields(&self) -> Vec<(fn(&PointwiseRecord) -> f64, bool)> {
+    fn fields(&self) -> Vec<Field<PointwiseRecord>> {
         let (gps, rgb) = (self.has_gps_time(), self.has_rgb());
-        let fields: [(fn(&PointwiseRecord) -> f64, bool); 9] = [
+        let fields: [Field<PointwiseRecord>; 9] = [
             (|r| f64::from(r.point.intensity), true),
             (|r| f64::from(r.point.return_number()), true),
             (|r| f64::from(r.point.number_of_returns()), true),
