@@ -147,12 +147,7 @@ pub fn compress_single(format: u8, extra: usize, raw: &[u8]) -> Laz {
     c.set_fields_from(vlr.items()).unwrap();
     c.compress_many(raw).unwrap();
     c.done().unwrap();
-    Laz {
-        bytes: c.into_inner().into_inner(),
-        vlr,
-        vlr_payload: payload,
-        start,
-    }
+    Laz::written(c.into_inner(), vlr, payload, start)
 }
 
 /// The fields scanfit decodes, of raw records.

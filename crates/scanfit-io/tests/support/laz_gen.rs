@@ -256,6 +256,19 @@ pub struct Laz {
     pub start: u64,
 }
 
+impl Laz {
+    /// The file a compressor wrote into `file` after its head, the points
+    /// starting at `start`, compressed as `vlr` (of payload `payload`) says.
+    pub fn written(file: Cursor<Vec<u8>>, vlr: LazVlr, payload: Vec<u8>, start: u64) -> Self {
+        Laz {
+            bytes: file.into_inner(),
+            vlr,
+            vlr_payload: payload,
+            start,
+        }
+    }
+}
+
 /// The LASzip VLR of `items` cut into `chunks`, and its payload bytes.
 pub fn laszip_vlr(items: Vec<laz::LazItem>, chunks: Chunks) -> (LazVlr, Vec<u8>) {
     let builder = LazVlrBuilder::new(items);
@@ -312,12 +325,7 @@ pub fn write_points(
         }
     }
     c.done().unwrap();
-    Laz {
-        bytes: c.into_inner().into_inner(),
-        vlr,
-        vlr_payload: payload,
-        start,
-    }
+    Laz::written(c.into_inner(), vlr, payload, start)
 }
 
 /// A LAS header of version 1.`minor` (`size` bytes) for records of
