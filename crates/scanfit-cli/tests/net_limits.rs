@@ -22,25 +22,30 @@ fn sheet(path: &std::path::Path) -> std::io::Result<()> {
     std::fs::write(path, s)
 }
 
-#[test]
-fn a_net_beyond_the_memory_limit_is_refused_with_its_estimate() -> TestResult {
-    let d = tmpdir("net_limits", "memory");
+/// `scanfit fit` on the sheet with `--ctrl NET` and the `extra` options,
+/// written to a JSON document: its stderr and exit code, and whether the
+/// document was written.
+fn fit(
+    name: &str,
+    net: &str,
+    extra: &[&str],
+) -> Result<(String, Option<i32>, bool), Box<dyn std::error::Error>> {
+    let d = tmpdir("net_limits", name);
     let input = d.join("s.xyz");
     sheet(&input)?;
     let out = d.join("s.json");
     let (i, o) = (input.to_string_lossy(), out.to_string_lossy());
-    let r = run(&[
-        "fit",
-        &i,
-        "--ctrl",
-        "1000x1000",
-        "--smooth",
-        "0.001",
-        "-o",
-        &o,
-    ]);
-    let err = String::from_utf8_lossy(&r.stderr);
-    assert_eq!(r.status.code(), Some(1), "{err}");
+    let mut args = vec!["fit", &i, "--ctrl", net, "-o", &o];
+    args.extend_from_slice(extra);
+    let r = run(&args);
+    let err = String::from_utf8_lossy(&r.stderr).into_owned();
+    Ok((err, r.status.code(), out.exists()))
+}
+
+#[test]
+fn a_net_beyond_the_memory_limit_is_refused_with_its_estimate() -> TestResult {
+    let (err, code, written) = fit("memory", "1000x1000", &["--smooth", "0.001"])?;
+    assert_eq!(code, Some(1), "{err}");
     assert_eq!(err.lines().count(), 1, "one error line: {err}");
     // the net, its memory, the limit and the largest square net that fits.
     // The documented estimate (`scanfit::fit::surface::memory_estimate`) of
@@ -57,24 +62,18 @@ fn a_net_beyond_the_memory_limit_is_refused_with_its_estimate() -> TestResult {
     }
     // smoothing was given: it is not the advice
     assert!(!err.contains("smooth"), "{err}");
-    assert!(!out.exists(), "no output after a refusal");
+    assert!(!written, "no output after a refusal");
     Ok(())
 }
 
 #[test]
 fn a_net_beyond_the_control_point_limit_is_refused() -> TestResult {
-    let d = tmpdir("net_limits", "count");
-    let input = d.join("s.xyz");
-    sheet(&input)?;
-    let out = d.join("s.json");
-    let (i, o) = (input.to_string_lossy(), out.to_string_lossy());
-    let r = run(&["fit", &i, "--ctrl", "4096x4096", "-o", &o]);
-    let err = String::from_utf8_lossy(&r.stderr);
-    assert_eq!(r.status.code(), Some(1), "{err}");
+    let (err, code, written) = fit("count", "4096x4096", &[])?;
+    assert_eq!(code, Some(1), "{err}");
     assert!(
         err.contains("a 4096 x 4096 control net of degrees 3 x 3 is beyond the limits"),
         "{err}"
     );
-    assert!(!out.exists());
+    assert!(!written);
     Ok(())
 }
