@@ -731,3 +731,15 @@ fn small_gaps_are_sewn_within_the_files_uncertainty() {
         assert_closed(&r, &m, "gappy cube-sphere", quad);
     }
 }
+
+/// Writes a small model document as a seed of the `model_json` fuzz target
+/// (a closed tetrahedron of three-sided faces, 7.5 KB, beside the 63 KB
+/// six-patch seed) into `$SCANFIT_SEED_DIR`:
+/// `SCANFIT_SEED_DIR=fuzz/corpus/model_json cargo test -p scanfit-io --test model_readback -- --ignored write_fuzz_seeds`
+#[test]
+#[ignore = "writes fuzz seeds; run by hand"]
+fn write_fuzz_seeds() {
+    let dir = std::path::PathBuf::from(std::env::var_os("SCANFIT_SEED_DIR").unwrap());
+    let json = ModelDoc::new(&tetrahedron()).to_json().unwrap();
+    std::fs::write(dir.join("tetrahedron.json"), json).unwrap();
+}
