@@ -22,7 +22,7 @@ secs=${1:-300}
 shift || true
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-  targets=(ply pcd las laz text stl obj curve_json surface_json model_json)
+  targets=(ply pcd las las_stream laz text stl obj curve_json surface_json model_json)
 fi
 # no sanitizer: the crates are safe Rust (unsafe_code = "forbid"); debug
 # assertions on, so integer overflow is a finding

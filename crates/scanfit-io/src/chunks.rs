@@ -129,6 +129,17 @@ impl PointChunks {
         )
     }
 
+    /// Sets the window of compressed bytes a pointwise LAZ chunk is
+    /// decoded through (by default [`crate::laz14::WINDOW`]; raised to the
+    /// least one point needs), before the first chunk is read: the fuzz
+    /// target of the streamed reader makes it small so that the decoder is
+    /// suspended and resumed every few points.
+    pub(crate) fn set_laz_window(&mut self, window: usize) {
+        if let Source::Las(l, _) = &mut self.source {
+            l.set_window(window);
+        }
+    }
+
     /// Warnings of the reader, complete once the pass has ended.
     pub fn warnings(&self) -> &[String] {
         &self.warnings

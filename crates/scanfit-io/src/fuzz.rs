@@ -5,8 +5,10 @@
 //! beyond the harness's limit is a finding; `Ok` and `Err` are both fine.
 
 use std::path::Path;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
-use crate::table::{NonFinite, ReadOptions};
+use crate::chunks::PointChunks;
+use crate::table::{NonFinite, PointTable, ReadOptions};
 
 /// Reads `data` as the point file `name` (its extension picks the reader)
 /// with both non-finite policies, and turns an accepted table into a
@@ -32,6 +34,90 @@ pub fn point_file(name: &str, data: &[u8]) -> bool {
         }
     }
     accepted
+}
+
+/// Reads `data` as a LAS/LAZ file twice, whole (the in-memory reader) and
+/// streamed ([`PointChunks`], the reader of `--chunk-points`) from a
+/// temporary file in chunks of `1 + data.len() % 7` points, with a
+/// pointwise LAZ chunk decoded through the smallest window its cursor
+/// allows (so the arithmetic decoder is suspended and resumed every few
+/// points, where the whole read decodes a fuzzer-sized chunk in one go).
+/// The two must agree: both refuse the file, or both give the same points,
+/// columns, point locations and warnings, bit for bit; a disagreement
+/// panics (a finding). Returns whether the file was accepted.
+///
+/// ```
+/// assert!(!scanfit_io::fuzz::streamed_las_file(b"LASF"));
+/// ```
+pub fn streamed_las_file(data: &[u8]) -> bool {
+    static FILES: AtomicUsize = AtomicUsize::new(0);
+    let path = std::env::temp_dir().join(format!(
+        "scanfit-fuzz-{}-{}.laz",
+        std::process::id(),
+        FILES.fetch_add(1, Ordering::Relaxed)
+    ));
+    if std::fs::write(&path, data).is_err() {
+        return false;
+    }
+    let options = ReadOptions::default();
+    let whole = crate::parse_cloud(&path, data, &options);
+    let streamed = read_streamed(&path, &options, 1 + data.len() % 7);
+    let _ = std::fs::remove_file(&path);
+    match (whole, streamed) {
+        (Ok(whole), Ok((chunks, warnings))) => {
+            same_points(&whole, &chunks);
+            assert_eq!(warnings, whole.warnings, "warnings, streamed and whole");
+            true
+        }
+        (Err(_), Err(_)) => false,
+        (Ok(_), Err(e)) => panic!("the whole read accepts the file, the streamed read fails: {e}"),
+        (Err(e), Ok(_)) => panic!("the streamed read accepts the file, the whole read fails: {e}"),
+    }
+}
+
+/// Every chunk of a streamed read, and the reader's warnings at the end.
+fn read_streamed(
+    path: &Path,
+    options: &ReadOptions,
+    chunk: usize,
+) -> crate::Result<(Vec<PointTable>, Vec<String>)> {
+    let mut reader = PointChunks::open(path, options, chunk)?;
+    reader.set_laz_window(0);
+    let mut chunks = Vec::new();
+    while let Some(t) = reader.next_chunk()? {
+        assert!(
+            (1..=chunk).contains(&t.points.len()),
+            "a chunk of {} points, {chunk} asked for",
+            t.points.len()
+        );
+        chunks.push(t);
+    }
+    Ok((chunks, reader.warnings().to_vec()))
+}
+
+/// Asserts that `chunks` hold the points of `whole`, bit for bit, with the
+/// same columns and locations.
+fn same_points(whole: &PointTable, chunks: &[PointTable]) {
+    let mut k = 0;
+    for t in chunks {
+        assert_eq!(t.columns, whole.columns, "columns, streamed and whole");
+        for (i, p) in t.points.iter().enumerate() {
+            let q = whole.points.get(k).copied();
+            let bits = |p: &scanfit::Point3| p.coords.map(f64::to_bits);
+            assert_eq!(Some(bits(p)), q.as_ref().map(bits), "point {k}");
+            for (c, col) in t.extra.iter().enumerate() {
+                let w = whole.extra.get(c).and_then(|w| w.get(k));
+                assert_eq!(
+                    col.get(i).map(|v| v.to_bits()),
+                    w.map(|v| v.to_bits()),
+                    "point {k}, column {c}"
+                );
+            }
+            assert_eq!(t.locate(i), whole.locate(k), "point {k}");
+            k += 1;
+        }
+    }
+    assert_eq!(k, whole.points.len(), "points, streamed and whole");
 }
 
 /// Parses `data` as a curve document and, when it is accepted, evaluates

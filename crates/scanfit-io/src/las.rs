@@ -562,29 +562,79 @@ fn column_names(gps_time: bool, color: bool, nir: bool) -> Vec<&'static str> {
     names
 }
 
-/// Decodes the chunks `spans` of a LAZ file held in `bytes` (chunk `c`
-/// has `size(c)` bytes, `declared` points in all) with `decode`, a few per
-/// thread at a time (chunks are independent), and hands each chunk's
-/// points to `append` in file order, with the coordinates and the columns
-/// `names` to append to; the first damaged chunk in file order is the
-/// error.
-#[allow(clippy::too_many_arguments)]
-fn decode_in_order<T: Send>(
+/// A column value of a decoded record, and whether a file's records have
+/// it.
+type Field<R> = (fn(&R) -> f64, bool);
+
+/// A LAZ file read by scanfit's own decoders ([`crate::laz14`], pointwise
+/// or layered): its chunks, how one is decoded, and the columns its
+/// records give.
+trait OwnLaz: Sync {
+    /// A decoded point.
+    type Record: Send;
+    /// The chunks, in file order.
+    fn spans(&self) -> &[crate::laz14::ChunkSpan];
+    /// The size in bytes of chunk `c`.
+    fn span_bytes(&self, c: usize) -> u64;
+    /// Decodes chunk `c` from its bytes `data`, appending to `out`.
+    fn decode_span(
+        &self,
+        c: usize,
+        data: &[u8],
+        out: &mut Vec<Self::Record>,
+    ) -> std::result::Result<(), crate::laz14::Laz14Error>;
+    /// The extra columns of its points (see [`column_names`]).
+    fn names(&self) -> Vec<&'static str>;
+    /// The record's stored coordinates.
+    fn xyz(record: &Self::Record) -> [i32; 3];
+    /// Every column value a record of this kind can give, in the order of
+    /// [`column_names`], with whether this file's records have it.
+    fn fields(&self) -> Vec<Field<Self::Record>>;
+
+    /// Appends decoded records: coordinates (scale times the stored
+    /// integer plus offset, per axis of `transform`) to `points`, and the
+    /// values of [`OwnLaz::names`] to `columns`.
+    fn append(
+        &self,
+        transform: &[(f64, f64); 3],
+        chunk: &[Self::Record],
+        points: &mut Vec<Point3>,
+        columns: &mut [Vec<f64>],
+    ) {
+        let at = |v: i32, k: usize| transform[k].0 * f64::from(v) + transform[k].1;
+        points.extend(chunk.iter().map(|r| {
+            let [x, y, z] = Self::xyz(r);
+            Point3::new(at(x, 0), at(y, 1), at(z, 2))
+        }));
+        let mut column = columns.iter_mut();
+        for (f, _) in self.fields().into_iter().filter(|(_, used)| *used) {
+            if let Some(col) = column.next() {
+                col.extend(chunk.iter().map(f));
+            }
+        }
+    }
+}
+
+/// Decodes every chunk of `file`, a LAZ file held in `bytes` with
+/// `declared` points (`table_chunks`: the chunks its chunk table lists),
+/// a few chunks per thread at a time (chunks are independent), and
+/// appends each chunk's points in file order; the first damaged chunk in
+/// file order is the error.
+fn decode_in_order<F: OwnLaz>(
     path: &Path,
     bytes: &[u8],
+    file: &F,
     declared: u64,
-    names: Vec<&'static str>,
-    spans: &[crate::laz14::ChunkSpan],
-    size: impl Fn(usize) -> u64 + Sync,
-    decode: impl Fn(usize, &[u8], &mut Vec<T>) -> std::result::Result<(), crate::laz14::Laz14Error>
-        + Sync,
-    append: impl Fn(&[T], &mut Vec<Point3>, &mut [Vec<f64>]),
+    table_chunks: Option<u64>,
 ) -> Result<Decoded> {
     use rayon::prelude::*;
+    let transform = transforms(path, bytes)?;
+    let names = file.names();
     let cap = capacity(declared, bytes.len()).min(1 << 24);
     let mut points = Vec::with_capacity(cap);
     let mut columns = vec![Vec::with_capacity(cap); names.len()];
     let group = 2 * rayon::current_num_threads().max(1);
+    let spans = file.spans();
     let count = spans.len();
     for first in (0..count).step_by(group) {
         let decoded: Vec<_> = (first..(first + group).min(count))
@@ -592,15 +642,15 @@ fn decode_in_order<T: Send>(
             .map(|c| {
                 let at = spans[c].offset as usize;
                 let data = bytes
-                    .get(at..at.saturating_add(size(c) as usize))
+                    .get(at..at.saturating_add(file.span_bytes(c) as usize))
                     .unwrap_or(&[]);
                 let mut chunk = Vec::new();
-                decode(c, data, &mut chunk).map(|()| chunk)
+                file.decode_span(c, data, &mut chunk).map(|()| chunk)
             })
             .collect();
         for chunk in decoded {
             let chunk = chunk.map_err(|e| layered::binary(path, e))?;
-            append(&chunk, &mut points, &mut columns);
+            file.append(&transform, &chunk, &mut points, &mut columns);
         }
     }
     Ok(Decoded {
@@ -608,7 +658,7 @@ fn decode_in_order<T: Send>(
         names,
         columns,
         declared,
-        warnings: Vec::new(),
+        warnings: unread_chunks(path, table_chunks, count, declared),
     })
 }
 

@@ -6,14 +6,13 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use std::io::Write;
-use std::path::Path;
-use std::process::Command;
-
 use scanfit::bspline::{Curve, KnotVector, Surface};
 use scanfit::Point3;
 use scanfit_io::iges::iges_file;
 use scanfit_io::step::{step_file, CadItem};
+
+#[path = "support/occ.rs"]
+mod occ;
 
 fn surfaces() -> (Surface, Surface) {
     let ku = KnotVector::new(vec![0., 0., 0., 0., 0.3, 0.55, 1., 1., 1., 1.], 3).unwrap();
@@ -77,14 +76,6 @@ fn periodic_items() -> (Surface, Curve) {
         q.push(q[j]);
     }
     (s, Curve::new_periodic(kc, q, None).unwrap())
-}
-
-fn occ_available() -> bool {
-    Command::new("python3")
-        .args(["-c", "import OCP"])
-        .output()
-        .map(|o| o.status.success())
-        .unwrap_or(false)
 }
 
 #[test]
@@ -155,36 +146,16 @@ fn step_and_iges_read_back_by_opencascade() {
         .map(|c| c.as_array().unwrap().len())
         .sum();
     let occ_checks = files * (surface_samples + curve_samples + 2);
-    if !occ_available() {
-        // straight to the process's stderr, not eprintln!: the test harness
-        // captures (and hides) the macros' output of a passing test
-        let stars = "*".repeat(72);
-        let msg = format!(
-            "\n{stars}\n* OpenCASCADE (pip install cadquery-ocp) is NOT installed.\n\
-             * SKIPPED {occ_checks} of the {} checks of this test: the read-back by a CAD kernel of\n\
-             * {files} files x ({surface_samples} surface + {curve_samples} curve samples + 2 entity counts).\n\
-             * Only the 3 structural checks of the STEP text ran.\n{stars}\n",
-            occ_checks + 3
-        );
-        std::io::stderr().write_all(msg.as_bytes()).ok();
-        assert!(
-            std::env::var_os("SCANFIT_REQUIRE_OCC").is_none(),
-            "SCANFIT_REQUIRE_OCC is set but OpenCASCADE is missing ({occ_checks} checks could not run)"
-        );
+    let skipped = format!(
+        "{occ_checks} of the {} checks of this test: the read-back by a CAD kernel of\n\
+         {files} files x ({surface_samples} surface + {curve_samples} curve samples + 2 entity counts).\n\
+         Only the 3 structural checks of the STEP text ran.",
+        occ_checks + 3
+    );
+    if occ::missing(&skipped) {
         return;
     }
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/occ/check_cad.py");
-    let o = Command::new("python3")
-        .arg(script)
-        .arg(&sp)
-        .arg(&step)
-        .arg(&iges)
-        .output()
-        .unwrap();
-    let out = String::from_utf8_lossy(&o.stdout);
-    let err = String::from_utf8_lossy(&o.stderr);
-    println!("{out}{err}");
-    assert!(o.status.success(), "OpenCASCADE disagrees:\n{out}\n{err}");
+    let out = occ::run("check_cad.py", &[&sp, &step, &iges], "CAD read-back");
     assert_eq!(out.matches("3 faces, 2 curves").count(), 2, "{out}");
     std::fs::remove_dir_all(&dir).ok();
 }

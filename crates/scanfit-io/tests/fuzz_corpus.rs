@@ -23,6 +23,7 @@ fn feed(target: &str, data: &[u8]) -> bool {
         "pcd" => scanfit_io::fuzz::point_file("f.pcd", data),
         "las" => scanfit_io::fuzz::point_file("f.las", data),
         "laz" => scanfit_io::fuzz::point_file("f.laz", data),
+        "las_stream" => scanfit_io::fuzz::streamed_las_file(data),
         "text" => scanfit_io::fuzz::point_file("f.xyz", data),
         "stl" => scanfit_io::fuzz::point_file("f.stl", data),
         "obj" => scanfit_io::fuzz::point_file("f.obj", data),
@@ -72,6 +73,7 @@ fn seed_corpora_replay_and_the_intact_seeds_are_accepted() {
         [
             "curve_json",
             "las",
+            "las_stream",
             "laz",
             "model_json",
             "obj",

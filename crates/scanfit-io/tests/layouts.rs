@@ -7,7 +7,6 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use scanfit::base::turntable::AxisChoice;
 use scanfit::cloud::segment::{segment, SegmentConfig};
@@ -17,6 +16,9 @@ use scanfit::progress::NoProgress;
 use scanfit::{PointCloud, Vector3};
 use scanfit_io::model::ModelDoc;
 use scanfit_io::step_shell::step_shell_file;
+
+#[path = "support/occ.rs"]
+mod occ;
 
 fn data(file: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -84,14 +86,6 @@ fn smooth_blob_has_no_edges_and_says_which_layout() {
     assert!(e.contains("--layout cube"), "{e}");
 }
 
-fn occ_available() -> bool {
-    Command::new("python3")
-        .args(["-c", "import OCP"])
-        .output()
-        .map(|o| o.status.success())
-        .unwrap_or(false)
-}
-
 #[test]
 fn blob_as_a_cube_is_a_closed_solid_of_the_true_volume() {
     let (cloud, _) = read("blob_30k.ply", None);
@@ -156,15 +150,7 @@ fn few_folds(r: &scanfit::pipeline::reconstruct::ReconstructReport) {
 /// or `None`, said loudly, when OpenCASCADE is not installed.
 fn occ_read(model: &scanfit::topology::PatchComplex, name: &str) -> Option<serde_json::Value> {
     let step = step_shell_file(model, name).unwrap();
-    if !occ_available() {
-        eprintln!("\n**************************************************************");
-        eprintln!("* OpenCASCADE (pip install cadquery-ocp) is NOT installed:   *");
-        eprintln!("* {name:<20} was NOT read back by a CAD kernel         *");
-        eprintln!("**************************************************************\n");
-        assert!(
-            std::env::var_os("SCANFIT_REQUIRE_OCC").is_none(),
-            "SCANFIT_REQUIRE_OCC is set but OpenCASCADE is missing"
-        );
+    if occ::missing(&format!("{name} was NOT read back by a CAD kernel")) {
         return None;
     }
     let dir = std::env::temp_dir().join(format!("scanfit-{name}-{}", std::process::id()));
@@ -172,18 +158,10 @@ fn occ_read(model: &scanfit::topology::PatchComplex, name: &str) -> Option<serde
     let (jp, sp) = (dir.join("model.json"), dir.join("model.stp"));
     std::fs::write(&jp, ModelDoc::new(model).to_json().unwrap()).unwrap();
     std::fs::write(&sp, &step.text).unwrap();
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/occ/check_model.py");
-    let o = Command::new("python3")
-        .arg(script)
-        .arg(&jp)
-        .arg(&sp)
-        .output()
-        .unwrap();
-    let out = String::from_utf8_lossy(&o.stdout);
-    assert!(
-        o.status.success(),
-        "{out}{}",
-        String::from_utf8_lossy(&o.stderr)
+    let out = occ::run(
+        "check_model.py",
+        &[&jp, &sp],
+        &format!("OpenCASCADE on {name}"),
     );
     std::fs::remove_dir_all(&dir).ok();
     let occ: serde_json::Value = serde_json::from_str(out.trim()).unwrap();

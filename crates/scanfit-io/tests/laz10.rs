@@ -11,7 +11,6 @@
 //! decoded by both.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use std::io::Cursor;
 use std::path::Path;
 
 use scanfit_io::laz14::{PointwiseLaz, PointwiseRecord};
@@ -21,15 +20,12 @@ use scanfit_io::{parse_cloud, ReadOptions};
 mod laz10_gen;
 use laz10_gen::laz_gen::laz_decode;
 use laz10_gen::{compress, compress_single, fields, ours, record_len, records, Chunks};
+#[path = "support/laz_compare.rs"]
+mod laz_compare;
+use laz_compare::TestResult;
 
 fn same(a: &[PointwiseRecord], b: &[PointwiseRecord], what: &str) {
-    assert_eq!(a.len(), b.len(), "{what}: point counts");
-    for (k, (p, q)) in a.iter().zip(b).enumerate() {
-        assert!(
-            p == q && p.gps_time.to_bits() == q.gps_time.to_bits(),
-            "{what}: point {k}:\n ours {p:?}\n laz  {q:?}"
-        );
-    }
+    laz_compare::same(a, b, |p| p.gps_time, what);
 }
 
 fn check(format: u8, extra: usize, chunks: Chunks, n: usize, seed: u64) -> usize {
@@ -82,64 +78,17 @@ fn many_seeds_of_format_3_match_laz() {
 /// The reader (`parse_cloud`) on LAZ files of formats 0-5 gives the
 /// columns and coordinates the las crate gives, value for value.
 #[test]
-fn the_reader_uses_the_decoder_and_matches_the_las_crate() {
+fn the_reader_uses_the_decoder_and_matches_the_las_crate() -> TestResult {
     for format in 0..=5u8 {
-        reader_matches_the_las_crate(format);
+        let n = 2500;
+        let raw = records(format, 0, n, 88 + u64::from(format));
+        let f = compress(format, 0, Chunks::Fixed(1000), &raw);
+        let names =
+            laz_compare::reader_matches_the_las_crate(&f.bytes, n, &format!("format {format}"))?;
+        // GPS time in 1, 3, 4, 5; RGB in 2, 3, 5
+        assert_eq!(names.len(), [5, 6, 8, 9, 6, 9][usize::from(format)]);
     }
-}
-
-fn reader_matches_the_las_crate(format: u8) {
-    let n = 2500;
-    let raw = records(format, 0, n, 88 + u64::from(format));
-    let f = compress(format, 0, Chunks::Fixed(1000), &raw);
-    let table = parse_cloud(Path::new("f.laz"), &f.bytes, &ReadOptions::default()).unwrap();
-    let mut reader = las::Reader::new(Cursor::new(f.bytes.clone())).unwrap();
-    let pd = reader.read_points(n as u64).unwrap();
-    let points: Vec<las::Point> = pd.points().map(|p| p.unwrap()).collect();
-    assert_eq!(table.points.len(), n);
-    let mut names: Vec<&str> = vec![
-        "intensity",
-        "return_number",
-        "number_of_returns",
-        "classification",
-        "point_source_id",
-    ];
-    if matches!(format, 1 | 3 | 4 | 5) {
-        names.push("gps_time");
-    }
-    if matches!(format, 2 | 3 | 5) {
-        names.extend(["red", "green", "blue"]);
-    }
-    assert_eq!(table.columns[3..], names[..], "format {format}");
-    for (k, p) in points.iter().enumerate() {
-        let q = table.points[k];
-        assert_eq!(
-            (q.x.to_bits(), q.y.to_bits(), q.z.to_bits()),
-            (p.x.to_bits(), p.y.to_bits(), p.z.to_bits()),
-            "format {format}, point {k}"
-        );
-        let mut expect = vec![
-            f64::from(p.intensity),
-            f64::from(p.return_number),
-            f64::from(p.number_of_returns),
-            f64::from(u8::from(p.classification)),
-            f64::from(p.point_source_id),
-        ];
-        if let Some(t) = p.gps_time {
-            expect.push(t);
-        }
-        if let Some(c) = p.color {
-            expect.extend([f64::from(c.red), f64::from(c.green), f64::from(c.blue)]);
-        }
-        for (c, v) in expect.iter().enumerate() {
-            assert_eq!(
-                table.extra[c][k].to_bits(),
-                v.to_bits(),
-                "format {format}, point {k}, {}",
-                names[c]
-            );
-        }
-    }
+    Ok(())
 }
 
 /// A LAZ file of version-1 items (LASzip 1.x) is still read (through the
@@ -158,10 +107,12 @@ fn version_1_items_are_read_through_the_laz_crate() {
     }
 }
 
-/// Writes small pointwise LAZ seeds for the laz fuzz target (formats 1 and
-/// 3 with GPS-time jumps and returns to earlier sequences, format 5 with
-/// wave packets and extra bytes) into `$SCANFIT_SEED_DIR`:
+/// Writes small pointwise LAZ seeds for the laz and las_stream fuzz targets
+/// (formats 1 and 3 with GPS-time jumps and returns to earlier sequences,
+/// format 5 with wave packets and extra bytes, format 3 with compressor 1)
+/// into `$SCANFIT_SEED_DIR`:
 /// `SCANFIT_SEED_DIR=fuzz/corpus/laz cargo test -p scanfit-io --test laz10 -- --ignored write_fuzz_seeds`
+/// (and again with `fuzz/corpus/las_stream`)
 #[test]
 #[ignore = "writes fuzz seeds; run by hand"]
 fn write_fuzz_seeds() {
@@ -175,6 +126,11 @@ fn write_fuzz_seeds() {
         let f = compress(format, extra, Chunks::Fixed(chunk), &raw);
         std::fs::write(dir.join(name), &f.bytes).unwrap();
     }
+    // compressor 1: all points one chunk without a chunk table, the case
+    // the streamed reader's cursor suspends and resumes
+    let raw = records(3, 0, 60, 6);
+    let f = compress_single(3, 0, &raw);
+    std::fs::write(dir.join("pointwise3-compressor1.laz"), &f.bytes).unwrap();
 }
 
 /// Writes the GPS-switch recursion input (see `laz10_gen::gps_switches`) to

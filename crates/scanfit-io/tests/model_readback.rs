@@ -15,7 +15,6 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::path::Path;
-use std::process::Command;
 
 use scanfit::bspline::{KnotVector, Surface};
 use scanfit::topology::{FaceCorners, PatchComplex};
@@ -23,6 +22,9 @@ use scanfit::{Point3, Vector3};
 use scanfit_io::iges::iges_model_file;
 use scanfit_io::model::{parse_model, ModelDoc};
 use scanfit_io::step_shell::{step_shell_file, ShellKind};
+
+#[path = "support/occ.rs"]
+mod occ;
 
 fn bezier(p: usize) -> KnotVector {
     KnotVector::uniform_clamped(p, p + 1).unwrap()
@@ -234,14 +236,6 @@ fn mesh_volume(m: &PatchComplex, n: usize) -> f64 {
     v
 }
 
-fn occ_available() -> bool {
-    Command::new("python3")
-        .args(["-c", "import OCP"])
-        .output()
-        .map(|o| o.status.success())
-        .unwrap_or(false)
-}
-
 /// Writes the model's JSON and STEP, runs the OpenCASCADE check, returns its
 /// report (None without OpenCASCADE).
 fn check(m: &PatchComplex, name: &str) -> Option<serde_json::Value> {
@@ -267,31 +261,10 @@ fn check(m: &PatchComplex, name: &str) -> Option<serde_json::Value> {
     std::fs::write(&jp, json).unwrap();
     std::fs::write(&sp, t).unwrap();
     std::fs::write(dir.join("m.igs"), iges_model_file(m, name).unwrap()).unwrap();
-    if !occ_available() {
-        eprintln!("\n**************************************************************");
-        eprintln!("* OpenCASCADE (pip install cadquery-ocp) is NOT installed:   *");
-        eprintln!("* the sewn-shell STEP check by a CAD kernel was NOT performed *");
-        eprintln!("**************************************************************\n");
-        assert!(
-            std::env::var_os("SCANFIT_REQUIRE_OCC").is_none(),
-            "SCANFIT_REQUIRE_OCC is set but OpenCASCADE is missing"
-        );
+    if occ::missing("the sewn-shell STEP check by a CAD kernel") {
         return None;
     }
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/occ/check_model.py");
-    let o = Command::new("python3")
-        .arg(script)
-        .arg(&jp)
-        .arg(&sp)
-        .output()
-        .unwrap();
-    let out = String::from_utf8_lossy(&o.stdout);
-    let err = String::from_utf8_lossy(&o.stderr);
-    println!("{name}: {out}{err}");
-    assert!(
-        o.status.success(),
-        "{name}: check_model.py failed:\n{out}\n{err}"
-    );
+    let out = occ::run("check_model.py", &[&jp, &sp], name);
     // the IGES file: every patch as entity 128 and every edge curve as 126,
     // evaluated by OpenCASCADE against scanfit (tests/occ/check_cad.py)
     let grid = |s: &Surface| -> Vec<[f64; 5]> {
@@ -312,18 +285,11 @@ fn check(m: &PatchComplex, name: &str) -> Option<serde_json::Value> {
         }).collect::<Vec<_>>()).collect::<Vec<_>>(),
     });
     std::fs::write(dir.join("samples.json"), samples.to_string()).unwrap();
-    let cad = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/occ/check_cad.py");
-    let o = Command::new("python3")
-        .arg(cad)
-        .arg(dir.join("samples.json"))
-        .arg(dir.join("m.igs"))
-        .output()
-        .unwrap();
-    let iges_out = String::from_utf8_lossy(&o.stdout);
-    assert!(
-        o.status.success(),
-        "{name}: IGES read back differs:\n{iges_out}{}",
-        String::from_utf8_lossy(&o.stderr)
+    let (samples, iges) = (dir.join("samples.json"), dir.join("m.igs"));
+    let iges_out = occ::run(
+        "check_cad.py",
+        &[&samples, &iges],
+        &format!("{name}: IGES read-back"),
     );
     let want = format!("{} faces, {} curves", m.faces.len(), m.edges.len());
     assert!(iges_out.contains(&want), "{name}: {iges_out}");
@@ -764,4 +730,16 @@ fn small_gaps_are_sewn_within_the_files_uncertainty() {
         let quad = m.signed_volume();
         assert_closed(&r, &m, "gappy cube-sphere", quad);
     }
+}
+
+/// Writes a small model document as a seed of the `model_json` fuzz target
+/// (a closed tetrahedron of three-sided faces, 7.5 KB, beside the 63 KB
+/// six-patch seed) into `$SCANFIT_SEED_DIR`:
+/// `SCANFIT_SEED_DIR=fuzz/corpus/model_json cargo test -p scanfit-io --test model_readback -- --ignored write_fuzz_seeds`
+#[test]
+#[ignore = "writes fuzz seeds; run by hand"]
+fn write_fuzz_seeds() {
+    let dir = std::path::PathBuf::from(std::env::var_os("SCANFIT_SEED_DIR").unwrap());
+    let json = ModelDoc::new(&tetrahedron()).to_json().unwrap();
+    std::fs::write(dir.join("tetrahedron.json"), json).unwrap();
 }

@@ -20,7 +20,6 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use scanfit::bspline::{KnotVector, Mesh, Surface};
 use scanfit::cloud::boundary::{boundary_loops, BoundaryConfig};
@@ -31,40 +30,20 @@ use scanfit_io::iges::iges_file_with;
 use scanfit_io::step::{step_file_with, CadItem};
 use scanfit_io::units::{CadOptions, LengthUnit};
 
-fn occ_available() -> bool {
-    Command::new("python3")
-        .args(["-c", "import OCP"])
-        .output()
-        .map(|o| o.status.success())
-        .unwrap_or(false)
-}
+#[path = "support/occ.rs"]
+mod occ;
 
 /// Runs check_faces.py on `files`; None (after saying so loudly) without OpenCASCADE.
 fn read_back(files: &[PathBuf], what: &str) -> Option<Vec<serde_json::Value>> {
-    if !occ_available() {
-        let stars = "*".repeat(72);
-        let msg = format!(
-            "\n{stars}\n* OpenCASCADE (pip install cadquery-ocp) is NOT installed.\n\
-             * SKIPPED: the read-back by a CAD kernel of {} files ({what}).\n{stars}\n",
-            files.len()
-        );
-        std::io::Write::write_all(&mut std::io::stderr(), msg.as_bytes()).ok();
-        assert!(
-            std::env::var_os("SCANFIT_REQUIRE_OCC").is_none(),
-            "SCANFIT_REQUIRE_OCC is set but OpenCASCADE is missing"
-        );
+    let skipped = format!(
+        "the read-back by a CAD kernel of {} files ({what}).",
+        files.len()
+    );
+    if occ::missing(&skipped) {
         return None;
     }
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/occ/check_faces.py");
-    let o = Command::new("python3")
-        .arg(script)
-        .args(files)
-        .output()
-        .unwrap();
-    let out = String::from_utf8_lossy(&o.stdout);
-    let err = String::from_utf8_lossy(&o.stderr);
-    println!("{what}:\n{out}{err}");
-    assert!(o.status.success(), "check_faces.py failed:\n{out}\n{err}");
+    let args: Vec<&Path> = files.iter().map(PathBuf::as_path).collect();
+    let out = occ::run("check_faces.py", &args, what);
     Some(
         out.lines()
             .filter(|l| l.starts_with('{'))

@@ -6,13 +6,9 @@
 
 use std::path::Path;
 
-use scanfit::Point3;
-
-use super::{
-    column_names, decode_in_order, transforms, unread_chunks, vlr_bytes, Decoded, Layered, Raw,
-};
-use crate::laz14::{LayeredLaz, Laz14Error, Point14, ReadAt};
-use crate::{Error, Result};
+use super::{column_names, decode_in_order, vlr_bytes, Decoded, Field, Layered, OwnLaz, Raw};
+use crate::laz14::{ChunkSpan, LayeredLaz, Laz14Error, Point14, ReadAt};
+use crate::Error;
 
 pub(super) fn binary(path: &Path, e: Laz14Error) -> Error {
     Error::Binary {
@@ -31,7 +27,7 @@ pub(super) fn open(
     format: u8,
     raw: &Raw,
     layered: &Layered,
-) -> Result<LayeredLaz> {
+) -> crate::Result<LayeredLaz> {
     let file = LayeredLaz::new(
         read,
         vlr,
@@ -57,45 +53,38 @@ pub(super) fn open(
     Ok(file)
 }
 
-/// The columns of a layered file's points (see [`column_names`]).
-pub(super) fn names(file: &LayeredLaz) -> Vec<&'static str> {
-    column_names(true, file.has_rgb(), file.has_nir())
-}
-
-/// Appends decoded points: coordinates to `points`, the columns of
-/// [`names`] to `columns`.
-pub(super) fn append(
-    file: &LayeredLaz,
-    transform: &[(f64, f64); 3],
-    chunk: &[Point14],
-    points: &mut Vec<Point3>,
-    columns: &mut [Vec<f64>],
-) {
-    let at = |v: i32, k: usize| transform[k].0 * f64::from(v) + transform[k].1;
-    points.extend(
-        chunk
-            .iter()
-            .map(|p| Point3::new(at(p.x, 0), at(p.y, 1), at(p.z, 2))),
-    );
-    let fields: [&(dyn Fn(&Point14) -> f64 + Sync); 10] = [
-        &|p| f64::from(p.intensity),
-        &|p| f64::from(p.return_number),
-        &|p| f64::from(p.number_of_returns),
-        &|p| f64::from(p.classification),
-        &|p| f64::from(p.point_source_id),
-        &|p| p.gps_time,
-        &|p| f64::from(p.rgb[0]),
-        &|p| f64::from(p.rgb[1]),
-        &|p| f64::from(p.rgb[2]),
-        &|p| f64::from(p.nir),
-    ];
-    let (rgb, nir) = (file.has_rgb(), file.has_nir());
-    let used = [true, true, true, true, true, true, rgb, rgb, rgb, nir];
-    let mut column = columns.iter_mut();
-    for (f, _) in fields.iter().zip(used).filter(|(_, u)| *u) {
-        if let Some(col) = column.next() {
-            col.extend(chunk.iter().map(f));
-        }
+impl OwnLaz for LayeredLaz {
+    type Record = Point14;
+    fn spans(&self) -> &[ChunkSpan] {
+        self.chunks()
+    }
+    fn span_bytes(&self, c: usize) -> u64 {
+        self.chunk_bytes(c)
+    }
+    fn decode_span(&self, c: usize, data: &[u8], out: &mut Vec<Point14>) -> Result<(), Laz14Error> {
+        self.decode_chunk(c, data, out)
+    }
+    fn names(&self) -> Vec<&'static str> {
+        column_names(true, self.has_rgb(), self.has_nir())
+    }
+    fn xyz(p: &Point14) -> [i32; 3] {
+        [p.x, p.y, p.z]
+    }
+    fn fields(&self) -> Vec<Field<Point14>> {
+        let (rgb, nir) = (self.has_rgb(), self.has_nir());
+        let fields: [Field<Point14>; 10] = [
+            (|p| f64::from(p.intensity), true),
+            (|p| f64::from(p.return_number), true),
+            (|p| f64::from(p.number_of_returns), true),
+            (|p| f64::from(p.classification), true),
+            (|p| f64::from(p.point_source_id), true),
+            (|p| p.gps_time, true),
+            (|p| f64::from(p.rgb[0]), rgb),
+            (|p| f64::from(p.rgb[1]), rgb),
+            (|p| f64::from(p.rgb[2]), rgb),
+            (|p| f64::from(p.nir), nir),
+        ];
+        fields.to_vec()
     }
 }
 
@@ -105,7 +94,7 @@ pub(super) fn read_layered(
     bytes: &[u8],
     raw: &Raw,
     layered: &Layered,
-) -> Result<Decoded> {
+) -> crate::Result<Decoded> {
     let format = bytes.get(104).copied().unwrap_or(0) & 0x3f;
     let vlr = vlr_bytes(bytes, layered.vlr_at, layered.vlr_len);
     let read = |at: u64, n: usize| -> Option<Vec<u8>> {
@@ -113,23 +102,5 @@ pub(super) fn read_layered(
         bytes.get(at..at.checked_add(n)?).map(<[u8]>::to_vec)
     };
     let file = open(path, &read, vlr, format, raw, layered)?;
-    let transform = transforms(path, bytes)?;
-    let names = names(&file);
-    let mut decoded = decode_in_order(
-        path,
-        bytes,
-        layered.count,
-        names,
-        file.chunks(),
-        |c| file.chunk_bytes(c),
-        |c, data, out| file.decode_chunk(c, data, out),
-        |chunk, points, columns| append(&file, &transform, chunk, points, columns),
-    )?;
-    decoded.warnings = unread_chunks(
-        path,
-        layered.table_chunks,
-        file.chunks().len(),
-        layered.count,
-    );
-    Ok(decoded)
+    decode_in_order(path, bytes, &file, layered.count, layered.table_chunks)
 }

@@ -6,17 +6,10 @@
 
 use std::path::Path;
 
-use scanfit::Point3;
-
 use super::layered::binary;
-use super::{column_names, decode_in_order, transforms, unread_chunks, Decoded, Pointwise};
-use crate::laz14::{PointwiseLaz, PointwiseRecord};
+use super::{column_names, decode_in_order, Decoded, Field, OwnLaz, Pointwise};
+use crate::laz14::{ChunkSpan, Laz14Error, PointwiseLaz, PointwiseRecord};
 use crate::{Error, Result};
-
-/// The columns of a pointwise file's points (see [`column_names`]).
-pub(super) fn names(file: &PointwiseLaz) -> Vec<&'static str> {
-    column_names(file.has_gps_time(), file.has_rgb(), false)
-}
 
 /// The file's chunks, checked (see [`PointwiseLaz::new`]).
 pub(super) fn open(
@@ -36,38 +29,42 @@ pub(super) fn open(
     .map_err(|e| binary(path, e))
 }
 
-/// The extra columns of decoded points, appended to `columns` (in the
-/// order of [`column_names`]) and their coordinates to `points`.
-pub(super) fn append(
-    file: &PointwiseLaz,
-    transform: &[(f64, f64); 3],
-    chunk: &[PointwiseRecord],
-    points: &mut Vec<Point3>,
-    columns: &mut [Vec<f64>],
-) {
-    let at = |v: i32, k: usize| transform[k].0 * f64::from(v) + transform[k].1;
-    points.extend(chunk.iter().map(|r| {
-        let p = &r.point;
-        Point3::new(at(p.x, 0), at(p.y, 1), at(p.z, 2))
-    }));
-    let fields: [&(dyn Fn(&PointwiseRecord) -> f64 + Sync); 9] = [
-        &|r| f64::from(r.point.intensity),
-        &|r| f64::from(r.point.return_number()),
-        &|r| f64::from(r.point.number_of_returns()),
-        &|r| f64::from(r.point.classification & 0x1f),
-        &|r| f64::from(r.point.point_source_id),
-        &|r| r.gps_time,
-        &|r| f64::from(r.rgb[0]),
-        &|r| f64::from(r.rgb[1]),
-        &|r| f64::from(r.rgb[2]),
-    ];
-    let (gps, rgb) = (file.has_gps_time(), file.has_rgb());
-    let used = [true, true, true, true, true, gps, rgb, rgb, rgb];
-    let mut column = columns.iter_mut();
-    for (f, _) in fields.iter().zip(used).filter(|(_, u)| *u) {
-        if let Some(col) = column.next() {
-            col.extend(chunk.iter().map(f));
-        }
+impl OwnLaz for PointwiseLaz {
+    type Record = PointwiseRecord;
+    fn spans(&self) -> &[ChunkSpan] {
+        self.chunks()
+    }
+    fn span_bytes(&self, c: usize) -> u64 {
+        self.chunk_bytes(c)
+    }
+    fn decode_span(
+        &self,
+        c: usize,
+        data: &[u8],
+        out: &mut Vec<PointwiseRecord>,
+    ) -> std::result::Result<(), Laz14Error> {
+        self.decode_chunk(c, data, out)
+    }
+    fn names(&self) -> Vec<&'static str> {
+        column_names(self.has_gps_time(), self.has_rgb(), false)
+    }
+    fn xyz(r: &PointwiseRecord) -> [i32; 3] {
+        [r.point.x, r.point.y, r.point.z]
+    }
+    fn fields(&self) -> Vec<Field<PointwiseRecord>> {
+        let (gps, rgb) = (self.has_gps_time(), self.has_rgb());
+        let fields: [Field<PointwiseRecord>; 9] = [
+            (|r| f64::from(r.point.intensity), true),
+            (|r| f64::from(r.point.return_number()), true),
+            (|r| f64::from(r.point.number_of_returns()), true),
+            (|r| f64::from(r.point.classification & 0x1f), true),
+            (|r| f64::from(r.point.point_source_id), true),
+            (|r| r.gps_time, gps),
+            (|r| f64::from(r.rgb[0]), rgb),
+            (|r| f64::from(r.rgb[1]), rgb),
+            (|r| f64::from(r.rgb[2]), rgb),
+        ];
+        fields.to_vec()
     }
 }
 
@@ -81,20 +78,7 @@ pub(super) fn read_pointwise(path: &Path, bytes: &[u8], pw: &Pointwise) -> Resul
         &file,
         pw.vlr_at,
     )?;
-    let transform = transforms(path, bytes)?;
-    let names = names(&file);
-    let mut decoded = decode_in_order(
-        path,
-        bytes,
-        pw.count,
-        names,
-        file.chunks(),
-        |c| file.chunk_bytes(c),
-        |c, data, out| file.decode_chunk(c, data, out),
-        |chunk, points, columns| append(&file, &transform, chunk, points, columns),
-    )?;
-    decoded.warnings = unread_chunks(path, pw.table_chunks, file.chunks().len(), pw.count);
-    Ok(decoded)
+    decode_in_order(path, bytes, &file, pw.count, pw.table_chunks)
 }
 
 /// The header's point format must be the one the LASzip items describe.

@@ -29,7 +29,7 @@ use scanfit::Point3;
 use super::view::{u8_at, FileView, View};
 use super::{
     crate_failed, header_warnings, layered, laz_check, pointwise, precheck, quietly, transforms,
-    unread_chunks, Compressed, CrateReader, Raw,
+    unread_chunks, Compressed, CrateReader, OwnLaz, Raw,
 };
 use crate::laz14::{LayeredLaz, PointwiseCursor, PointwiseLaz, PointwiseRecord};
 use crate::table::{Format, Origin, PointTable};
@@ -54,6 +54,8 @@ struct PointwiseStream {
     cursor: Option<PointwiseCursor>,
     /// the last batch decoded
     records: Vec<PointwiseRecord>,
+    /// bytes of a LAZ chunk the cursor holds at a time
+    window: usize,
 }
 
 impl PointwiseStream {
@@ -71,7 +73,7 @@ impl PointwiseStream {
                     }
                     let c = self
                         .file
-                        .cursor(self.next)
+                        .cursor_with_window(self.next, self.window)
                         .map_err(|e| layered::binary(path, e))?;
                     self.next += 1;
                     self.cursor.insert(c)
@@ -132,7 +134,7 @@ impl LasChunks {
             Compressed::Layered(l) => {
                 let vlr = view.read(l.vlr_at, l.vlr_len as usize).unwrap_or_default();
                 let file = layered::open(path, &read, &vlr, format, &raw, &l)?;
-                let names = layered::names(&file);
+                let names = file.names();
                 let w = unread_chunks(path, l.table_chunks, file.chunks().len(), l.count);
                 (Decoder::Layered(file, 0), names, l.count, w)
             }
@@ -142,13 +144,14 @@ impl LasChunks {
                     .unwrap_or_default();
                 let file = pointwise::open(path, len, &pw, &vlr)?;
                 pointwise::check_format(path, format, &file, pw.vlr_at)?;
-                let names = pointwise::names(&file);
+                let names = file.names();
                 let w = unread_chunks(path, pw.table_chunks, file.chunks().len(), pw.count);
                 let stream = PointwiseStream {
                     file,
                     next: 0,
                     cursor: None,
                     records: Vec::new(),
+                    window: crate::laz14::WINDOW,
                 };
                 (Decoder::Pointwise(Box::new(stream)), names, pw.count, w)
             }
@@ -179,6 +182,14 @@ impl LasChunks {
             warnings: Vec::new(),
             laz_warnings,
         })
+    }
+
+    /// Sets the window of a pointwise LAZ chunk's cursor (see
+    /// [`crate::chunks::PointChunks::set_laz_window`]).
+    pub(crate) fn set_window(&mut self, window: usize) {
+        if let Decoder::Pointwise(s) = &mut self.decoder {
+            s.window = window;
+        }
     }
 
     /// The reader's warnings, complete once the pass has ended.
@@ -231,8 +242,7 @@ impl LasChunks {
                 if !stream.next_batch(&self.view, &path, chunk)? {
                     return Ok(false);
                 }
-                pointwise::append(
-                    &stream.file,
+                stream.file.append(
                     &self.transform,
                     &stream.records,
                     &mut self.points,
@@ -249,13 +259,7 @@ impl LasChunks {
                 let mut decoded = Vec::new();
                 file.decode_chunk(c, &bytes, &mut decoded)
                     .map_err(|e| layered::binary(&path, e))?;
-                layered::append(
-                    file,
-                    &self.transform,
-                    &decoded,
-                    &mut self.points,
-                    &mut self.extra,
-                );
+                file.append(&self.transform, &decoded, &mut self.points, &mut self.extra);
                 *next += 1;
             }
         }

@@ -46,12 +46,16 @@ pub(super) struct VlrItems {
 }
 
 impl VlrItems {
-    /// Reads the VLR payload `vlr` (found at byte `at`, for messages).
-    pub(super) fn read(vlr: &[u8], at: u64) -> Result<Self, Laz14Error> {
-        let err = |message: String| Laz14Error {
-            offset: at,
-            message,
-        };
+    /// Reads the VLR payload `vlr` (found at byte `at`, for messages) of a
+    /// file whose compressor must be one of `compressors`; `uses` says
+    /// which points use them, in the message of another compressor.
+    pub(super) fn read(
+        vlr: &[u8],
+        at: u64,
+        compressors: &[u16],
+        uses: &str,
+    ) -> Result<Self, Laz14Error> {
+        let err = Laz14Error::at(at);
         let (Some(compressor), Some(chunk_size), Some(count)) =
             (u16_at(vlr, 0), u32_at(vlr, 12), u16_at(vlr, 32))
         else {
@@ -72,6 +76,11 @@ impl VlrItems {
                 }
             })
             .collect::<Result<_, _>>()?;
+        if !compressors.contains(&compressor) {
+            return Err(err(format!(
+                "the LASzip VLR declares compressor {compressor}; {uses}"
+            )));
+        }
         Ok(Self {
             compressor,
             chunk_size,
@@ -183,18 +192,17 @@ impl Items {
     /// optionally RGB or RGB+NIR, extra bytes and a wave packet, all of
     /// the same version (3 or 4).
     fn from_vlr(vlr: &[u8], at: u64) -> Result<(Self, u32), Laz14Error> {
-        let err = |message: String| Laz14Error {
-            offset: at,
-            message,
-        };
+        let err = Laz14Error::at(at);
         let VlrItems {
-            compressor,
             chunk_size,
             items: list,
-        } = VlrItems::read(vlr, at)?;
-        if compressor != 3 {
-            return Err(err(format!("the LASzip VLR declares compressor {compressor}; LAS 1.4 points (formats 6-10) use the layered compressor 3")));
-        }
+            ..
+        } = VlrItems::read(
+            vlr,
+            at,
+            &[3],
+            "LAS 1.4 points (formats 6-10) use the layered compressor 3",
+        )?;
         let mut items = Items::default();
         let mut version = None;
         let mut stage = 0; // 0: point14 expected, 1: colour, 2: extra bytes, 3: wave packet, 4: done
@@ -297,10 +305,7 @@ impl LayeredLaz {
         let (items, chunk_size) = Items::from_vlr(vlr, vlr_at)?;
         let head = (items.record() + 4 + 4 * items.layers()) as u64;
         let (chunks, sizes) = walk_chunks(start.saturating_add(8), count, |c, pos, left| {
-            let err = |message: String| Laz14Error {
-                offset: pos,
-                message,
-            };
+            let err = Laz14Error::at(pos);
             if pos.saturating_add(head) > end {
                 return Err(err(format!(
                     "the header declares {count} points, but the compressed data ends after {} of them (before the header of chunk {c}); the file is truncated",

@@ -140,6 +140,13 @@ pub struct Laz14Error {
     pub message: String,
 }
 
+impl Laz14Error {
+    /// A maker of errors at byte `offset`.
+    pub(crate) fn at(offset: u64) -> impl Fn(String) -> Laz14Error {
+        move |message| Laz14Error { offset, message }
+    }
+}
+
 impl std::fmt::Display for Laz14Error {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "byte offset {}: {}", self.offset, self.message)

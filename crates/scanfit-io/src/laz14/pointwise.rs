@@ -76,18 +76,17 @@ impl Items {
     /// RGB, wave packet and extra bytes, each optional and in this order,
     /// all of version 2 (a wave packet of version 1 or 2: LASzip has one).
     fn from_vlr(vlr: &[u8], at: u64) -> Result<(Self, u16, u32), Laz14Error> {
-        let err = |message: String| Laz14Error {
-            offset: at,
-            message,
-        };
+        let err = Laz14Error::at(at);
         let VlrItems {
             compressor,
             chunk_size,
             items: list,
-        } = VlrItems::read(vlr, at)?;
-        if !matches!(compressor, 1 | 2) {
-            return Err(err(format!("the LASzip VLR declares compressor {compressor}; point formats 0-5 use the pointwise compressors 1 and 2")));
-        }
+        } = VlrItems::read(
+            vlr,
+            at,
+            &[1, 2],
+            "point formats 0-5 use the pointwise compressors 1 and 2",
+        )?;
         let mut items = Items::default();
         let mut stage = 0; // 0: point-10 expected, then 1 GPS, 2 RGB, 3 wave packet, 4 extra bytes, 5 done
         for (k, &(kind, size, version)) in list.iter().enumerate() {
@@ -187,10 +186,7 @@ impl PointwiseLaz {
             });
         }
         let (chunks, sizes) = walk_chunks(start.saturating_add(8), count, |c, pos, _| {
-            let err = |message: String| Laz14Error {
-                offset: pos,
-                message,
-            };
+            let err = Laz14Error::at(pos);
             let Some(table) = table else {
                 return Err(Laz14Error {
                     offset: start,

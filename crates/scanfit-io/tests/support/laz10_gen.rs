@@ -14,8 +14,10 @@ use scanfit_io::laz14::{Point10, PointwiseLaz, PointwiseRecord};
 
 #[path = "laz_gen.rs"]
 pub mod laz_gen;
-use laz_gen::{laszip_vlr, with_laszip_vlr, write_points};
-pub use laz_gen::{table_end, Chunks, Laz, Rng};
+use laz_gen::{
+    each_chunk, las_header, laszip_vlr, wave_packet, with_laszip_vlr, write_points, Scan,
+};
+pub use laz_gen::{table, table_end, Chunks, Laz};
 
 /// Bytes of a record of `format` (0-5) with `extra` extra bytes.
 pub fn record_len(format: u8, extra: usize) -> usize {
@@ -36,112 +38,57 @@ fn has_wave(format: u8) -> bool {
 /// from `seed`.
 pub fn records(format: u8, extra: usize, n: usize, seed: u64) -> Vec<u8> {
     let len = record_len(format, extra);
-    let mut rng = Rng(seed | 1);
+    let mut scan = Scan::new(seed, [2.0e8, 4.0e8, 6.5e8, 8.0e8]);
     let mut out = Vec::with_capacity(n * len);
-    let mut times = [2.0e8f64, 4.0e8, 6.5e8, 8.0e8];
-    let mut seq = 0usize;
-    let (mut x, mut y, mut z) = (1000i32, -2000i32, 500i32);
-    let (mut class, mut flags, mut source, mut angle, mut user) = (2u8, 0u8, 7u16, 0i8, 0u8);
-    let mut rgb = [1000u16, 2000, 3000];
     let mut bytes = vec![0u8; extra];
     let mut k = 0;
     while k < n {
         // one pulse: 1 to 5 returns (sometimes up to 7), one GPS time
-        let returns = if rng.below(100) < 3 {
-            6 + rng.below(2) as u8
-        } else {
-            1 + rng.below(5) as u8
-        };
-        match rng.below(100) {
-            0..=1 => {
-                // a jump to a new far time (a new sequence)
-                seq = (seq + 1) % 4;
-                times[seq] += 1.0e7 * (1 + rng.below(50)) as f64;
-            }
-            2..=4 => seq = rng.below(4) as usize, // back to another sequence
-            5..=14 => {}                          // time repeated
-            15..=19 => times[seq] += 0.001 * rng.below(3000) as f64,
-            _ => times[seq] += 1.0e-5,
-        }
+        let returns = scan.returns(2);
+        let time = scan.pulse_time(10);
         for r in 1..=returns {
             if k == n {
                 break;
             }
-            x = x.wrapping_add(rng.below(400) as i32 - 200);
-            y = y.wrapping_add(if rng.below(100) < 2 {
-                1 << 20
-            } else {
-                rng.below(60) as i32 - 30
-            });
-            z = z.wrapping_add(rng.below(100) as i32 - 50 - 20 * i32::from(r));
-            if rng.below(100) < 10 {
-                class = [1, 2, 3, 5, 6, 9, 17, 64, 200][rng.below(9) as usize];
-            }
-            if rng.below(100) < 5 {
-                flags = (rng.below(4) as u8) << 6;
-            }
-            if rng.below(100) < 4 {
-                source = rng.below(65536) as u16;
-            }
-            if rng.below(100) < 30 {
-                angle = (rng.below(181) as i32 - 90) as i8;
-            }
-            if rng.below(100) < 5 {
-                user = rng.below(256) as u8;
-            }
-            if rng.below(100) < 40 {
-                if rng.below(100) < 30 {
-                    let g = rng.below(65536) as u16;
-                    rgb = [g, g, g];
-                } else {
-                    for c in &mut rgb {
-                        *c = c.wrapping_add(rng.below(600) as u16).wrapping_sub(300);
-                    }
-                }
-            }
+            scan.next_return(
+                r,
+                |rng| (rng.below(4) as u8) << 6,
+                |rng| rng.below(181) as i16 - 90,
+            );
             for b in &mut bytes {
-                if rng.below(100) < 20 {
-                    *b = b.wrapping_add(rng.below(7) as u8);
+                if scan.rng.chance(20) {
+                    *b = b.wrapping_add(scan.rng.below(7) as u8);
                 }
             }
-            let intensity = (rng.below(4000) + 100 * u64::from(r)) as u16;
             let mut rec = vec![0u8; len];
-            rec[0..4].copy_from_slice(&x.to_le_bytes());
-            rec[4..8].copy_from_slice(&y.to_le_bytes());
-            rec[8..12].copy_from_slice(&z.to_le_bytes());
-            rec[12..14].copy_from_slice(&intensity.to_le_bytes());
-            rec[14] = (r & 7) | ((returns & 7) << 3) | flags;
-            rec[15] = class;
-            rec[16] = angle as u8;
-            rec[17] = user;
-            rec[18..20].copy_from_slice(&source.to_le_bytes());
+            rec[..14].copy_from_slice(&scan.head(r));
+            rec[14] = (r & 7) | ((returns & 7) << 3) | scan.flags;
+            rec[15] = scan.class;
+            rec[16] = scan.angle as i8 as u8;
+            rec[17] = scan.user;
+            rec[18..20].copy_from_slice(&scan.source.to_le_bytes());
             let mut at = 20;
             if has_gps(format) {
-                rec[at..at + 8].copy_from_slice(&times[seq].to_le_bytes());
+                rec[at..at + 8].copy_from_slice(&time.to_le_bytes());
                 at += 8;
             }
             if has_rgb(format) {
-                for (c, v) in rgb.iter().enumerate() {
+                for (c, v) in scan.rgb.iter().enumerate() {
                     rec[at + 2 * c..at + 2 + 2 * c].copy_from_slice(&v.to_le_bytes());
                 }
                 at += 6;
             }
             if has_wave(format) {
-                // descriptor, offset (same, after the last, a jump), size,
-                // return point, dx dy dz
-                rec[at] = 1 + rng.below(3) as u8;
-                let offset = match rng.below(4) {
+                // the offset: the same, after the last, a jump or raw
+                let d = 1 + scan.rng.below(3) as u8;
+                let offset = match scan.rng.below(4) {
                     0 => 256 * k as u64,
                     1 => 256 * k as u64 + 7,
                     2 => 1 << 40,
                     // (the laz encoder subtracts offsets as i64: keep them below 2^60)
-                    _ => rng.next() >> 4,
+                    _ => scan.rng.next() >> 4,
                 };
-                rec[at + 1..at + 9].copy_from_slice(&offset.to_le_bytes());
-                rec[at + 9..at + 13].copy_from_slice(&256u32.to_le_bytes());
-                for (j, v) in [r as f32, 0.5, -0.25, 1.0].iter().enumerate() {
-                    rec[at + 13 + 4 * j..at + 17 + 4 * j].copy_from_slice(&v.to_le_bytes());
-                }
+                rec[at..at + 29].copy_from_slice(&wave_packet(d, offset, r));
                 at += 29;
             }
             rec[at..at + extra].copy_from_slice(&bytes);
@@ -164,23 +111,11 @@ fn items(format: u8, extra: u16) -> Vec<laz::LazItem> {
     }
 }
 
-/// The LAS 1.2 header (and VLR header) of a file of `n` records of
-/// `format` with `len` bytes, points at `start`.
+/// The LAS 1.2 header of a file of `n` records of `format` with `len`
+/// bytes, points at `start` after `vlrs` VLRs.
 pub fn las12_header(format: u8, len: usize, n: u64, start: u64, vlrs: u32) -> Vec<u8> {
-    let mut h = vec![0u8; 227];
-    h[0..4].copy_from_slice(b"LASF");
-    h[24] = 1;
-    h[25] = 2;
-    h[94..96].copy_from_slice(&227u16.to_le_bytes());
-    h[96..100].copy_from_slice(&(start as u32).to_le_bytes());
-    h[100..104].copy_from_slice(&vlrs.to_le_bytes());
-    h[104] = format;
-    h[105..107].copy_from_slice(&(len as u16).to_le_bytes());
+    let mut h = las_header(2, 227, format, len, start, vlrs);
     h[107..111].copy_from_slice(&(n as u32).to_le_bytes());
-    for (k, s) in [0.01f64, 0.01, 0.001].iter().enumerate() {
-        h[131 + 8 * k..139 + 8 * k].copy_from_slice(&s.to_le_bytes());
-        h[155 + 8 * k..163 + 8 * k].copy_from_slice(&(1.0e5 * (k + 1) as f64).to_le_bytes());
-    }
     h
 }
 
@@ -212,12 +147,7 @@ pub fn compress_single(format: u8, extra: usize, raw: &[u8]) -> Laz {
     c.set_fields_from(vlr.items()).unwrap();
     c.compress_many(raw).unwrap();
     c.done().unwrap();
-    Laz {
-        bytes: c.into_inner().into_inner(),
-        vlr,
-        vlr_payload: payload,
-        start,
-    }
+    Laz::written(c.into_inner(), vlr, payload, start)
 }
 
 /// The fields scanfit decodes, of raw records.
@@ -242,27 +172,17 @@ pub fn fields(raw: &[u8], format: u8, extra: usize) -> Vec<PointwiseRecord> {
         .collect()
 }
 
-/// The chunk table as (points, bytes) per chunk.
-pub fn table(f: &Laz) -> Vec<(u64, u64)> {
-    let mut c = Cursor::new(&f.bytes);
-    c.set_position(f.start);
-    let t = laz::laszip::ChunkTable::read_from(&mut c, &f.vlr).unwrap();
-    (0..t.len())
-        .map(|k| (t[k].point_count, t[k].byte_count))
-        .collect()
-}
-
 /// Ours, chunk by chunk.
 pub fn ours(f: &Laz, n: u64) -> (Vec<PointwiseRecord>, usize) {
     let t = table(f);
     let file =
         PointwiseLaz::new(&f.vlr_payload, 227 + 54, f.start, table_end(f), n, Some(&t)).unwrap();
-    let mut out = Vec::new();
-    for c in 0..file.chunks().len() {
-        let at = file.chunks()[c].offset as usize;
-        let bytes = &f.bytes[at..at + file.chunk_bytes(c) as usize];
-        file.decode_chunk(c, bytes, &mut out).unwrap();
-    }
+    let out = each_chunk(
+        f,
+        file.chunks(),
+        |c| file.chunk_bytes(c),
+        |c, b, out| file.decode_chunk(c, b, out),
+    );
     (out, file.chunks().len())
 }
 
