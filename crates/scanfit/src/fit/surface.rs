@@ -297,7 +297,7 @@ pub fn knots_degenerate(interior: &[f64]) -> bool {
     let mut before = None;
     for t in ends {
         if let Some(b) = before {
-            if !(t - b >= shortest) {
+            if t - b < shortest {
                 return true;
             }
         }
