@@ -255,8 +255,12 @@ pub fn distribution_applies(len: usize, p: usize, count: usize) -> bool {
 
 /// The clamped knot vector on `[0, 1]` with the interior knots of eq. 9.69,
 /// kept strictly inside `(0, 1)` and strictly increasing (the last step of
-/// [`distribution_knots`]).
+/// [`distribution_knots`]); the uniform clamped knots when the distribution
+/// cannot place them ([`knots_degenerate`]).
 pub fn knots_from_interior(mut interior: Vec<f64>, p: usize) -> Result<KnotVector> {
+    if knots_degenerate(&interior) {
+        return KnotVector::uniform_clamped(p, interior.len() + p + 1);
+    }
     // keep interior knots strictly inside (0, 1) and below multiplicity p
     let eps = 1e-9;
     for t in interior.iter_mut() {
@@ -268,6 +272,38 @@ pub fn knots_from_interior(mut interior: Vec<f64>, p: usize) -> Result<KnotVecto
         }
     }
     KnotVector::clamped(p, 0.0, 1.0, &interior)
+}
+
+/// Whether eq. 9.69's interior knots leave a knot span
+/// shorter than a millionth of the uniform one (between consecutive knots,
+/// the ends 0 and 1 included): the parameters repeat (the rows of a grid,
+/// 30 distinct values for 40 control points) or cluster, so spans hold no
+/// parameter, and the basis functions over them are pinned down neither
+/// by the data nor by a smoothing term of any weight (the normal equations
+/// are singular). The distribution cannot place such knots, and
+/// [`knots_from_interior`] uses the uniform ones, as [`distribution_knots`]
+/// does for fewer parameters than control points.
+///
+/// ```
+/// use scanfit::fit::surface::knots_degenerate;
+/// assert!(!knots_degenerate(&[0.25, 0.5, 0.75]));
+/// assert!(knots_degenerate(&[0.25, 0.25, 0.75]));
+/// ```
+pub fn knots_degenerate(interior: &[f64]) -> bool {
+    let shortest = 1e-6 / (interior.len() + 1) as f64;
+    let ends = std::iter::once(0.0)
+        .chain(interior.iter().copied())
+        .chain(std::iter::once(1.0));
+    let mut before = None;
+    for t in ends {
+        if let Some(b) = before {
+            if t - b < shortest {
+                return true;
+            }
+        }
+        before = Some(t);
+    }
+    false
 }
 
 /// Least-squares surface with given knot vectors (clamped, or periodic in `u`).
@@ -868,6 +904,41 @@ mod tests {
             .iter()
             .zip(b.control_points())
             .fold(0.0f64, |m, (x, y)| m.max((x - y).norm()))
+    }
+
+    /// A 30 x 30 grid has 30 distinct values of `u` and of `v`: eq. 9.69
+    /// for 40 control points puts knots on repeated values, and those spans
+    /// made the smoothed normal equations singular (`fit --ctrl 40x40
+    /// --smooth 0.001` on 900 points failed). The knots are now uniform
+    /// and the fit follows the sheet.
+    #[test]
+    fn repeated_parameters_take_uniform_knots_and_fit() -> Result<()> {
+        let (mut pts, mut uv) = (Vec::new(), Vec::new());
+        for i in 0..30 {
+            for j in 0..30 {
+                let (u, v) = (f64::from(i) / 29.0, f64::from(j) / 29.0);
+                pts.push(Point3::new(u, v, 0.2 * (3.0 * u).sin() * v));
+                uv.push([u, v]);
+            }
+        }
+        let k = distribution_knots(uv.iter().map(|t| t[0]), 3, 40)?;
+        assert_eq!(k, KnotVector::uniform_clamped(3, 40)?);
+        // 30 control points: eq. 9.69 finds 26 distinct interior knots
+        let k30 = distribution_knots(uv.iter().map(|t| t[0]), 3, 30)?;
+        assert_ne!(k30, KnotVector::uniform_clamped(3, 30)?);
+        let cfg = SurfaceFitConfig {
+            ctrl: (40, 40),
+            smoothing: 1e-3,
+            ..SurfaceFitConfig::default()
+        };
+        let s = fit_surface(&pts, &uv, &cfg)?;
+        let worst = pts
+            .iter()
+            .zip(&uv)
+            .fold(0.0f64, |m, (p, t)| m.max((s.point(t[0], t[1]) - p).norm()));
+        // relief 0.2: the smoothed fit stays within 1% of it
+        assert!(worst < 2e-3, "max error {worst}");
+        Ok(())
     }
 
     #[test]
