@@ -13,7 +13,8 @@ pub use coons::{
 pub use coons_cloud::{coons_from_cloud, CoonsFromCloud, CoonsFromCloudConfig};
 pub use coons_param::{coons_parameters, CoonsParamConfig, CoonsParameters, CoonsProjection};
 pub use plane::{
-    plane_frame, plane_parameters, FlatHull, PlaneAxes, PlaneExtents, PlaneFrame, PlaneMap,
-    PlaneParameterization,
+    choose_projection, plane_frame, plane_parameters, FlatHull, PlaneAxes, PlaneExtents,
+    PlaneFrame, PlaneMap, PlaneParameterization, Projection, ProjectionAxis, FOLD_MARGIN,
+    FOLD_MIN_POINTS, FOLD_SAMPLE, FOLD_SEED,
 };
 pub mod turntable;
