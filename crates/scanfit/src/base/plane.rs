@@ -11,11 +11,12 @@
 //! projection onto it folds where the bumps face away from the tilt, while
 //! the projection along the heights' axis would not fold at all. So
 //! [`plane_parameters`] measures the fold-over share of each candidate
-//! direction ([`choose_projection`]: the best-fit plane's normal and the
-//! three coordinate axes) on a seeded sample and projects along the best;
-//! the best-fit plane is kept whenever it does not fold more than the
+//! direction ([`super::choose_projection`]: the best-fit plane's normal and
+//! the three coordinate axes) on a seeded sample and projects along the
+//! best; the best-fit plane is kept whenever it does not fold more than the
 //! others, so a sheet over its plane is parameterized as before.
 
+use super::projection::{fold_sample, projected_frame, Projection};
 use crate::wire::{Reader, Writer};
 use crate::{Error, Point3, Result, Vector3};
 
@@ -37,72 +38,6 @@ pub struct PlaneParameterization {
     /// The projection direction and why it was chosen.
     pub projection: Projection,
 }
-
-/// The directions [`plane_parameters`] can project the points along.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ProjectionAxis {
-    /// The normal of the points' best-fit plane (PCA).
-    BestFitPlane,
-    /// The `x` axis (the points' `y, z`).
-    X,
-    /// The `y` axis (the points' `x, z`).
-    Y,
-    /// The `z` axis (the points' `x, y`).
-    Z,
-}
-
-impl ProjectionAxis {
-    /// The candidates in the order of [`Projection::fold_shares`].
-    pub const ALL: [ProjectionAxis; 4] = [
-        ProjectionAxis::BestFitPlane,
-        ProjectionAxis::X,
-        ProjectionAxis::Y,
-        ProjectionAxis::Z,
-    ];
-
-    /// `"best-fit plane"`, `"x"`, `"y"` or `"z"`.
-    pub fn name(self) -> &'static str {
-        match self {
-            ProjectionAxis::BestFitPlane => "best-fit plane",
-            ProjectionAxis::X => "x",
-            ProjectionAxis::Y => "y",
-            ProjectionAxis::Z => "z",
-        }
-    }
-}
-
-/// The direction the points are projected along, and the measure that
-/// chose it ([`choose_projection`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Projection {
-    /// The chosen candidate.
-    pub axis: ProjectionAxis,
-    /// Its unit direction (the parameter plane's normal).
-    pub direction: Vector3,
-    /// Share of sampled points on the folded-back side, per candidate in
-    /// the order of [`ProjectionAxis::ALL`] (all 0 when the cloud is too
-    /// small to measure, [`FOLD_MIN_POINTS`]).
-    pub fold_shares: [f64; 4],
-    /// Points sampled for the measure (0: not measured, the best-fit plane
-    /// kept).
-    pub sampled: usize,
-    /// Lengths of the parameter rectangle's sides along `u` and `v` (data
-    /// units): the parameters times these are lengths in the projection
-    /// plane.
-    pub extent: [f64; 2],
-}
-
-/// Points sampled by [`choose_projection`] (seeded, [`FOLD_SEED`]).
-pub const FOLD_SAMPLE: usize = 4000;
-/// Seed of the sample of [`choose_projection`].
-pub const FOLD_SEED: u64 = 0x5ca1_f01d;
-/// Below this many points the best-fit plane is kept unmeasured (too few
-/// for 16-neighbour normals that say anything about folds).
-pub const FOLD_MIN_POINTS: usize = 64;
-/// Margin by which a coordinate axis must fold less than the best-fit
-/// plane to replace it: 0.2% of the sample (8 of 4000 normals, noise at
-/// the borders), so a sheet over its plane keeps it.
-pub const FOLD_MARGIN: f64 = 0.002;
 
 /// The best-fit plane's frame: the centroid, the in-plane axes along the
 /// minimum-area bounding rectangle and the normal, without the parameters
@@ -150,15 +85,17 @@ pub fn plane_frame(points: &[Point3]) -> Result<PlaneFrame> {
 
 /// Parameters of `points` on their best-fit plane, or, when that plane
 /// folds the points over and a coordinate axis does not
-/// ([`choose_projection`]), on the plane across that axis. Axis signs are
-/// made deterministic (largest component positive), so the result does not
-/// depend on the eigen solver.
+/// ([`super::choose_projection`]), on the plane across that axis. Axis
+/// signs are made deterministic (largest component positive), so the result
+/// does not depend on the eigen solver.
 ///
-/// The steps are those of a chunked or distributed run ([`PlaneAxes`] from
-/// the covariance sums, [`FlatHull`], [`PlaneExtents`], [`PlaneMap`]), each
-/// fed all points at once here; the choice of direction needs the sampled
-/// normals, which streamed sums do not give, so a distributed run always
-/// projects onto the best-fit plane.
+/// The steps are those of a chunked or distributed run
+/// ([`super::PlaneMoments`]: the covariance sums and the seeded sample that
+/// chooses the direction; [`FlatHull`], [`PlaneExtents`], [`PlaneMap`]),
+/// each fed all points at once here, the point's index its position in
+/// `points`: a streamed or distributed run over the same points in the same
+/// order makes the same choice and gives the same parameters (to the
+/// rounding of the sums).
 ///
 /// ```
 /// use scanfit::base::{plane_parameters, ProjectionAxis};
@@ -176,17 +113,12 @@ pub fn plane_frame(points: &[Point3]) -> Result<PlaneFrame> {
 /// # Ok::<(), scanfit::Error>(())
 /// ```
 pub fn plane_parameters(points: &[Point3]) -> Result<PlaneParameterization> {
-    let (pca, best) = best_axes(points)?;
-    let mut projection = choose_projection_from(points, &best)?;
-    let axes = match projection.axis {
-        ProjectionAxis::BestFitPlane => best,
-        _ => axis_frame(&pca, projection.direction),
-    };
+    let pca = checked_pca(points)?;
+    let mut sample = fold_sample();
+    sample.add(0, points);
+    let (axes, mut projection) = projected_frame(&pca, &sample)?;
     let map = map_along(&axes, points)?;
-    projection.extent = [
-        map.bounds[0].1 - map.bounds[0].0,
-        map.bounds[1].1 - map.bounds[1].0,
-    ];
+    projection.extent = map.extent();
     let uv = points.iter().map(|p| map.uv(p)).collect();
     Ok(PlaneParameterization {
         origin: map.origin,
@@ -199,98 +131,8 @@ pub fn plane_parameters(points: &[Point3]) -> Result<PlaneParameterization> {
     })
 }
 
-/// The projection direction [`plane_parameters`] uses for `points`: among
-/// the best-fit plane's normal and the `x`, `y`, `z` axes, the one whose
-/// projection folds the fewest points over.
-///
-/// The measure: a seeded sample of [`FOLD_SAMPLE`] points gets normals by
-/// PCA over 16 neighbours, oriented consistently by Hoppe's spanning tree
-/// ([`crate::cloud::normals`]). Projecting a surface along `d` is locally
-/// one-to-one and orientation-preserving where `n . d` has one sign; where
-/// the surface turns back over the plane the sign flips. A candidate's
-/// fold share is the share of the sampled normals on the minority side,
-/// `min(#{n . d > 0}, #{n . d < 0}) / sample` (0 for a projection that
-/// does not fold; independent of the orientation's global sign and of the
-/// data's scale). The best-fit plane is kept unless an axis folds less by
-/// more than [`FOLD_MARGIN`]; among axes, the smallest share wins, ties to
-/// the larger mean `|n . d|` (the less stretched projection). Clouds of
-/// fewer than [`FOLD_MIN_POINTS`] points keep the best-fit plane.
-///
-/// Errors: those of [`plane_frame`] (invalid, too few or collinear points).
-///
-/// ```
-/// use scanfit::base::{choose_projection, ProjectionAxis};
-/// use scanfit::Point3;
-/// // a tilted flat sheet: its best-fit plane folds nothing and is kept
-/// let pts: Vec<Point3> = (0..900)
-///     .map(|k| {
-///         let (x, y) = ((k % 30) as f64, (k / 30) as f64);
-///         Point3::new(x, y, 2.0 * x + 0.5 * y)
-///     })
-///     .collect();
-/// let c = choose_projection(&pts).unwrap();
-/// assert_eq!(c.axis, ProjectionAxis::BestFitPlane);
-/// assert_eq!(c.fold_shares[0], 0.0);
-/// # Ok::<(), scanfit::Error>(())
-/// ```
-pub fn choose_projection(points: &[Point3]) -> Result<Projection> {
-    let (_, best) = best_axes(points)?;
-    choose_projection_from(points, &best)
-}
-
-/// [`choose_projection`] given the points' best-fit frame.
-fn choose_projection_from(points: &[Point3], best: &PlaneAxes) -> Result<Projection> {
-    let dirs = [best.normal, Vector3::x(), Vector3::y(), Vector3::z()];
-    let mut projection = Projection {
-        axis: ProjectionAxis::BestFitPlane,
-        direction: best.normal,
-        fold_shares: [0.0; 4],
-        sampled: 0,
-        extent: [0.0; 2],
-    };
-    if points.len() < FOLD_MIN_POINTS {
-        return Ok(projection);
-    }
-    let sample: Vec<Point3> = crate::sampling::sample_indices(points.len(), FOLD_SAMPLE, FOLD_SEED)
-        .into_iter()
-        .map(|i| points[i])
-        .collect();
-    let cloud = crate::PointCloud::new(sample)?;
-    let normals = crate::cloud::normals::estimate_normals(
-        &cloud,
-        &crate::cloud::normals::NormalsConfig::default(),
-    )?
-    .normals;
-    let m = normals.len() as f64;
-    let mut alignment = [0.0; 4];
-    for (k, d) in dirs.iter().enumerate() {
-        let (mut pos, mut neg, mut sum) = (0usize, 0usize, 0.0);
-        for n in &normals {
-            let c = n.dot(d);
-            pos += usize::from(c > 0.0);
-            neg += usize::from(c < 0.0);
-            sum += c.abs();
-        }
-        projection.fold_shares[k] = pos.min(neg) as f64 / m;
-        alignment[k] = sum / m;
-    }
-    projection.sampled = normals.len();
-    let s = projection.fold_shares;
-    let best_axis = (1..4)
-        .min_by(|&a, &b| {
-            s[a].total_cmp(&s[b])
-                .then(alignment[b].total_cmp(&alignment[a]))
-        })
-        .unwrap_or(0);
-    if s[best_axis] + FOLD_MARGIN < s[0] {
-        projection.axis = ProjectionAxis::ALL[best_axis];
-        projection.direction = dirs[best_axis];
-    }
-    Ok(projection)
-}
-
-/// The points' PCA and their best-fit plane's frame.
-fn best_axes(points: &[Point3]) -> Result<(crate::Pca, PlaneAxes)> {
+/// The points' PCA, after checking that there are enough valid points.
+pub(super) fn checked_pca(points: &[Point3]) -> Result<crate::Pca> {
     crate::validate_points(points)?;
     if points.len() < 3 {
         return Err(Error::TooFewPoints {
@@ -299,36 +141,18 @@ fn best_axes(points: &[Point3]) -> Result<(crate::Pca, PlaneAxes)> {
             what: "a best-fit plane".into(),
         });
     }
-    let pca = crate::geom::pca(points).ok_or(Error::TooFewPoints {
+    crate::geom::pca(points).ok_or(Error::TooFewPoints {
         got: 0,
         needed: 3,
         what: "a best-fit plane".into(),
-    })?;
-    let axes = PlaneAxes::of(&pca)?;
-    Ok((pca, axes))
-}
-
-/// The frame across the unit `axis` through the centroid: the provisional
-/// in-plane axis is the first principal direction projected onto the plane
-/// (or the second, if the first is nearly along `axis`); the parameter axes
-/// are the minimum-area rectangle's, as for the best-fit plane.
-fn axis_frame(pca: &crate::Pca, axis: Vector3) -> PlaneAxes {
-    let flat = |v: Vector3| v - axis * v.dot(&axis);
-    let (f0, f1) = (flat(pca.axes[0]), flat(pca.axes[1]));
-    let a1 = orient(if f0.norm() >= f1.norm() { f0 } else { f1 }.normalize());
-    PlaneAxes {
-        origin: pca.centroid,
-        a1,
-        a2: axis.cross(&a1),
-        normal: axis,
-    }
+    })
 }
 
 /// The steps of a chunked or distributed run ([`PlaneAxes`] from the
 /// covariance sums, [`FlatHull`], [`PlaneExtents`]), each fed all points at
 /// once.
 fn plane_map(points: &[Point3]) -> Result<PlaneMap> {
-    let (_, axes) = best_axes(points)?;
+    let axes = PlaneAxes::of(&checked_pca(points)?)?;
     map_along(&axes, points)
 }
 
@@ -342,7 +166,7 @@ fn map_along(axes: &PlaneAxes, points: &[Point3]) -> Result<PlaneMap> {
 }
 
 /// `v` with its largest component made positive (deterministic signs).
-fn orient(v: Vector3) -> Vector3 {
+pub(super) fn orient(v: Vector3) -> Vector3 {
     let j = v.iamax();
     if v[j] < 0.0 {
         -v
@@ -589,6 +413,13 @@ pub struct PlaneMap {
 }
 
 impl PlaneMap {
+    /// Lengths of the parameter rectangle's sides along `u` and `v` (data
+    /// units).
+    pub fn extent(&self) -> [f64; 2] {
+        let [(lo1, hi1), (lo2, hi2)] = self.bounds;
+        [hi1 - lo1, hi2 - lo2]
+    }
+
     /// The parameters of `p`.
     #[inline]
     pub fn uv(&self, p: &Point3) -> [f64; 2] {
@@ -744,6 +575,7 @@ fn convex_hull(pts: &[[f64; 2]]) -> Vec<[f64; 2]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::base::{choose_projection, ProjectionAxis, FOLD_SAMPLE};
     use crate::cloud::testutil::Rng;
 
     /// Franke's function on `n` seeded uniform points of the unit square.
