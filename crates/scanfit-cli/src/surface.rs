@@ -361,7 +361,7 @@ fn leaves_fix(q: &SurfaceQuality, projection: Option<&Projection>) -> String {
 }
 
 /// The report's line on the projection direction.
-fn projection_line(p: &Projection) -> String {
+pub(crate) fn projection_line(p: &Projection) -> String {
     let shares: Vec<String> = ProjectionAxis::ALL
         .iter()
         .zip(p.fold_shares)
@@ -385,7 +385,7 @@ fn vec_text(v: &scanfit::Vector3) -> String {
 }
 
 /// The projection in the JSON report.
-fn projection_json(p: &Projection) -> serde_json::Value {
+pub(crate) fn projection_json(p: &Projection) -> serde_json::Value {
     let shares: serde_json::Map<String, serde_json::Value> = ProjectionAxis::ALL
         .iter()
         .zip(p.fold_shares)

@@ -3,6 +3,8 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -657,13 +659,7 @@ fn curve_pictures_as_png() {
 fn surface_fit_of_a_height_field_of_large_relief_projects_along_z() {
     let d = tmpdir("sfranke");
     let input = d.join("franke.xyz");
-    let pts =
-        scanfit::testdata::scattered(20_000, 29, [0.0, 0.0, 1.0, 1.0], scanfit::testdata::franke);
-    let text: String = pts
-        .iter()
-        .map(|p| format!("{} {} {}\n", p.x, p.y, p.z))
-        .collect();
-    std::fs::write(&input, text).unwrap();
+    common::write_franke_xyz(&input, 20_000);
     let json = d.join("f.json");
     let o = run(&[
         "fit",
