@@ -418,7 +418,14 @@ fn streamed_fit_of_a_height_field_of_large_relief_projects_along_z_as_in_memory(
     common::write_franke_xyz(&input, 20_000);
     let input = input.to_str().unwrap();
     let a = d.join("a.json");
-    let memory = scanfit(&["fit", input, "--no-trim", "-o", a.to_str().unwrap(), "--json"]);
+    let memory = scanfit(&[
+        "fit",
+        input,
+        "--no-trim",
+        "-o",
+        a.to_str().unwrap(),
+        "--json",
+    ]);
     ok(&memory);
     let memory: serde_json::Value = serde_json::from_slice(&memory.stdout).unwrap();
     assert_eq!(memory["projection"]["axis"], "z", "{memory}");
@@ -445,7 +452,10 @@ fn streamed_fit_of_a_height_field_of_large_relief_projects_along_z_as_in_memory(
         assert_eq!(report["projection"]["sampled"], 4000);
         let (x, y) = (surface(&b), surface(&a));
         let worst = relative(&x[0], &y[0]);
-        assert!(worst <= 1e-12, "chunk {chunk}: control points differ by {worst:e}");
+        assert!(
+            worst <= 1e-12,
+            "chunk {chunk}: control points differ by {worst:e}"
+        );
         knots_close(&x, &y, &format!("chunk {chunk}"));
         // relief 1.2: orthogonal RMSE under 0.1% of it, as in memory
         let rmse = report["quality"]["rmse_distance"].as_f64().unwrap();

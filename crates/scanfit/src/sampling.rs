@@ -545,7 +545,10 @@ mod tests {
         // two points swapped: out of hash order
         let mut swapped = b.clone();
         let at = 8 + 24;
-        let (x, y) = (swapped[at..at + 32].to_vec(), swapped[at + 32..at + 64].to_vec());
+        let (x, y) = (
+            swapped[at..at + 32].to_vec(),
+            swapped[at + 32..at + 64].to_vec(),
+        );
         swapped[at..at + 32].copy_from_slice(&y);
         swapped[at + 32..at + 64].copy_from_slice(&x);
         let e = HashSample::from_bytes(&swapped).unwrap_err();

@@ -222,10 +222,7 @@ pub fn choose_projection_from(sample: &HashSample, best: &PlaneAxes) -> Result<P
 /// The frame the points are projected in, and the choice that gave it: the
 /// best-fit plane's ([`PlaneAxes::of`]) or, when [`choose_projection_from`]
 /// picks an axis, the plane across that axis through the centroid.
-pub(crate) fn projected_frame(
-    pca: &Pca,
-    sample: &HashSample,
-) -> Result<(PlaneAxes, Projection)> {
+pub(crate) fn projected_frame(pca: &Pca, sample: &HashSample) -> Result<(PlaneAxes, Projection)> {
     let best = PlaneAxes::of(pca)?;
     let projection = choose_projection_from(sample, &best)?;
     let axes = match projection.axis {

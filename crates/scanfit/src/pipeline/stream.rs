@@ -791,11 +791,14 @@ mod tests {
                 .map(|q| Point3::new(q.x + 3.0e3, q.y - 7.0e3, q.z))
                 .collect();
         let mut cfg = FitConfig::default();
-        let once = surface_fit::run(&PointCloud::new(p.clone()).unwrap(), &cfg, &NoProgress)
-            .unwrap();
+        let once =
+            surface_fit::run(&PointCloud::new(p.clone()).unwrap(), &cfg, &NoProgress).unwrap();
         let po = once.projection.unwrap();
         assert_eq!(po.axis, ProjectionAxis::Z);
-        assert!(po.fold_shares[0] > 0.02 && po.fold_shares[3] == 0.0, "{po:?}");
+        assert!(
+            po.fold_shares[0] > 0.02 && po.fold_shares[3] == 0.0,
+            "{po:?}"
+        );
         assert_eq!(once.assessment.quality.parameterization.fold_overs, 0);
         for chunk in [999, 4096, 20_000] {
             let mut s = SliceSource {
@@ -817,8 +820,8 @@ mod tests {
         }
         // with a correction round too
         cfg.correction_rounds = 1;
-        let once = surface_fit::run(&PointCloud::new(p.clone()).unwrap(), &cfg, &NoProgress)
-            .unwrap();
+        let once =
+            surface_fit::run(&PointCloud::new(p.clone()).unwrap(), &cfg, &NoProgress).unwrap();
         let mut s = SliceSource {
             points: &p,
             uv: None,
