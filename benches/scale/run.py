@@ -7,7 +7,7 @@ make_franke.py.
     python3 benches/scale/make_franke.py 1000000 /tmp/franke_1000000.ply
     python3 benches/scale/make_franke.py 1000000 /tmp/franke_uv_1000000.ply --uv
     python3 benches/scale/make_franke.py 10000000 /tmp/franke_10000000.las
-    python3 benches/scale/run.py target/release/scanfit 1000000 [--repeat 3] [--only fit|fit_streamed|fit_plane|fit_plane_streamed|mba|mba_notrim|mba_las|mba_las_streamed|mba_laz1|mba_laz1_streamed] [--out-dir /tmp] [-- EXTRA...]
+    python3 benches/scale/run.py target/release/scanfit 1000000 [--repeat 3] [--only fit|fit_streamed|fit_plane|fit_plane_streamed|fit_fold|fit_fold_streamed|mba|mba_notrim|mba_las|mba_las_streamed|mba_laz1|mba_laz1_streamed] [--out-dir /tmp] [-- EXTRA...]
 
 Each command runs `--repeat` times (default 3) under `/usr/bin/time -v`
 with SCANFIT_TIMINGS=1 (the CLI then prints each stage's wall time); the
@@ -23,6 +23,10 @@ defaults (best-fit plane, distribution knots; untrimmed) on /tmp/franke_N.ply,
 `fit_plane_streamed` the same in chunks of 10^6 points (plane and knots as
 passes of sums); their input is `make_franke.py N /tmp/franke_xy10_N.ply
 --xy-scale 10` (on the unit square the plane is not a height field's).
+`fit_fold` is `fit` with its defaults on the unit-square /tmp/franke_N.ply,
+whose best-fit plane folds the bumps over, so the fit projects along z
+(the fold sample's normals decide), and `fit_fold_streamed` the same in
+chunks of 10^6 points (the sample gathered in the covariance pass).
 When
 /tmp/franke_N_c1.laz exists (the LAS as a compressor-1 LAZ: `cargo run
 --release -p scanfit-io --example laz_pointwise -- /tmp/franke_N.las
@@ -79,6 +83,9 @@ def main():
     commands["fit_plane"] = [binary, "fit", f"/tmp/franke_xy10_{n}.ply", "--ctrl", "64x64",
                              "--no-trim", "-o", f"{out}/scale_fit_plane.json", "--json", "-q"]
     commands["fit_plane_streamed"] = commands["fit_plane"] + ["--chunk-points", "1000000"]
+    commands["fit_fold"] = [binary, "fit", f"/tmp/franke_{n}.ply", "--ctrl", "64x64",
+                            "--no-trim", "-o", f"{out}/scale_fit_fold.json", "--json", "-q"]
+    commands["fit_fold_streamed"] = commands["fit_fold"] + ["--chunk-points", "1000000"]
     # the LAS and its compressor-1 LAZ, in memory and streamed
     for key, path in (("las", f"/tmp/franke_{n}.las"), ("laz1", f"/tmp/franke_{n}_c1.laz")):
         if os.path.exists(path):

@@ -8,7 +8,7 @@
 //! what streaming measured.
 
 use anyhow::{bail, Result};
-use scanfit::pipeline::stream::{fit as fit_streamed, mba as mba_streamed};
+use scanfit::pipeline::stream::{fit as fit_streamed, mba as mba_streamed, StreamedFit};
 use scanfit_io::json::SurfaceDoc;
 use scanfit_io::source::{reads_in_chunks, FileSource};
 use scanfit_io::write_all_atomic;
@@ -20,7 +20,9 @@ use crate::outputs::{
     SurfaceOutputArgs,
 };
 use crate::progress::Progress;
-use crate::surface::{fit_title, quality_table, FitArgs, ParamsArg};
+use crate::surface::{
+    fit_title, projection_json, projection_line, quality_table, FitArgs, ParamsArg,
+};
 
 /// What the report says about the streamed measures.
 const MEASURED: &str = "errors at the parameters, orthogonal distances, eq. 17 and sample distances over all points; point spacing from the first chunk; parameterization not measured";
@@ -122,28 +124,41 @@ pub fn fit(a: &FitArgs, chunk: usize) -> Result<()> {
     )?;
     write_all_atomic(&files)?;
     progress.finish();
-    let (cu, cv) = r.surface.counts();
-    let report = Report {
-        json: a.json,
-        title: fit_title(a, q.points, &r.surface, r.smoothing),
-        chunk,
-        passes: r.passes,
-        extra: serde_json::json!({
-            "input": a.input.input.display().to_string(),
-            "degree": [a.degree.0, a.degree.1],
-            "control_points": [cu, cv],
-            "parameters": name,
-            "trim": crate::cad::trim_json(None),
-        }),
-    };
+    let (report, before) = fit_report(a, &r, chunk, name);
     report.print(
         q,
         &files,
         exaggeration,
         &a.out,
         "|P - S(u,v)| at the parameters (eq. 15)",
-        "",
+        &before,
     )
+}
+
+/// The streamed fit's report (the in-memory fit's keys, with the projection
+/// direction) and the projection's line above its table.
+fn fit_report(a: &FitArgs, r: &StreamedFit, chunk: usize, name: &str) -> (Report, String) {
+    let (cu, cv) = r.surface.counts();
+    let mut extra = serde_json::json!({
+        "input": a.input.input.display().to_string(),
+        "degree": [a.degree.0, a.degree.1],
+        "control_points": [cu, cv],
+        "parameters": name,
+        "trim": crate::cad::trim_json(None),
+    });
+    let mut before = String::new();
+    if let Some(p) = &r.projection {
+        extra["projection"] = projection_json(p);
+        before = format!("{}\n\n", projection_line(p));
+    }
+    let report = Report {
+        json: a.json,
+        title: fit_title(a, r.quality.points, &r.surface, r.smoothing),
+        chunk,
+        passes: r.passes,
+        extra,
+    };
+    (report, before)
 }
 
 /// The streamed fit keeps the parameter rectangle: `--trim` is refused with

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 use clap::{Args, ValueEnum};
+use scanfit::base::{Projection, ProjectionAxis};
 use scanfit::bspline::Surface;
 use scanfit::fit::surface::KnotPlacement;
 use scanfit::pipeline::assess::SurfaceQuality;
@@ -29,15 +30,17 @@ const EXAMPLES: &str = "Examples:
   scanfit fit patch.csv --correct 5 --points-out params.ply --mesh patch.obj --json
 
 Parameters come from the best-fit plane of the points (--params plane, for
-height-field-like patches) or from columns named u and v in the input
-(--params uv-columns). The error table reports the PDE paper's eq. 15 errors at
+height-field-like patches; along the x, y or z axis instead when the plane
+folds the points over and the axis does not) or from columns named u and v in
+the input (--params uv-columns). The error table reports the PDE paper's eq. 15 errors at
 the parameters, true orthogonal distances, the MBA paper's grid RMSE (eq. 17)
 and the parameterization's fold-overs and stretch.";
 
 /// `--params`: where the parameters come from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum ParamsArg {
-    /// The best-fit plane of the points.
+    /// The best-fit plane of the points (or the plane across x, y or z when
+    /// the best-fit plane folds the points over and that axis does not).
     Plane,
     /// Columns named u and v in the input.
     UvColumns,
@@ -239,17 +242,14 @@ pub fn run(a: FitArgs) -> Result<()> {
         surface: &r.surface,
         cloud: &mut cloud,
         uv: &r.uv,
-        loops: Loops::BestFitPlane,
+        loops: loops_of(r.projection.as_ref()),
     };
     let q = &mut r.assessment.quality;
     let trimmed = a
         .trim
         .apply(plane, trim, q, &a.config().assess, &progress)?;
     let pts = cloud.points();
-    a.out.guard(
-        q,
-        "raise the smoothing (--smooth; by default it is scaled to the data) or use fewer control points (--ctrl)",
-    )?;
+    a.out.guard(q, &leaves_fix(q, r.projection.as_ref()))?;
     progress.stage("writing");
     let q = &r.assessment.quality;
     let quality = quality_doc(q, r.rounds.iter().map(|r| r.errors.rmse).collect());
@@ -291,7 +291,7 @@ pub fn run(a: FitArgs) -> Result<()> {
     write_all_atomic(&files)?;
     progress.finish();
     if a.json {
-        let report = serde_json::json!({
+        let mut report = serde_json::json!({
             "input": a.input.input.display().to_string(),
             "point_count": pts.len(),
             "degree": [a.degree.0, a.degree.1],
@@ -303,6 +303,9 @@ pub fn run(a: FitArgs) -> Result<()> {
             "trim": crate::cad::trim_json(trimmed.as_ref()),
             "outputs": files.iter().map(|(p, _)| p.display().to_string()).collect::<Vec<_>>(),
         });
+        if let Some(p) = &r.projection {
+            report["projection"] = projection_json(p);
+        }
         out!(
             "{}",
             scanfit_io::json::finite_json(&report, "the JSON report")?
@@ -313,6 +316,88 @@ pub fn run(a: FitArgs) -> Result<()> {
     crate::cad::print_trim(trimmed.as_ref())?;
     print_written(&files, a.out.png.as_deref(), exaggeration)?;
     Ok(())
+}
+
+/// The trim's loops: in the best-fit plane the parameters were made in, or,
+/// when they were projected along a coordinate axis, in the parameters
+/// scaled back to lengths (the projection is linear, so the scaled
+/// parameters are the points' coordinates across that axis).
+fn loops_of(projection: Option<&Projection>) -> Loops<'static> {
+    match projection {
+        Some(p) if p.axis != ProjectionAxis::BestFitPlane => Loops::Parameters { scale: p.extent },
+        _ => Loops::BestFitPlane,
+    }
+}
+
+/// Share of the parameterization's triangles that fold over above which a
+/// surface that leaves the data is blamed on the parameters, not on the
+/// smoothing (0.5%: noise at the borders stays below it).
+const FOLDED_SHARE: f64 = 0.005;
+
+/// What to change when the surface leaves the data: the smoothing or the
+/// net, and, when the parameters fold over too, the parameters (a noisy
+/// scan's sparse outline can fold a few triangles and still be cured by the
+/// smoothing, so the smoothing advice stays).
+fn leaves_fix(q: &SurfaceQuality, projection: Option<&Projection>) -> String {
+    let pq = &q.parameterization;
+    let share = pq.fold_overs as f64 / pq.triangles.max(1) as f64;
+    let smoothing = "raise the smoothing (--smooth; by default it is scaled to the data) or use fewer control points (--ctrl)";
+    if share <= FOLDED_SHARE {
+        return smoothing.into();
+    }
+    let tried = match projection {
+        Some(p) => format!(
+            " (projected along {}, the least folding of the best-fit plane's normal and the x, y, z axes)",
+            p.axis.name()
+        ),
+        None => String::new(),
+    };
+    format!(
+        "{smoothing}; the parameters also fold over in {} of {} triangles ({:.1}%){tried}: if that persists, give parameters that do not fold (--params uv-columns), or use `scanfit mba` for a height field, `scanfit coons` or `scanfit turntable` for a closed or overhanging shape",
+        pq.fold_overs,
+        pq.triangles,
+        100.0 * share
+    )
+}
+
+/// The report's line on the projection direction.
+pub(crate) fn projection_line(p: &Projection) -> String {
+    let shares: Vec<String> = ProjectionAxis::ALL
+        .iter()
+        .zip(p.fold_shares)
+        .map(|(a, s)| format!("{} {:.1}%", a.name(), 100.0 * s))
+        .collect();
+    if p.sampled == 0 {
+        return "projected onto the best-fit plane (too few points to measure folds)".into();
+    }
+    format!(
+        "projected along {} ({}): sampled normals on the folded-back side: {} ({} points, seed {})",
+        p.axis.name(),
+        vec_text(&p.direction),
+        shares.join(", "),
+        p.sampled,
+        scanfit::base::FOLD_SEED,
+    )
+}
+
+fn vec_text(v: &scanfit::Vector3) -> String {
+    format!("{:.4}, {:.4}, {:.4}", v.x, v.y, v.z)
+}
+
+/// The projection in the JSON report.
+pub(crate) fn projection_json(p: &Projection) -> serde_json::Value {
+    let shares: serde_json::Map<String, serde_json::Value> = ProjectionAxis::ALL
+        .iter()
+        .zip(p.fold_shares)
+        .map(|(a, s)| (a.name().to_string(), s.into()))
+        .collect();
+    serde_json::json!({
+        "axis": p.axis.name(),
+        "direction": [p.direction.x, p.direction.y, p.direction.z],
+        "fold_shares": shares,
+        "sampled": p.sampled,
+        "extent": p.extent,
+    })
 }
 
 /// ", smoothing λ = ... (scaled to the data)" for the report's first line.
@@ -366,7 +451,11 @@ pub(crate) fn quality_table(
 
 fn print_report(a: &FitArgs, r: &FitReport) -> Result<()> {
     let q = &r.assessment.quality;
-    outln!("{}\n", fit_title(a, q.points, &r.surface, r.smoothing));
+    outln!("{}", fit_title(a, q.points, &r.surface, r.smoothing));
+    if let Some(p) = &r.projection {
+        outln!("{}", projection_line(p));
+    }
+    outln!();
     out!(
         "{}",
         quality_table(

@@ -3,6 +3,8 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -647,4 +649,42 @@ fn curve_pictures_as_png() {
         assert_eq!(&bytes[1..4], b"PNG");
         assert!(bytes.len() > 5000, "{} is suspiciously small", p.display());
     }
+}
+
+/// Franke's function on 20000 seeded points of the unit square (relief
+/// 1.2): its best-fit plane is tilted and folded the default fit over
+/// (13067 fold-overs in 199454 triangles at 10^5 points, refused as
+/// "leaves the data"); the default fit now projects along z.
+#[test]
+fn surface_fit_of_a_height_field_of_large_relief_projects_along_z() {
+    let d = tmpdir("sfranke");
+    let input = d.join("franke.xyz");
+    common::write_franke_xyz(&input, 20_000);
+    let json = d.join("f.json");
+    let o = run(&[
+        "fit",
+        input.to_str().unwrap(),
+        "-o",
+        json.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["projection"]["axis"], "z", "{v}");
+    assert_eq!(v["projection"]["fold_shares"]["z"], 0.0, "{v}");
+    assert!(
+        v["projection"]["fold_shares"]["best-fit plane"]
+            .as_f64()
+            .unwrap()
+            > 0.02,
+        "{v}"
+    );
+    let q = &v["quality"];
+    assert_eq!(q["fold_overs"], 0, "{q}");
+    // relief 1.2: RMSE under 0.1% of it
+    assert!(q["rmse"].as_f64().unwrap() < 1.2e-3, "{q}");
+    let o = run(&["fit", input.to_str().unwrap(), "-o", json.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("projected along z"), "{out}");
 }

@@ -5,6 +5,8 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -52,6 +54,18 @@ fn relative(a: &serde_json::Value, b: &serde_json::Value) -> f64 {
                 / scale
         })
         .fold(0.0, f64::max)
+}
+
+/// The knots of two [`surface`]s within 1e-12 of each other.
+fn knots_close(x: &serde_json::Value, y: &serde_json::Value, what: &str) {
+    for j in [1, 2] {
+        let (a, b) = (x[j].as_array().unwrap(), y[j].as_array().unwrap());
+        assert_eq!(a.len(), b.len(), "{what}: knot counts");
+        for (s, t) in a.iter().zip(b) {
+            let (s, t) = (s.as_f64().unwrap(), t.as_f64().unwrap());
+            assert!((s - t).abs() <= 1e-12, "{what}: knots {s} {t}");
+        }
+    }
 }
 
 fn ok(out: &std::process::Output) {
@@ -330,20 +344,12 @@ fn streamed_fit_with_the_plane_distribution_knots_and_correction_is_the_in_memor
             worst <= 1e-12,
             "{extra:?}: control points differ by {worst:e}"
         );
-        for j in [1, 2] {
-            for (s, t) in x[j]
-                .as_array()
-                .unwrap()
-                .iter()
-                .zip(y[j].as_array().unwrap())
-            {
-                let (s, t) = (s.as_f64().unwrap(), t.as_f64().unwrap());
-                assert!((s - t).abs() <= 1e-12, "{extra:?}: knots {s} {t}");
-            }
-        }
+        knots_close(&x, &y, &format!("{extra:?}"));
         // the passes: box, plane x3, then per fit the knot rounds (none when
         // uniform), the equations and (when correcting) the errors; measuring
         let report: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+        // the wavy sheet does not fold over its best-fit plane: kept
+        assert_eq!(report["projection"]["axis"], "best-fit plane", "{report}");
         let passes = report["streamed"]["passes"].as_u64().unwrap();
         let doc: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(&b).unwrap()).unwrap();
@@ -398,5 +404,75 @@ fn streamed_fit_with_the_plane_distribution_knots_and_correction_is_the_in_memor
         err.contains("NOT trimmed") && err.contains("--no-trim"),
         "{err}"
     );
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// Franke's function on 20000 seeded points of the unit square (relief
+/// 1.2), whose best-fit plane folds the bumps over: the streamed default fit
+/// chooses the in-memory fit's projection (along z) from the same seeded
+/// sample, gathered in its covariance pass, and writes its surface.
+#[test]
+fn streamed_fit_of_a_height_field_of_large_relief_projects_along_z_as_in_memory() {
+    let d = tmp("franke");
+    let input = d.join("franke.xyz");
+    common::write_franke_xyz(&input, 20_000);
+    let input = input.to_str().unwrap();
+    let a = d.join("a.json");
+    let memory = scanfit(&[
+        "fit",
+        input,
+        "--no-trim",
+        "-o",
+        a.to_str().unwrap(),
+        "--json",
+    ]);
+    ok(&memory);
+    let memory: serde_json::Value = serde_json::from_slice(&memory.stdout).unwrap();
+    assert_eq!(memory["projection"]["axis"], "z", "{memory}");
+    for chunk in ["1777", "20000"] {
+        let b = d.join(format!("b{chunk}.json"));
+        let run = scanfit(&[
+            "fit",
+            input,
+            "--no-trim",
+            "-o",
+            b.to_str().unwrap(),
+            "--chunk-points",
+            chunk,
+            "--json",
+        ]);
+        ok(&run);
+        let report: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+        // the same choice from the same sample: shares equal to the bit
+        assert_eq!(report["projection"]["axis"], "z", "{report}");
+        assert_eq!(
+            report["projection"]["fold_shares"],
+            memory["projection"]["fold_shares"]
+        );
+        assert_eq!(report["projection"]["sampled"], 4000);
+        let (x, y) = (surface(&b), surface(&a));
+        let worst = relative(&x[0], &y[0]);
+        assert!(
+            worst <= 1e-12,
+            "chunk {chunk}: control points differ by {worst:e}"
+        );
+        knots_close(&x, &y, &format!("chunk {chunk}"));
+        // relief 1.2: orthogonal RMSE under 0.1% of it, as in memory
+        let rmse = report["quality"]["rmse_distance"].as_f64().unwrap();
+        assert!(rmse < 1.2e-3, "{rmse}");
+    }
+    // the table says which way it projected
+    let run = scanfit(&[
+        "fit",
+        input,
+        "--no-trim",
+        "-o",
+        a.to_str().unwrap(),
+        "--chunk-points",
+        "5000",
+    ]);
+    ok(&run);
+    let out = String::from_utf8_lossy(&run.stdout);
+    assert!(out.contains("projected along z"), "{out}");
     std::fs::remove_dir_all(&d).unwrap();
 }

@@ -3,10 +3,15 @@
 //! cloud in the single-process fit, each as passes of mergeable sums.
 //!
 //! * `PlanePasses`: the best-fit plane's parameters (`params="plane"`) in
-//!   three passes: the covariance sums about the first point (PCA), the
-//!   convex hull in the plane (its minimum-area rectangle), the extents along
-//!   the rectangle's axes; then every point's `(u, v)` is computed where the
-//!   point is, as `scanfit.fit_surface` computes it.
+//!   three passes: the covariance sums about the first point (PCA) with the
+//!   seeded fold sample that chooses the projection direction (the best-fit
+//!   plane, or a coordinate axis when the plane folds the points over and
+//!   the axis does not; `scanfit::base::PlaneMoments`: the points of
+//!   smallest index hash, merged across tasks, so the choice is the
+//!   single-process fit's), the convex hull in the plane (its minimum-area
+//!   rectangle), the extents along the rectangle's axes; then every point's
+//!   `(u, v)` is computed where the point is, as `scanfit.fit_surface`
+//!   computes it.
 //! * `FitSetup` and `KnotSearch`: the net and smoothing of `fit_surface` for
 //!   the point count, and the knots from the parameter distribution
 //!   ([NURBS97] eq. 9.69, `knots="distribution"`) from the few order
@@ -20,7 +25,8 @@
 
 use numpy::{IntoPyArray, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
-use scanfit::base::{FlatHull, PlaneAxes, PlaneExtents, PlaneMap};
+use pyo3::types::PyDict;
+use scanfit::base::{FlatHull, PlaneAxes, PlaneExtents, PlaneMap, PlaneMoments, Projection};
 use scanfit::bspline::{KnotVector, Surface};
 use scanfit::fit::knot_ranks::{KnotSearch, RankCounts, RankQuery};
 use scanfit::fit::surface::SurfaceFitConfig;
@@ -29,7 +35,7 @@ use scanfit::metrics::parametric_distances;
 use scanfit::pipeline::surface_fit::ParameterSource;
 use scanfit::project::{InversionConfig, SurfaceInverter};
 use scanfit::wire::{Reader, Writer};
-use scanfit::{CovarianceSums, Error, Point3, Vector3};
+use scanfit::{Error, Point3, Vector3};
 
 use crate::convert::{err, uv_columns, value_err, vec3};
 use crate::sums::{
@@ -42,7 +48,8 @@ use crate::surfaces::fit_config;
 /// What one pass of `PlanePasses` computes per chunk.
 #[derive(Clone)]
 enum Stage {
-    /// Covariance sums about the reference point (centred).
+    /// Covariance sums about the reference point (centred) and the fold
+    /// sample.
     Moments(Point3),
     /// The convex hull in the plane of these axes.
     Hull(PlaneAxes),
@@ -147,7 +154,7 @@ pickled!(PyPlaneStage {
     fn accumulator(&self) -> PyPlaneSums {
         PyPlaneSums {
             inner: match &self.stage {
-                Stage::Moments(p) => Sums::Moments(CovarianceSums::new(*p)),
+                Stage::Moments(p) => Sums::Moments(Box::new(PlaneMoments::new(*p))),
                 Stage::Hull(_) => Sums::Hull(FlatHull::default()),
                 Stage::Extents(e) => Sums::Extents(e.clone()),
             },
@@ -156,7 +163,7 @@ pickled!(PyPlaneStage {
 
     fn __repr__(&self) -> String {
         let s = match self.stage {
-            Stage::Moments(_) => "covariance",
+            Stage::Moments(_) => "covariance and fold sample",
             Stage::Hull(_) => "hull",
             Stage::Extents(_) => "extents",
         };
@@ -166,15 +173,16 @@ pickled!(PyPlaneStage {
 
 #[derive(Clone)]
 enum Sums {
-    Moments(CovarianceSums),
+    Moments(Box<PlaneMoments>),
     Hull(FlatHull),
     Extents(Box<PlaneExtents>),
 }
 
-const PLANE_SUMS_TAG: &[u8; 8] = b"SFPYPLA1";
+// version 2: the first pass's sums carry the fold sample (PlaneMoments)
+const PLANE_SUMS_TAG: &[u8; 8] = b"SFPYPLA2";
 
-/// The sums of one plane pass over some chunks (covariance sums, a convex
-/// hull, or extents); mergeable and exact as bytes.
+/// The sums of one plane pass over some chunks (covariance sums with the
+/// fold sample, a convex hull, or extents); mergeable and exact as bytes.
 #[pyclass(name = "PlaneSums", module = "scanfit.sums")]
 #[derive(Clone)]
 pub struct PyPlaneSums {
@@ -209,7 +217,7 @@ impl Wire for PyPlaneSums {
         // tag, kind: the stage's own record follows
         let rest = &data[16..];
         let inner = match kind {
-            0 => Sums::Moments(CovarianceSums::from_bytes(rest).map_err(err)?),
+            0 => Sums::Moments(Box::new(PlaneMoments::from_bytes(rest).map_err(err)?)),
             1 => Sums::Hull(FlatHull::from_bytes(rest).map_err(err)?),
             2 => Sums::Extents(Box::new(PlaneExtents::from_bytes(rest).map_err(err)?)),
             x => return Err(err(r.corrupt(&format!("plane sums kind {x}")))),
@@ -220,16 +228,25 @@ impl Wire for PyPlaneSums {
 
 pickled!(PyPlaneSums {
     /// Adds an ``(N, 3)`` chunk (``N = 0`` allowed) for ``stage``.
+    /// ``offset`` is the global row of the chunk's first point (its index in
+    /// the whole data, in the order of a single-process call: the rows of
+    /// the chunks and tiles before it); the first stage needs it, for the
+    /// seeded sample that chooses the projection direction.
+    #[pyo3(signature = (stage, points, offset = None))]
     fn add(
         &mut self,
         py: Python<'_>,
         stage: &PyPlaneStage,
         points: &Bound<'_, PyAny>,
+        offset: Option<u64>,
     ) -> PyResult<()> {
         let p = stage.centring.apply(chunk(points)?);
         py.detach(|| match (&mut self.inner, &stage.stage) {
             (Sums::Moments(c), Stage::Moments(_)) => {
-                p.iter().for_each(|q| c.add(q));
+                let first = offset.ok_or_else(|| {
+                    value_err("the first plane pass samples points by their global row: give offset=, the row of this chunk's first point in the whole data".into())
+                })?;
+                c.add(first, &p);
                 Ok(())
             }
             (Sums::Hull(h), Stage::Hull(a)) => {
@@ -268,7 +285,7 @@ pickled!(PyPlaneSums {
 
     fn __repr__(&self) -> String {
         match &self.inner {
-            Sums::Moments(c) => format!("PlaneSums(covariance, points={})", c.count()),
+            Sums::Moments(c) => format!("PlaneSums(covariance and fold sample, points={})", c.count()),
             Sums::Hull(h) => format!("PlaneSums(hull, vertices={})", h.vertices().len()),
             Sums::Extents(_) => "PlaneSums(extents)".into(),
         }
@@ -280,19 +297,24 @@ pickled!(PyPlaneSums {
 /// broadcast, every chunk's ``PlaneSums`` merged and ``push``-ed; then
 /// ``parameterization()``. ``first`` is the first point of the data (the
 /// covariance is summed about it, as the single-process fit sums it),
-/// ``count`` the number of points.
+/// ``count`` the number of points. The first pass also chooses the
+/// projection direction (``projection``) from the seeded sample, as the
+/// single-process fit does.
 ///
 /// Example::
 ///
 ///     >>> plane = scanfit.sums.PlanePasses(centring, pts[0], len(pts))
 ///     >>> while not plane.done:
-///     ...     stage = plane.stage(); s = stage.accumulator(); s.add(stage, pts); plane.push(s)
+///     ...     stage = plane.stage(); s = stage.accumulator(); s.add(stage, pts, offset=0); plane.push(s)
 ///     >>> uv = plane.parameterization().uv(pts)
+///     >>> plane.projection["axis"]  # doctest: +SKIP
+///     'best-fit plane'
 #[pyclass(name = "PlanePasses", module = "scanfit.sums")]
 pub struct PyPlanePasses {
     centring: PyCentring,
     stage: Stage,
     map: Option<PlaneMap>,
+    projection: Option<Projection>,
 }
 
 #[pymethods]
@@ -312,6 +334,7 @@ impl PyPlanePasses {
             centring: centring.clone(),
             stage: Stage::Moments(f[0]),
             map: None,
+            projection: None,
         })
     }
 
@@ -319,6 +342,17 @@ impl PyPlanePasses {
     #[getter]
     fn done(&self) -> bool {
         self.map.is_some()
+    }
+
+    /// The projection direction chosen by the first pass (``None`` before
+    /// it): ``axis``, ``direction``, ``fold_shares``, ``sampled``, ``extent``
+    /// (0 until the last pass), as ``scanfit.fit_surface``'s.
+    #[getter]
+    fn projection<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        self.projection
+            .as_ref()
+            .map(|p| crate::report::projection(py, p))
+            .transpose()
     }
 
     /// What the workers need for the next pass.
@@ -337,18 +371,24 @@ impl PyPlanePasses {
     /// Finishes the pass from the merged sums of all chunks.
     fn push(&mut self, sums: &PyPlaneSums) -> PyResult<()> {
         match (&self.stage, &sums.inner) {
-            (Stage::Moments(_), Sums::Moments(c)) => {
-                let pca = c
-                    .finish()
-                    .ok_or_else(|| value_err("the covariance sums hold no point".into()))?;
-                self.stage = Stage::Hull(PlaneAxes::of(&pca).map_err(err)?);
+            (Stage::Moments(_), Sums::Moments(m)) => {
+                if m.count() == 0.0 {
+                    return Err(value_err("the covariance sums hold no point".into()));
+                }
+                let (axes, projection) = m.finish().map_err(err)?;
+                self.projection = Some(projection);
+                self.stage = Stage::Hull(axes);
             }
             (Stage::Hull(a), Sums::Hull(h)) => {
                 self.stage =
                     Stage::Extents(Box::new(PlaneExtents::new(a, h.rectangle_direction())));
             }
             (Stage::Extents(_), Sums::Extents(e)) => {
-                self.map = Some(e.finish().map_err(err)?);
+                let map = e.finish().map_err(err)?;
+                if let Some(p) = self.projection.as_mut() {
+                    p.extent = map.extent();
+                }
+                self.map = Some(map);
             }
             _ => {
                 return Err(value_err(

@@ -4,6 +4,7 @@
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use scanfit::base::{Projection, ProjectionAxis};
 use scanfit::metrics::{ErrorStats, ParamQuality};
 use scanfit::pipeline::{Assessment, SurfaceQuality};
 
@@ -17,6 +18,24 @@ pub fn stats<'py>(py: Python<'py>, s: &ErrorStats) -> PyResult<Bound<'py, PyDict
     d.set_item("max", s.max)?;
     d.set_item("max_index", s.max_index)?;
     d.set_item("rmse", s.rmse)?;
+    Ok(d)
+}
+
+/// The projection direction of ``params="plane"`` and the fold shares that
+/// chose it, with the keys of the command line's ``projection``: ``axis``
+/// (``"best-fit plane"``, ``"x"``, ``"y"`` or ``"z"``), ``direction``,
+/// ``fold_shares`` (per candidate name), ``sampled``, ``extent``.
+pub fn projection<'py>(py: Python<'py>, p: &Projection) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("axis", p.axis.name())?;
+    d.set_item("direction", [p.direction.x, p.direction.y, p.direction.z])?;
+    let shares = PyDict::new(py);
+    for (a, s) in ProjectionAxis::ALL.iter().zip(p.fold_shares) {
+        shares.set_item(a.name(), s)?;
+    }
+    d.set_item("fold_shares", shares)?;
+    d.set_item("sampled", p.sampled)?;
+    d.set_item("extent", p.extent)?;
     Ok(d)
 }
 

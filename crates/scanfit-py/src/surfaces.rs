@@ -135,7 +135,12 @@ pub fn mba_config(
 /// ``max_error``, ``rmse`` at the parameters (PDE paper eq. 15),
 /// ``*_distance`` orthogonal, ``grid_rmse`` (MBA paper eq. 17), fold-overs,
 /// ``samples_to_points``), ``residuals`` and ``distances`` per point,
-/// ``converged`` per point, ``rounds`` (the correction rounds). A surface
+/// ``converged`` per point, ``rounds`` (the correction rounds), with
+/// ``params="plane"`` ``projection`` (the direction the points were
+/// projected along: ``axis`` is ``"best-fit plane"``, or ``"x"``, ``"y"``,
+/// ``"z"`` when the best-fit plane folds the points over and that axis does
+/// not; ``fold_shares`` per candidate, measured on a seeded sample of 4000
+/// points; ``direction``, ``sampled``, ``extent``). A surface
 /// whose samples leave the points' bounding box by more than the library's
 /// limit (``quality["samples_to_points"]["leaves_data"]``) raises a
 /// ``UserWarning`` (the command line refuses to write it).
@@ -198,6 +203,9 @@ pub fn fit_surface<'py>(
         rounds.append(e)?;
     }
     d.set_item("rounds", rounds)?;
+    if let Some(p) = &r.projection {
+        d.set_item("projection", crate::report::projection(py, p)?)?;
+    }
     Ok(d)
 }
 

@@ -7,6 +7,7 @@ Needs dask and distributed; without them these tests are skipped with a loud
 message, and with SCANFIT_REQUIRE_DASK=1 (CI) they fail instead.
 """
 
+import json
 import os
 import pickle
 import signal
@@ -160,6 +161,9 @@ def test_the_default_fit_plane_and_distribution_knots_equals_the_single_process_
     assert np.abs(once["surface"].knots[0][3:-3] - uniform).max() > 1e-4
     assert r["smoothing"] == once["smoothing"]
     assert r["errors"]["rmse"] == pytest.approx(once["quality"]["rmse"], rel=1e-9)
+    # the terrain does not fold over its best-fit plane: both keep it
+    assert r["projection"]["axis"] == once["projection"]["axis"] == "best-fit plane"
+    assert r["projection"]["fold_shares"] == once["projection"]["fold_shares"]
     # box, 3 plane passes, 2 rounds of knot counts at 10^6 points, equations, errors
     assert r["passes"] == 1 + 3 + 2 + 2
     # the same on a rotated copy: the plane and its rectangle are not the axes
@@ -170,6 +174,83 @@ def test_the_default_fit_plane_and_distribution_knots_equals_the_single_process_
     r = sd.fit_surface(da.from_array(rot, chunks=(70_000, 3)), ctrl=(20, 14))
     close(r["surface"].control_points, once["surface"].control_points, "rotated")
     knots_close(r, once, "rotated")
+
+
+def franke(n, seed=29):
+    """Franke's function (relief about 1.2) on ``n`` seeded uniform points of the
+    unit square: its best-fit plane is tilted and folds the bumps over."""
+    rng = np.random.default_rng(seed)
+    x, y = rng.random(n), rng.random(n)
+    z = (
+        0.75 * np.exp(-((9 * x - 2) ** 2 + (9 * y - 2) ** 2) / 4)
+        + 0.75 * np.exp(-((9 * x + 1) ** 2) / 49 - (9 * y + 1) / 10)
+        + 0.5 * np.exp(-((9 * x - 7) ** 2 + (9 * y - 3) ** 2) / 4)
+        - 0.2 * np.exp(-((9 * x - 4) ** 2) - (9 * y - 7) ** 2)
+    )
+    return np.column_stack([x, y, z])
+
+
+def test_a_folding_height_field_is_projected_along_z_on_the_workers_as_in_one_process(
+    client, tmp_path
+):
+    # the single-process fit projects along z (the best-fit plane folds); the
+    # workers gather the same seeded sample (the smallest hashes of the global
+    # rows) in the covariance pass, whatever the chunks, tiles and tasks
+    p = franke(100_000)
+    once = scanfit.fit_surface(p)
+    proj = once["projection"]
+    assert proj["axis"] == "z" and proj["direction"] == [0.0, 0.0, 1.0]
+    assert proj["fold_shares"]["best-fit plane"] > 0.02 and proj["fold_shares"]["z"] == 0.0
+    assert proj["sampled"] == 4000
+    assert once["quality"]["fold_overs"] == 0
+    # relief 1.2: orthogonal RMSE far under 0.1% of it
+    assert once["quality"]["rmse_distance"] < 1.2e-3
+    chunked = client.persist(da.from_array(p, chunks=((0, 30_000, 0, 45_000, 25_000), 3)))
+    sizes = [20_000, 65_000, 15_000]  # tiles, the big one split into tasks
+    paths = []
+    for k, part in enumerate(np.split(p, np.cumsum(sizes)[:-1])):
+        paths.append(tmp_path / f"f{k}.ply")
+        scanfit.write_cloud(str(paths[-1]), part)
+    for what, r in [
+        ("array", sd.fit_surface(chunked)),
+        ("tiles", sd.fit_surface(paths, chunk_points=7_000, task_points=30_000)),
+    ]:
+        assert r["projection"]["axis"] == "z", what
+        assert r["projection"]["fold_shares"] == proj["fold_shares"], what
+        assert r["projection"]["sampled"] == 4000, what
+        close(r["surface"].control_points, once["surface"].control_points, f"franke, {what}")
+        knots_close(r, once, f"franke, {what}")
+        assert r["errors"]["rmse"] == pytest.approx(once["quality"]["rmse"], rel=1e-9)
+    # with a correction round: the same choice, the same corrected surface
+    once = scanfit.fit_surface(p[:40_000], ctrl=(16, 16), correct=1)
+    r = sd.fit_surface(da.from_array(p[:40_000], chunks=(9_000, 3)), ctrl=(16, 16), correct=1)
+    assert r["projection"]["axis"] == once["projection"]["axis"] == "z"
+    close(r["surface"].control_points, once["surface"].control_points, "franke, corrected")
+
+
+def test_a_folding_height_field_gives_one_surface_in_memory_streamed_and_on_dask(
+    cli, client, tmp_path
+):
+    # the command line in memory and with --chunk-points, and Dask: one choice
+    p = franke(30_000, seed=31)
+    xyz = tmp_path / "franke.xyz"
+    np.savetxt(xyz, p, fmt="%.17g")  # exact round trip
+    docs = {}
+    for what, extra in [("memory", []), ("streamed", ["--chunk-points", "4321"])]:
+        out = tmp_path / f"{what}.json"
+        rep = cli("fit", xyz, "--no-trim", "-q", "--json", "-o", out, *extra)
+        assert rep["projection"]["axis"] == "z", what
+        docs[what] = (rep, json.loads(out.read_text()))
+    a, b = docs["memory"][0]["projection"], docs["streamed"][0]["projection"]
+    for key in ("axis", "direction", "fold_shares", "sampled"):
+        assert a[key] == b[key], key
+    r = sd.fit_surface(da.from_array(p, chunks=(6_000, 3)))
+    assert r["projection"]["fold_shares"] == docs["memory"][0]["projection"]["fold_shares"]
+    for what, (_, doc) in docs.items():
+        cp = np.asarray(doc["control_points"]).reshape(doc["count_u"], doc["count_v"], 3)
+        close(r["surface"].control_points, cp, f"dask vs the command line {what}")
+        for x, key in zip(r["surface"].knots, ("knots_u", "knots_v")):
+            assert np.abs(x - np.asarray(doc[key])).max() <= 1e-12, (what, key)
 
 
 def test_parameter_correction_on_the_workers_equals_the_single_process_correction(client, pts):
@@ -409,16 +490,29 @@ def test_plane_knot_and_correction_sums_by_hand_equal_the_single_process_fit():
             total = x if total is None else (total.merge(x) or total)
         return total
 
+    offsets = {id(x): o for x, o in zip(parts, [0, 9_000, 9_000, 31_000])}
     plane = S.PlanePasses(c, p[0], len(p))
+    assert plane.projection is None
+    # the first pass samples by global row: a chunk without its offset is refused
+    moments = plane.stage()
+    with pytest.raises(scanfit.ScanfitError, match="offset="):
+        moments.accumulator().add(moments, p[:10])
+    # its sums of the version before the sample are refused as such
+    old = b"SFPYPLA1" + moments.accumulator().to_bytes()[8:]
+    with pytest.raises(scanfit.ScanfitError, match="version 1, but this scanfit reads version 2"):
+        S.PlaneSums.from_bytes(old)
     while not plane.done:
         stage = pickle.loads(pickle.dumps(plane.stage()))
 
         def task(part, stage):
             s = stage.accumulator()
-            s.add(stage, part)
+            s.add(stage, part, offset=offsets[id(part)])
             return s
 
         plane.push(over(parts, task, stage))
+    # the terrain keeps its best-fit plane, as the single-process fit does
+    assert plane.projection["axis"] == "best-fit plane"
+    assert plane.projection["sampled"] == 4000
     param = pickle.loads(pickle.dumps(plane.parameterization()))
     first = scanfit.fit_surface(p, ctrl=(9, 7))
     # the plane's parameters, computed per chunk

@@ -15,8 +15,14 @@
 //!   their circumcircles, or it would be in the sample), so fold-overs and
 //!   stretch are measured on the very triangles the full computation uses,
 //!   at the data's own density.
+//! * [`HashSample`]: the `k` points whose indices have the smallest seeded
+//!   hash (a bottom-k sketch, Cohen & Kaplan 2007): a uniform random
+//!   `k`-subset like [`sample_indices`], but needing no count in advance
+//!   and mergeable (the sample of two sets of points is the `k` smallest of
+//!   their two samples), so a streamed or distributed pass over chunks in
+//!   any order and grouping gathers exactly the sample of one call.
 //!
-//! Both draw from SplitMix64 (Steele, Lea & Flood 2014) started at a fixed
+//! All draw from SplitMix64 (Steele, Lea & Flood 2014) started at a fixed
 //! seed, so a sample is the same on every run, thread count and machine.
 
 /// The seed of every sample the assessment draws (issue 18), unless its
@@ -24,6 +30,9 @@
 pub const DEFAULT_SEED: u64 = 18;
 
 use rayon::prelude::*;
+
+use crate::wire::{Reader, Writer};
+use crate::{Error, Point3, Result};
 
 /// Points per cell of a [`CellSample`] on average (32 x 32 points: a
 /// triangle's circumcircle is a few spacings wide, so most triangles of a
@@ -34,9 +43,12 @@ const POINTS_PER_CELL: f64 = 1024.0;
 #[derive(Debug, Clone)]
 struct SplitMix64(u64);
 
+/// SplitMix64's increment (the golden ratio times 2^64, odd).
+const GOLDEN: u64 = 0x9E37_79B9_7F4A_7C15;
+
 impl SplitMix64 {
     fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        self.0 = self.0.wrapping_add(GOLDEN);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
@@ -213,6 +225,193 @@ impl CellSample {
     }
 }
 
+/// The hash [`HashSample`] ranks point `index` by under `seed`: the
+/// `index + 1`-th output of SplitMix64 started at `seed` (its state after
+/// `index + 1` steps is `seed + (index + 1) * GOLDEN`, and its output
+/// function is a bijection), so distinct indices never share a hash.
+///
+/// ```
+/// use scanfit::sampling::index_hash;
+/// assert_ne!(index_hash(7, 0), index_hash(7, 1));
+/// assert_eq!(index_hash(7, 41), index_hash(7, 41));
+/// ```
+pub fn index_hash(seed: u64, index: u64) -> u64 {
+    SplitMix64(seed.wrapping_add(index.wrapping_mul(GOLDEN))).next()
+}
+
+/// The `k` points of smallest [`index_hash`] among those added (a bottom-k
+/// sketch, Cohen & Kaplan 2007): each point comes with its global index
+/// (its position in the whole data, however the data are split), so every
+/// `k`-subset of the indices is equally likely (up to the hash) and the
+/// sample is a function of the data alone: points added chunk by chunk, in
+/// any order, or merged from samples of other chunks ([`merge`](Self::merge))
+/// give exactly the sample of one call over all of them. Memory: at most
+/// `2k` points while adding; `k` between calls.
+///
+/// ```
+/// use scanfit::sampling::HashSample;
+/// use scanfit::Point3;
+/// let pts: Vec<Point3> = (0..1000).map(|k| Point3::new(k as f64, 0.0, 0.0)).collect();
+/// let mut once = HashSample::new(50, 18);
+/// once.add(0, &pts);
+/// // two chunks sampled apart (say, on two workers) and merged
+/// let (mut a, mut b) = (HashSample::new(50, 18), HashSample::new(50, 18));
+/// b.add(600, &pts[600..]);
+/// a.add(0, &pts[..600]);
+/// b.merge(&a)?;
+/// assert_eq!(b, once);
+/// assert_eq!(once.points().len(), 50);
+/// assert_eq!(HashSample::from_bytes(&once.to_bytes())?, once);
+/// # Ok::<(), scanfit::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct HashSample {
+    k: usize,
+    seed: u64,
+    /// `(hash, index, point)`, increasing in hash, at most `k` between calls.
+    kept: Vec<(u64, u64, Point3)>,
+}
+
+const SAMPLE_TAG: &[u8; 8] = b"SFHSMPL1";
+
+impl HashSample {
+    /// An empty sample of at most `k` points, ranked by [`index_hash`] under
+    /// `seed`.
+    pub fn new(k: usize, seed: u64) -> Self {
+        Self {
+            k,
+            seed,
+            kept: Vec::new(),
+        }
+    }
+
+    /// The hash no further point can beat without entering: the largest kept
+    /// when `k` are kept (every hash is distinct), else none.
+    fn bar(&self) -> u64 {
+        match self.kept.last() {
+            Some(&(h, _, _)) if self.kept.len() >= self.k => h,
+            _ => u64::MAX,
+        }
+    }
+
+    /// Keeps the `k` smallest hashes, increasing, each index once.
+    fn compact(&mut self) {
+        self.kept.sort_unstable_by_key(|e| e.0);
+        self.kept.dedup_by_key(|e| e.0);
+        self.kept.truncate(self.k);
+    }
+
+    /// Adds `points`, the first of which has the global index `first` (the
+    /// next `first + 1`, and so on).
+    pub fn add(&mut self, first: u64, points: &[Point3]) {
+        if self.k == 0 {
+            return;
+        }
+        let mut bar = self.bar();
+        let before = self.kept.len();
+        for (j, p) in points.iter().enumerate() {
+            let index = first.wrapping_add(j as u64);
+            let h = index_hash(self.seed, index);
+            if h < bar || (h == u64::MAX && self.kept.len() < self.k) {
+                self.kept.push((h, index, *p));
+                if self.kept.len() >= 2 * self.k {
+                    self.compact();
+                    bar = self.bar();
+                }
+            }
+        }
+        if self.kept.len() != before {
+            self.compact();
+        }
+    }
+
+    /// Adds the sample of other points (disjoint from these, of the same `k`
+    /// and seed).
+    pub fn merge(&mut self, other: &Self) -> Result<()> {
+        if (self.k, self.seed) != (other.k, other.seed) {
+            return Err(Error::InvalidInput(format!(
+                "cannot merge a sample of {} points (seed {}) with one of {} points (seed {}); every chunk must be sampled alike",
+                self.k, self.seed, other.k, other.seed
+            )));
+        }
+        self.kept.extend_from_slice(&other.kept);
+        self.compact();
+        Ok(())
+    }
+
+    /// The most points kept.
+    pub fn k(&self) -> usize {
+        self.k
+    }
+
+    /// The seed of the hash.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// Points kept (`min(k, points added)`).
+    pub fn len(&self) -> usize {
+        self.kept.len()
+    }
+
+    /// Whether no point was kept.
+    pub fn is_empty(&self) -> bool {
+        self.kept.is_empty()
+    }
+
+    /// The global indices of the sample, increasing.
+    pub fn indices(&self) -> Vec<u64> {
+        let mut i: Vec<u64> = self.kept.iter().map(|e| e.1).collect();
+        i.sort_unstable();
+        i
+    }
+
+    /// The sampled points in the order of their global indices.
+    pub fn points(&self) -> Vec<Point3> {
+        let mut e: Vec<(u64, Point3)> = self.kept.iter().map(|e| (e.1, e.2)).collect();
+        e.sort_unstable_by_key(|e| e.0);
+        e.into_iter().map(|e| e.1).collect()
+    }
+
+    /// The sample as exact bytes ([`crate::wire`]): `k`, the seed, then per
+    /// point its index and coordinates (the hashes are recomputed on reading).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut w = Writer::new(SAMPLE_TAG);
+        w.usize(self.k);
+        w.u64(self.seed);
+        w.usize(self.kept.len());
+        for (_, i, p) in &self.kept {
+            w.u64(*i);
+            for c in p.coords.iter() {
+                w.f64(*c);
+            }
+        }
+        w.finish()
+    }
+
+    /// Reads what [`to_bytes`](Self::to_bytes) wrote; refuses records that
+    /// hold more than `k` points or points out of hash order.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
+        let mut r = Reader::new(bytes, SAMPLE_TAG, "a seeded point sample")?;
+        let (k, seed, n) = (r.usize()?, r.u64()?, r.usize()?);
+        if n > k || n > bytes.len() / 32 {
+            return Err(r.corrupt(&format!("{n} points for a sample of {k}")));
+        }
+        let mut kept = Vec::with_capacity(n);
+        for _ in 0..n {
+            let i = r.u64()?;
+            let p = Point3::new(r.f64()?, r.f64()?, r.f64()?);
+            let h = index_hash(seed, i);
+            if kept.last().is_some_and(|&(g, _, _)| g >= h) {
+                return Err(r.corrupt("points out of hash order"));
+            }
+            kept.push((h, i, p));
+        }
+        r.end()?;
+        Ok(Self { k, seed, kept })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -254,5 +453,109 @@ mod tests {
         assert!(!s.keeps_triangle([1.0, 1.0], [2.0, 2.0], [3.0, 3.0]));
         // beyond the grid counts as taken: a triangle on the left edge is kept
         assert!(s.keeps_triangle([0.0, 10.0], [1.0, 10.0], [0.0, 11.0]));
+    }
+
+    fn line(n: usize) -> Vec<Point3> {
+        (0..n)
+            .map(|k| Point3::new(k as f64, (k % 7) as f64, 0.5 * k as f64))
+            .collect()
+    }
+
+    #[test]
+    fn the_hash_sample_is_the_k_smallest_hashes_however_it_is_gathered() {
+        let pts = line(30_000);
+        let mut once = HashSample::new(400, 77);
+        once.add(0, &pts);
+        // independently: sort all indices by hash, take 400
+        let mut all: Vec<u64> = (0..30_000).collect();
+        all.sort_by_key(|&i| index_hash(77, i));
+        let mut want = all[..400].to_vec();
+        want.sort_unstable();
+        assert_eq!(once.indices(), want);
+        let got = once.points();
+        assert!(want.iter().zip(&got).all(|(&i, p)| pts[i as usize] == *p));
+        // chunkings, merged in several orders and trees, through bytes
+        for cuts in [
+            vec![0, 1, 2, 399, 400, 401, 12_345, 30_000],
+            vec![0, 30_000],
+            vec![0, 7, 7, 29_999, 30_000],
+            vec![0, 800, 1600, 15_000, 15_001, 30_000],
+        ] {
+            let parts: Vec<HashSample> = cuts
+                .windows(2)
+                .map(|w| {
+                    let mut s = HashSample::new(400, 77);
+                    s.add(w[0] as u64, &pts[w[0]..w[1]]);
+                    HashSample::from_bytes(&s.to_bytes()).unwrap()
+                })
+                .collect();
+            let mut forward = HashSample::new(400, 77);
+            parts.iter().for_each(|s| forward.merge(s).unwrap());
+            let mut backward = HashSample::new(400, 77);
+            parts.iter().rev().for_each(|s| backward.merge(s).unwrap());
+            // a tree: pairs first
+            let mut tree = HashSample::new(400, 77);
+            for pair in parts.chunks(2) {
+                let mut t = pair[0].clone();
+                pair[1..].iter().for_each(|s| t.merge(s).unwrap());
+                tree.merge(&t).unwrap();
+            }
+            for s in [&forward, &backward, &tree] {
+                assert_eq!(*s, once, "{cuts:?}");
+                assert_eq!(s.to_bytes(), once.to_bytes());
+            }
+        }
+        // fewer points than k: all of them, in index order
+        let mut few = HashSample::new(400, 77);
+        few.add(10, &pts[..50]);
+        assert_eq!(few.indices(), (10..60).collect::<Vec<u64>>());
+        assert_eq!(few.points(), pts[..50].to_vec());
+        // another seed is another (uniformly drawn) sample, and refuses to merge
+        let mut other = HashSample::new(400, 78);
+        other.add(0, &pts);
+        assert_ne!(other.indices(), want);
+        assert!(other.merge(&once).unwrap_err().to_string().contains("seed"));
+    }
+
+    #[test]
+    fn the_hash_sample_is_uniform() {
+        // every index of 0..40 is kept about equally often over many seeds
+        let pts = line(40);
+        let mut hits = [0usize; 40];
+        for seed in 0..4000 {
+            let mut s = HashSample::new(10, seed);
+            s.add(0, &pts);
+            s.indices().iter().for_each(|&i| hits[i as usize] += 1);
+        }
+        // expected 1000 each; binomial sd about 27
+        assert!(hits.iter().all(|&h| (850..1150).contains(&h)), "{hits:?}");
+    }
+
+    #[test]
+    fn damaged_sample_bytes_are_refused_with_the_reason() {
+        let mut s = HashSample::new(20, 5);
+        s.add(0, &line(100));
+        let b = s.to_bytes();
+        let e = HashSample::from_bytes(&b[..b.len() - 3]).unwrap_err();
+        assert!(e.to_string().contains("cut short"), "{e}");
+        let mut old = b.clone();
+        old[7] = b'0';
+        let e = HashSample::from_bytes(&old).unwrap_err();
+        assert!(e.to_string().contains("format version 0"), "{e}");
+        // two points swapped: out of hash order
+        let mut swapped = b.clone();
+        let at = 8 + 24;
+        let (x, y) = (
+            swapped[at..at + 32].to_vec(),
+            swapped[at + 32..at + 64].to_vec(),
+        );
+        swapped[at..at + 32].copy_from_slice(&y);
+        swapped[at + 32..at + 64].copy_from_slice(&x);
+        let e = HashSample::from_bytes(&swapped).unwrap_err();
+        assert!(e.to_string().contains("hash order"), "{e}");
+        // more points than k
+        let mut big = b.clone();
+        big[8..16].copy_from_slice(&3u64.to_le_bytes());
+        assert!(HashSample::from_bytes(&big).is_err());
     }
 }

@@ -71,6 +71,13 @@ impl Writer {
         }
     }
 
+    /// Appends another record (its length, then its bytes), to be read
+    /// back by [`Reader::record`].
+    pub fn record(&mut self, bytes: &[u8]) {
+        self.usize(bytes.len());
+        self.bytes.extend_from_slice(bytes);
+    }
+
     /// The record.
     pub fn finish(self) -> Vec<u8> {
         self.bytes
@@ -157,6 +164,19 @@ impl<'a> Reader<'a> {
             return Err(self.truncated(8 * (n - left)));
         }
         (0..n).map(|_| self.f64()).collect()
+    }
+
+    /// The next record written by [`Writer::record`] (its length checked
+    /// against the bytes left), to be read by that record's own reader.
+    pub fn record(&mut self) -> Result<&'a [u8]> {
+        let n = self.usize()?;
+        let left = self.bytes.len() - self.at;
+        if n > left {
+            return Err(self.truncated(n - left));
+        }
+        let b = &self.bytes[self.at..self.at + n];
+        self.at += n;
+        Ok(b)
     }
 
     /// An error for a field whose value cannot be right.

@@ -36,3 +36,16 @@ pub fn ok(o: &Output) -> String {
     );
     String::from_utf8_lossy(&o.stdout).into_owned()
 }
+
+/// Franke's function (relief 1.2) on `n` seeded uniform points of the unit
+/// square ([`scanfit::testdata::scattered`], seed 29), written to `path` as
+/// `x y z` text (shortest round-trip numbers: read back exactly). Its
+/// best-fit plane is tilted and folds the bumps over.
+pub fn write_franke_xyz(path: &Path, n: usize) {
+    let pts = scanfit::testdata::scattered(n, 29, [0.0, 0.0, 1.0, 1.0], scanfit::testdata::franke);
+    let text: String = pts
+        .iter()
+        .map(|p| format!("{} {} {}\n", p.x, p.y, p.z))
+        .collect();
+    std::fs::write(path, text).unwrap();
+}

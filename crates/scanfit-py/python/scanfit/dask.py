@@ -20,9 +20,13 @@ that fails to read raises a ``ScanfitError`` naming the tile.
 
 The keywords are those of ``scanfit.mba`` and ``scanfit.fit_surface``, with their
 defaults. The fit's settings that look at all points at once run as more passes of
-mergeable sums: ``params="plane"`` (covariance sums for the plane, the convex hull
-in it for the minimum-area rectangle, the extents along its axes; then every
-worker computes its points' parameters), ``knots="distribution"`` (the few order
+mergeable sums: ``params="plane"`` (covariance sums for the plane and, in the same
+pass, the seeded sample that chooses the projection direction: the 4000 points of
+smallest hash of their global row, merged across tasks, so the workers choose the
+best-fit plane or a coordinate axis exactly as the single-process fit does; the
+convex hull in the projection plane for the minimum-area rectangle, the extents
+along its axes; then every worker computes its points' parameters),
+``knots="distribution"`` (the few order
 statistics eq. 9.69 needs, found exactly by rounds of histograms) and ``correct``
 (per round, the workers re-project their points onto the surfaces of the accepted
 rounds in turn, as the single-process correction does). MBA's ``adjust`` (the
@@ -289,10 +293,13 @@ def _start_pass(part, state, up="z"):
     return sums
 
 
-def _plane(part, stage):
+def _plane(part, offset, stage):
+    """A plane pass's sums of a part whose first point is the global row
+    ``offset`` (the first pass samples points by their global row)."""
     sums = stage.accumulator()
     for pts, _ in _blocks(part):
-        sums.add(stage, pts)
+        sums.add(stage, pts, offset=offset)
+        offset += len(pts)
     return sums
 
 
@@ -339,12 +346,17 @@ def _shared(value):
     return delayed(value, pure=False, traverse=False)
 
 
-def _pass(client, parts, task, *args, merge=_merge):
-    """One pass: ``task(part, *args)`` per part, merged in a fixed tree, computed."""
+def _pass(client, parts, task, *args, merge=_merge, offsets=None):
+    """One pass: ``task(part, *args)`` per part (``task(part, offset, *args)``
+    with the parts' first global rows ``offsets``), merged in a fixed tree,
+    computed."""
     from dask import delayed
 
     fn = delayed(task, pure=True)
-    items = [fn(p, *args) for p in parts]
+    if offsets is None:
+        items = [fn(p, *args) for p in parts]
+    else:
+        items = [fn(p, o, *args) for p, o in zip(parts, offsets)]
     join = delayed(merge, pure=True)
     while len(items) > 1:
         items = [join(*items[i : i + FAN_IN]) for i in range(0, len(items), FAN_IN)]
@@ -373,16 +385,26 @@ def _centring(box, domain, up="z"):
 
 def _split(parts, counts, task_points):
     """Tiles of more than ``task_points`` rows as several tasks of at most that
-    many rows each (in file order); other parts as they are."""
+    many rows each (in file order); other parts as they are. Returns the parts
+    and their rows."""
     if task_points is None:
-        return parts
-    out = []
+        return parts, counts
+    out, rows = [], []
     for part, n in zip(parts, counts):
         if isinstance(part, _Tile) and n > task_points:
-            out.extend(part.part(a, min(a + task_points, n)) for a in range(0, n, task_points))
+            for a in range(0, n, task_points):
+                out.append(part.part(a, min(a + task_points, n)))
+                rows.append(min(a + task_points, n) - a)
         else:
             out.append(part)
-    return out
+            rows.append(n)
+    return out, rows
+
+
+def _offsets(rows):
+    """The global row of each part's first point: the rows of the parts before
+    it (the index a single-process call gives that point)."""
+    return [int(x) for x in np.cumsum([0] + list(rows[:-1]))]
 
 
 def _check_reading(chunk_points, task_points):
@@ -413,7 +435,7 @@ def _mba_survey(client, parts, domain, up, task_points):
     box, counts = _survey(client, parts, sample=up == "auto")
     if up == "auto":
         up = up_axis(box[4].points)
-    return _split(parts, counts, task_points), up, box, 1
+    return _split(parts, counts, task_points)[0], up, box, 1
 
 
 # ---- the fits (run on the client) ----------------------------------------------
@@ -584,8 +606,17 @@ def fit_surface(
     ``knots="distribution"`` (the default, NURBS Book eq. 9.69) or
     ``"uniform"``; ``correct=k`` rounds of Hoschek's parameter correction.
 
+    With ``params="plane"`` the points are projected onto their best-fit plane,
+    or along the x, y or z axis when that plane folds them over and the axis
+    does not, chosen as ``scanfit.fit_surface`` chooses it: from the normals of
+    the same seeded sample of 4000 points (the smallest hashes of their global
+    rows: a point's row is its row in the Dask array, or the rows of the
+    tiles before it plus its row in its tile), gathered in the covariance pass
+    and merged across tasks; so the surface is the single-process one on
+    folding data too.
+
     Passes over the points: bounding box, count and first point; with the
-    plane 3 (covariance sums, convex hull, extents); then per fit (one, plus
+    plane 3 (covariance sums with the sample, convex hull, extents); then per fit (one, plus
     one per correction round): with distribution knots 2 to 3 rounds of
     counts (more above about 10^9 points), the normal equations, the errors at
     the parameters. Correction round ``r`` re-projects every point onto the
@@ -602,7 +633,9 @@ def fit_surface(
     ``count``, ``mean``, ``max``, ``max_index``, ``rmse``), ``rounds`` (per
     fit: ``round``, ``rmse``, ``max``; as ``scanfit.fit_surface``'s, empty
     without correction), ``passes``, ``seconds``, ``equation_bytes`` (the size
-    of the sums each task returns).
+    of the sums each task returns), ``projection`` (with the plane:
+    ``scanfit.fit_surface``'s ``projection``, the direction and the fold shares
+    that chose it; ``None`` with given parameters).
 
     Example::
 
@@ -619,19 +652,20 @@ def fit_surface(
     _check_reading(chunk_points, task_points)
     parts = _parts(points, uv, given, chunk_points)
     box, counts = _survey(client, parts)
-    parts = _split(parts, counts, task_points)
+    parts, rows = _split(parts, counts, task_points)
     centring, count, first = _centring(box, None), box[2], box[3]
     setup = FitSetup(count, centring, ctrl, degree, given, knots, smooth, periodic_u, correct)
     passes = 1
     if setup.plane:
         plane = PlanePasses(centring, tuple(map(float, first)), count)
+        offsets = _offsets(rows)
         while not plane.done:
             stage = _shared(plane.stage())
-            plane.push(_pass(client, parts, _plane, stage))
+            plane.push(_pass(client, parts, _plane, stage, offsets=offsets))
             passes += 1
-        param = plane.parameterization()
+        param, projection = plane.parameterization(), plane.projection
     else:
-        param = Parameterization.given(centring)
+        param, projection = Parameterization.given(centring), None
 
     def fit(param):
         """One least-squares fit to the parameters of ``param``: the knots, the
@@ -678,4 +712,5 @@ def fit_surface(
         "tasks": len(parts),
         "seconds": time.perf_counter() - t0,
         "equation_bytes": eq.nbytes,
+        "projection": projection,
     }

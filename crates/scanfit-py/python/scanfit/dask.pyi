@@ -52,5 +52,7 @@ def fit_surface(
     """scanfit.fit_surface's surface, computed by the workers' partial sums.
 
     Returns ``surface``, ``smoothing``, ``points``, ``tasks``, ``errors``,
-    ``rounds``, ``passes``, ``seconds``, ``equation_bytes``.
+    ``rounds``, ``passes``, ``seconds``, ``equation_bytes``, ``projection``
+    (with ``params="plane"``: the single-process fit's choice, from the same
+    seeded sample; else None).
     """

@@ -27,7 +27,11 @@ additions (about 1e-15 relative).
   / ``RankCounts``), ``equations(search=None)`` (empty ``NormalEquations``).
 - ``NormalEquations``: ``add(points, uv)``, ``merge``, ``finish() -> Surface``.
 - ``PlanePasses(centring, first, count)``: the best-fit plane (``params="plane"``)
-  in three passes of ``PlaneStage`` / ``PlaneSums`` (covariance, hull, extents).
+  in three passes of ``PlaneStage`` / ``PlaneSums`` (covariance with the seeded
+  fold sample, hull, extents); the first pass's ``add(stage, points, offset=row)``
+  needs the global row of the chunk's first point, and ``projection`` is then the
+  single-process fit's choice of direction (best-fit plane, or x, y, z when the
+  plane folds the points over).
 - ``Parameterization``: a chunk's ``(u, v)`` (plane or given), re-projected
   onto the surfaces of the accepted correction rounds; ``errors`` at them.
 - ``surface_errors(surface, points, uv) -> ResidualSums``: errors at the parameters.

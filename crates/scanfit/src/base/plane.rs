@@ -5,7 +5,18 @@
 //! square, are the parameters. This parameterizes any patch that is a height
 //! field over its best-fit plane (terrain, a face seen from the front, a gently
 //! curved panel); it folds over where the patch turns back over that plane.
+//!
+//! A height field of large relief (Franke's function over the unit square:
+//! relief 1.2 on a side of 1) has a strongly tilted best-fit plane, and the
+//! projection onto it folds where the bumps face away from the tilt, while
+//! the projection along the heights' axis would not fold at all. So
+//! [`plane_parameters`] measures the fold-over share of each candidate
+//! direction ([`super::choose_projection`]: the best-fit plane's normal and
+//! the three coordinate axes) on a seeded sample and projects along the
+//! best; the best-fit plane is kept whenever it does not fold more than the
+//! others, so a sheet over its plane is parameterized as before.
 
+use super::projection::{fold_sample, projected_frame, Projection};
 use crate::wire::{Reader, Writer};
 use crate::{Error, Point3, Result, Vector3};
 
@@ -24,6 +35,8 @@ pub struct PlaneParameterization {
     pub bounds: [(f64, f64); 2],
     /// Parameters in `[0, 1]^2`, one per point.
     pub uv: Vec<[f64; 2]>,
+    /// The projection direction and why it was chosen.
+    pub projection: Projection,
 }
 
 /// The best-fit plane's frame: the centroid, the in-plane axes along the
@@ -70,15 +83,42 @@ pub fn plane_frame(points: &[Point3]) -> Result<PlaneFrame> {
     })
 }
 
-/// Parameters of `points` on their best-fit plane. Axis signs are made
-/// deterministic (largest component positive), so the result does not depend
-/// on the eigen solver.
+/// Parameters of `points` on their best-fit plane, or, when that plane
+/// folds the points over and a coordinate axis does not
+/// ([`super::choose_projection`]), on the plane across that axis. Axis
+/// signs are made deterministic (largest component positive), so the result
+/// does not depend on the eigen solver.
 ///
-/// The steps are those of a chunked or distributed run ([`PlaneAxes`] from
-/// the covariance sums, [`FlatHull`], [`PlaneExtents`], [`PlaneMap`]), each
-/// fed all points at once here.
+/// The steps are those of a chunked or distributed run
+/// ([`super::PlaneMoments`]: the covariance sums and the seeded sample that
+/// chooses the direction; [`FlatHull`], [`PlaneExtents`], [`PlaneMap`]),
+/// each fed all points at once here, the point's index its position in
+/// `points`: a streamed or distributed run over the same points in the same
+/// order makes the same choice and gives the same parameters (to the
+/// rounding of the sums).
+///
+/// ```
+/// use scanfit::base::{plane_parameters, ProjectionAxis};
+/// use scanfit::Point3;
+/// // a steep ridge over the unit square: its best-fit plane is tilted
+/// let pts: Vec<Point3> = (0..2500)
+///     .map(|k| {
+///         let (x, y) = ((k % 50) as f64 / 49.0, (k / 50) as f64 / 49.0);
+///         Point3::new(x, y, (-30.0 * (x - 0.3) * (x - 0.3)).exp() + 0.8 * x)
+///     })
+///     .collect();
+/// let p = plane_parameters(&pts).unwrap();
+/// assert_eq!(p.projection.axis, ProjectionAxis::Z);
+/// assert_eq!(p.normal, scanfit::Vector3::z());
+/// # Ok::<(), scanfit::Error>(())
+/// ```
 pub fn plane_parameters(points: &[Point3]) -> Result<PlaneParameterization> {
-    let map = plane_map(points)?;
+    let pca = checked_pca(points)?;
+    let mut sample = fold_sample();
+    sample.add(0, points);
+    let (axes, mut projection) = projected_frame(&pca, &sample)?;
+    let map = map_along(&axes, points)?;
+    projection.extent = map.extent();
     let uv = points.iter().map(|p| map.uv(p)).collect();
     Ok(PlaneParameterization {
         origin: map.origin,
@@ -87,13 +127,12 @@ pub fn plane_parameters(points: &[Point3]) -> Result<PlaneParameterization> {
         normal: map.normal,
         bounds: map.bounds,
         uv,
+        projection,
     })
 }
 
-/// The steps of a chunked or distributed run ([`PlaneAxes`] from the
-/// covariance sums, [`FlatHull`], [`PlaneExtents`]), each fed all points at
-/// once.
-fn plane_map(points: &[Point3]) -> Result<PlaneMap> {
+/// The points' PCA, after checking that there are enough valid points.
+pub(super) fn checked_pca(points: &[Point3]) -> Result<crate::Pca> {
     crate::validate_points(points)?;
     if points.len() < 3 {
         return Err(Error::TooFewPoints {
@@ -102,21 +141,32 @@ fn plane_map(points: &[Point3]) -> Result<PlaneMap> {
             what: "a best-fit plane".into(),
         });
     }
-    let pca = crate::geom::pca(points).ok_or(Error::TooFewPoints {
+    crate::geom::pca(points).ok_or(Error::TooFewPoints {
         got: 0,
         needed: 3,
         what: "a best-fit plane".into(),
-    })?;
-    let axes = PlaneAxes::of(&pca)?;
+    })
+}
+
+/// The steps of a chunked or distributed run ([`PlaneAxes`] from the
+/// covariance sums, [`FlatHull`], [`PlaneExtents`]), each fed all points at
+/// once.
+fn plane_map(points: &[Point3]) -> Result<PlaneMap> {
+    let axes = PlaneAxes::of(&checked_pca(points)?)?;
+    map_along(&axes, points)
+}
+
+/// [`FlatHull`] and [`PlaneExtents`] of `points` in the frame `axes`.
+fn map_along(axes: &PlaneAxes, points: &[Point3]) -> Result<PlaneMap> {
     let mut hull = FlatHull::default();
-    hull.add(&axes, points);
-    let mut extents = PlaneExtents::new(&axes, hull.rectangle_direction());
+    hull.add(axes, points);
+    let mut extents = PlaneExtents::new(axes, hull.rectangle_direction());
     extents.add(points);
     extents.finish()
 }
 
 /// `v` with its largest component made positive (deterministic signs).
-fn orient(v: Vector3) -> Vector3 {
+pub(super) fn orient(v: Vector3) -> Vector3 {
     let j = v.iamax();
     if v[j] < 0.0 {
         -v
@@ -363,6 +413,13 @@ pub struct PlaneMap {
 }
 
 impl PlaneMap {
+    /// Lengths of the parameter rectangle's sides along `u` and `v` (data
+    /// units).
+    pub fn extent(&self) -> [f64; 2] {
+        let [(lo1, hi1), (lo2, hi2)] = self.bounds;
+        [hi1 - lo1, hi2 - lo2]
+    }
+
     /// The parameters of `p`.
     #[inline]
     pub fn uv(&self, p: &Point3) -> [f64; 2] {
@@ -518,6 +575,65 @@ fn convex_hull(pts: &[[f64; 2]]) -> Vec<[f64; 2]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::base::{choose_projection, ProjectionAxis, FOLD_SAMPLE};
+    use crate::cloud::testutil::Rng;
+
+    /// Franke's function on `n` seeded uniform points of the unit square.
+    fn franke(n: usize) -> Vec<Point3> {
+        crate::testdata::scattered(n, 29, [0.0, 0.0, 1.0, 1.0], crate::testdata::franke)
+    }
+
+    #[test]
+    fn a_height_field_of_large_relief_is_projected_along_its_heights() {
+        // the best-fit plane of Franke's bumps is tilted and folds them over
+        // (the fit through it had 13067 fold-overs in 199454 triangles at
+        // 10^5 points); along z nothing folds
+        let pts = franke(20_000);
+        let p = plane_parameters(&pts).unwrap();
+        let s = p.projection.fold_shares;
+        assert!(s[0] > 0.02, "{s:?}");
+        assert_eq!(s[3], 0.0, "{s:?}");
+        assert_eq!(p.projection.axis, ProjectionAxis::Z);
+        assert_eq!(p.projection.sampled, FOLD_SAMPLE);
+        assert_eq!((p.normal, p.e1.z, p.e2.z), (Vector3::z(), 0.0, 0.0));
+        // u, v are the points' x, y (in some order and sign) over the unit square
+        let [(lo1, hi1), (lo2, hi2)] = p.bounds;
+        assert!(p.e1.x.abs().max(p.e1.y.abs()) > 0.999, "{:?}", p.e1);
+        assert!((hi1 - lo1 - 1.0).abs() < 1e-3 && (hi2 - lo2 - 1.0).abs() < 1e-3);
+        assert!(
+            (p.projection.extent[0] - 1.0).abs() < 1e-3,
+            "{:?}",
+            p.projection.extent
+        );
+        // the y-up copy of the same data picks y
+        let yup: Vec<Point3> = pts.iter().map(|q| Point3::new(q.x, q.z, q.y)).collect();
+        let c = choose_projection(&yup).unwrap();
+        assert_eq!((c.axis, c.direction), (ProjectionAxis::Y, Vector3::y()));
+        assert_eq!(c.fold_shares[2], 0.0);
+    }
+
+    #[test]
+    fn a_clean_tilted_sheet_keeps_its_best_fit_plane() {
+        // a gently curved sheet tilted 60 degrees about a rotated axis:
+        // the best-fit plane folds nothing, z would not fold either but the
+        // plane is kept, and the parameters are the best-fit plane map's
+        let (c, s) = (0.4f64.cos(), 0.4f64.sin());
+        let mut rng = Rng::new(3);
+        let pts: Vec<Point3> = (0..5000)
+            .map(|_| {
+                let (x, y) = (rng.uniform() * 40.0, rng.uniform() * 25.0);
+                let z = 1.7 * x + 0.5 * (x * 0.15).sin() * (y * 0.2).cos();
+                Point3::new(x * c - y * s + 700.0, x * s + y * c, z - 30.0)
+            })
+            .collect();
+        let p = plane_parameters(&pts).unwrap();
+        assert_eq!(p.projection.axis, ProjectionAxis::BestFitPlane);
+        assert_eq!(p.projection.fold_shares[0], 0.0);
+        assert_eq!(p.projection.fold_shares[3], 0.0);
+        let map = plane_map(&pts).unwrap();
+        assert_eq!((p.normal, p.e1, p.bounds), (map.normal, map.e1, map.bounds));
+        assert!(pts.iter().zip(&p.uv).all(|(q, t)| map.uv(q) == *t));
+    }
 
     #[test]
     fn terrain_like_points_map_to_the_unit_square() {

@@ -642,6 +642,7 @@ impl<'s> StreamAssessor<'s> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::base::ProjectionAxis;
     use crate::fit::surface::KnotPlacement;
     use crate::pipeline::{mba as mba_pipeline, surface_fit};
     use crate::progress::NoProgress;
@@ -758,6 +759,79 @@ mod tests {
         }
     }
 
+    /// `a`'s knots within 1e-12 of `b`'s (on `[0, 1]`), its control points
+    /// within 1e-12 of `b`'s largest coordinate.
+    fn assert_same_surface(a: &Surface, b: &Surface) {
+        assert_eq!(a.knots_u().as_slice().len(), b.knots_u().as_slice().len());
+        assert_eq!(a.knots_v().as_slice().len(), b.knots_v().as_slice().len());
+        for (x, y) in [(a.knots_u(), b.knots_u()), (a.knots_v(), b.knots_v())] {
+            for (s, t) in x.as_slice().iter().zip(y.as_slice()) {
+                assert!((s - t).abs() <= 1e-12, "knots {s} {t}");
+            }
+        }
+        let scale = b
+            .control_points()
+            .iter()
+            .fold(0.0f64, |m, q| m.max(q.coords.abs().max()));
+        assert_eq!(a.control_points().len(), b.control_points().len());
+        for (x, y) in a.control_points().iter().zip(b.control_points()) {
+            assert!((x - y).norm() <= 1e-12 * scale, "{x} {y}");
+        }
+    }
+
+    #[test]
+    fn streamed_fit_of_a_folding_height_field_makes_the_in_memory_choice() {
+        use crate::pipeline::surface_fit::FitConfig;
+        // Franke's function (relief 1.2 over the unit square), far from the
+        // origin: its best-fit plane folds the bumps over, z does not; the
+        // fold sample is gathered in the covariance pass, whatever the chunks
+        let p: Vec<Point3> =
+            crate::testdata::scattered(20_000, 29, [0.0, 0.0, 1.0, 1.0], crate::testdata::franke)
+                .into_iter()
+                .map(|q| Point3::new(q.x + 3.0e3, q.y - 7.0e3, q.z))
+                .collect();
+        let mut cfg = FitConfig::default();
+        let once =
+            surface_fit::run(&PointCloud::new(p.clone()).unwrap(), &cfg, &NoProgress).unwrap();
+        let po = once.projection.unwrap();
+        assert_eq!(po.axis, ProjectionAxis::Z);
+        assert!(
+            po.fold_shares[0] > 0.02 && po.fold_shares[3] == 0.0,
+            "{po:?}"
+        );
+        assert_eq!(once.assessment.quality.parameterization.fold_overs, 0);
+        for chunk in [999, 4096, 20_000] {
+            let mut s = SliceSource {
+                points: &p,
+                uv: None,
+                chunk,
+            };
+            let r = fit(&mut s, &cfg, &NoProgress).unwrap();
+            let pr = r.projection.unwrap();
+            assert_eq!(
+                (pr.axis, pr.direction, pr.fold_shares, pr.sampled),
+                (po.axis, po.direction, po.fold_shares, po.sampled),
+                "chunk {chunk}"
+            );
+            assert!((pr.extent[0] - po.extent[0]).abs() <= 1e-12 * po.extent[0]);
+            assert_same_surface(&r.surface, &once.surface);
+            // bounding box, plane x3, knots x2, equations, measure
+            assert_eq!(r.passes, 8);
+        }
+        // with a correction round too
+        cfg.correction_rounds = 1;
+        let once =
+            surface_fit::run(&PointCloud::new(p.clone()).unwrap(), &cfg, &NoProgress).unwrap();
+        let mut s = SliceSource {
+            points: &p,
+            uv: None,
+            chunk: 3333,
+        };
+        let r = fit(&mut s, &cfg, &NoProgress).unwrap();
+        assert_eq!(r.projection.unwrap().axis, ProjectionAxis::Z);
+        assert_same_surface(&r.surface, &once.surface);
+    }
+
     #[test]
     fn streamed_fit_equals_the_in_memory_pipeline_with_every_setting() {
         use crate::pipeline::surface_fit::{FitConfig, ParameterSource};
@@ -798,21 +872,7 @@ mod tests {
         assert_eq!(a.grid_rmse, b.grid_rmse);
         // the plane, the distribution knots and the correction: more passes,
         // the in-memory surface to the rounding of the sums
-        let close = |a: &Surface, b: &Surface| {
-            assert_eq!(a.knots_u().as_slice().len(), b.knots_u().as_slice().len());
-            for (x, y) in [(a.knots_u(), b.knots_u()), (a.knots_v(), b.knots_v())] {
-                for (s, t) in x.as_slice().iter().zip(y.as_slice()) {
-                    assert!((s - t).abs() <= 1e-12, "knots {s} {t}");
-                }
-            }
-            let scale = b
-                .control_points()
-                .iter()
-                .fold(0.0f64, |m, q| m.max(q.coords.abs().max()));
-            for (x, y) in a.control_points().iter().zip(b.control_points()) {
-                assert!((x - y).norm() <= 1e-12 * scale, "{x} {y}");
-            }
-        };
+        let close = assert_same_surface;
         for (params, knots, rounds, passes) in [
             // bounding box, plane x3, knots x2, equations, measure
             (ParameterSource::Plane, KnotPlacement::Distribution, 0, 8),
@@ -838,6 +898,13 @@ mod tests {
             let once = surface_fit::run(&cloud, &c, &NoProgress).unwrap();
             let r = fit(&mut s, &c, &NoProgress).unwrap();
             close(&r.surface, &once.surface);
+            // the terrain does not fold over its best-fit plane: kept by both
+            let key = |p: Option<crate::base::Projection>| p.map(|p| (p.axis, p.fold_shares));
+            assert_eq!(key(r.projection), key(once.projection));
+            if c.params == ParameterSource::Plane {
+                let p = r.projection.unwrap();
+                assert_eq!((p.axis, p.sampled), (ProjectionAxis::BestFitPlane, 4000));
+            }
             assert_eq!(r.rounds.len(), once.rounds.len());
             for (x, y) in r.rounds.iter().zip(&once.rounds) {
                 assert!((x.errors.rmse - y.errors.rmse).abs() <= 1e-12 * y.errors.rmse);

@@ -2,7 +2,9 @@
 //! scattered points.
 //!
 //! The points get their parameters from their best-fit plane
-//! ([`ParameterSource::Plane`], for height-field-like patches) or from two
+//! ([`ParameterSource::Plane`], for height-field-like patches; projected
+//! along a coordinate axis instead when the best-fit plane folds the points
+//! over and the axis does not, [`crate::base::choose_projection`]) or from two
 //! attributes of the cloud ([`ParameterSource::Attributes`], e.g. the columns
 //! `u` and `v` of the input file); the surface is the least-squares fit of
 //! [`fit_surface`] (NURBS Book eq. 9.63 on a tensor-product basis, optional
@@ -15,7 +17,7 @@
 //! stay tame; `relative_smoothing = None` with `fit.smoothing = 0` and
 //! `ctrl_from_density = false` is the bare fit of the paper.
 
-use crate::base::plane_parameters;
+use crate::base::{plane_parameters, Projection};
 use crate::bspline::Surface;
 use crate::centring::Centring;
 use crate::fit::correction::{correct_parameters, CorrectionConfig, CorrectionRound};
@@ -30,7 +32,9 @@ use crate::{Error, PointCloud, Result};
 #[non_exhaustive]
 pub enum ParameterSource {
     /// Orthogonal projection onto the best-fit plane of the points, scaled to
-    /// `[0, 1]^2` (the default).
+    /// `[0, 1]^2` (the default); onto the plane across a coordinate axis
+    /// when the best-fit plane folds the points over and the axis does not
+    /// ([`crate::base::plane_parameters`]).
     #[default]
     Plane,
     /// Two attributes of the cloud hold `u` and `v`.
@@ -138,6 +142,9 @@ pub struct FitReport {
     pub assessment: Assessment,
     /// The thin-plate weight `lambda` used (0 for the bare fit).
     pub smoothing: f64,
+    /// With [`ParameterSource::Plane`]: the projection direction and the
+    /// fold shares that chose it.
+    pub projection: Option<Projection>,
 }
 
 /// Fits a least-squares B-spline surface to `cloud` (see the module
@@ -181,6 +188,7 @@ fn run_centred(
 ) -> Result<FitReport> {
     let pts = cloud.points();
     progress.stage("parameterizing", None);
+    let mut projection = None;
     let mut uv: Vec<[f64; 2]> = match &config.params {
         ParameterSource::Plane => {
             if config.fit.periodic_u {
@@ -190,7 +198,9 @@ fn run_centred(
                     hint: "a periodic surface needs parameters that go around (ParameterSource::Attributes); a plane cannot close".into(),
                 });
             }
-            plane_parameters(pts)?.uv
+            let p = plane_parameters(pts)?;
+            projection = Some(p.projection);
+            p.uv
         }
         ParameterSource::Attributes { u, v } => {
             let (Some(us), Some(vs)) = (cloud.attribute(u), cloud.attribute(v)) else {
@@ -230,6 +240,7 @@ fn run_centred(
         rounds,
         assessment,
         smoothing: fit_config.smoothing,
+        projection,
     })
 }
 
@@ -238,6 +249,26 @@ mod tests {
     use super::*;
     use crate::progress::NoProgress;
     use crate::Point3;
+
+    #[test]
+    fn the_default_fit_of_a_height_field_of_large_relief_does_not_fold() {
+        // Franke's function (relief 1.2 over the unit square): the best-fit
+        // plane folded the bumps over; the default fit projects along z
+        let pts =
+            crate::testdata::scattered(20_000, 29, [0.0, 0.0, 1.0, 1.0], crate::testdata::franke);
+        let r = run(
+            &PointCloud::new(pts).unwrap(),
+            &FitConfig::default(),
+            &NoProgress,
+        )
+        .unwrap();
+        let p = r.projection.unwrap();
+        assert_eq!(p.axis, crate::base::ProjectionAxis::Z);
+        let q = &r.assessment.quality;
+        assert_eq!(q.parameterization.fold_overs, 0);
+        assert!(!q.extent.leaves, "{:?}", q.extent);
+        assert!(q.orthogonal.rmse < 1.2e-3, "{:?}", q.orthogonal);
+    }
 
     fn wave(n: usize) -> Vec<Point3> {
         (0..n * n)

@@ -3,12 +3,16 @@
 //! chunks, every setting of the in-memory fit run as passes of mergeable sums:
 //!
 //! * parameters from the best-fit plane (`ParameterSource::Plane`): the
-//!   covariance sums about the first point ([`CovarianceSums`], the PCA
-//!   normal), the convex hull in the plane ([`FlatHull`], its minimum-area
-//!   rectangle, Freeman & Shapira 1975), the extents along the rectangle's
-//!   axes ([`PlaneExtents`]): three passes, then every chunk's parameters from
-//!   the [`PlaneMap`], as [`crate::base::plane_parameters`] computes them;
-//!   given parameters come with the chunks;
+//!   covariance sums about the first point (the PCA normal) and, in the same
+//!   pass, the seeded sample whose normals choose the projection direction
+//!   ([`PlaneMoments`]: the best-fit plane, or a coordinate axis when the
+//!   plane folds the points over and the axis does not; the sample is the
+//!   points of smallest index hash, so it is the in-memory call's whatever
+//!   the chunking), the convex hull in the plane ([`FlatHull`], its
+//!   minimum-area rectangle, Freeman & Shapira 1975), the extents along the
+//!   rectangle's axes ([`PlaneExtents`]): three passes, then every chunk's
+//!   parameters from the [`PlaneMap`], as [`crate::base::plane_parameters`]
+//!   computes them; given parameters come with the chunks;
 //! * knots from the parameter distribution ([NURBS97] eq. 9.69): the few order
 //!   statistics the knots need, found exactly by rounds of histograms
 //!   ([`KnotSearch`], 2-3 passes);
@@ -23,7 +27,7 @@
 //! The surface equals the in-memory one to the rounding of the sums (tested
 //! at 1e-12 of the largest control point coordinate).
 
-use crate::base::{FlatHull, PlaneAxes, PlaneExtents, PlaneMap};
+use crate::base::{FlatHull, PlaneExtents, PlaneMap, PlaneMoments, Projection, ProjectionAxis};
 use crate::bspline::Surface;
 use crate::fit::correction::CorrectionRound;
 use crate::fit::knot_ranks::KnotSearch;
@@ -35,7 +39,7 @@ use crate::pipeline::surface_fit::{FitConfig, ParameterSource};
 use crate::progress::Progress;
 use crate::project::{InversionConfig, SurfaceInverter};
 use crate::up_axis::UpAxis;
-use crate::{CovarianceSums, Error, Result};
+use crate::{Error, Point3, Result};
 
 use super::{centring_pass, chunk_uv, Centred, Chunk, PointSource, StreamAssessor};
 
@@ -55,6 +59,10 @@ pub struct StreamedFit {
     pub rounds: Vec<CorrectionRound>,
     /// The streamed measures (see the [`super`] module documentation).
     pub quality: SurfaceQuality,
+    /// With [`ParameterSource::Plane`]: the projection direction and the
+    /// fold shares that chose it, as the in-memory
+    /// [`crate::pipeline::surface_fit::FitReport::projection`].
+    pub projection: Option<Projection>,
 }
 
 /// The least-squares surface of the points of `source` with the settings of
@@ -106,12 +114,14 @@ pub fn fit(
         up: UpAxis::Z,
     };
     let mut passes = Passes { count: 1, progress };
+    let (map, projection) = if plane {
+        let (m, p) = plane_map(source, count, &mut passes)?;
+        (Some(m), Some(p))
+    } else {
+        (None, None)
+    };
     let start = ChunkParameters {
-        plane: if plane {
-            Some(plane_map(source, count, &mut passes)?)
-        } else {
-            None
-        },
+        plane: map,
         chain: Vec::new(),
     };
     let fit_config = config.resolved_fit(count);
@@ -139,6 +149,7 @@ pub fn fit(
         passes: passes.count,
         smoothing: fit_config.smoothing,
         rounds,
+        projection,
     })
 }
 
@@ -194,46 +205,56 @@ impl ChunkParameters {
     }
 }
 
-/// The best-fit plane's map in three passes (covariance, hull, extents):
-/// [`crate::base::plane_parameters`]'s steps, fed chunk after chunk.
+/// The plane's map in three passes (the covariance sums with the fold
+/// sample, hull, extents): [`crate::base::plane_parameters`]'s steps, fed
+/// chunk after chunk, the points numbered in the order they come; the
+/// direction is the one-call choice ([`PlaneMoments`]).
 fn plane_map(
     source: &mut dyn PointSource,
     count: usize,
     passes: &mut Passes<'_>,
-) -> Result<PlaneMap> {
-    let few = || Error::TooFewPoints {
-        got: count,
-        needed: 3,
-        what: "a best-fit plane".into(),
-    };
+) -> Result<(PlaneMap, Projection)> {
     if count < 3 {
-        return Err(few());
+        return Err(Error::TooFewPoints {
+            got: count,
+            needed: 3,
+            what: "a best-fit plane".into(),
+        });
     }
-    passes.stage("best-fit plane (covariance about the first point)");
-    let mut moments: Option<CovarianceSums> = None;
+    passes.stage("best-fit plane (covariance about the first point, fold sample)");
+    let mut moments: Option<PlaneMoments> = None;
+    let mut next = 0u64;
     source.pass(&mut |c| {
-        for p in c.points {
+        if let Some(p) = c.points.first() {
             moments
-                .get_or_insert_with(|| CovarianceSums::new(*p))
-                .add(p);
+                .get_or_insert_with(|| PlaneMoments::new(*p))
+                .add(next, c.points);
         }
+        next += c.points.len() as u64;
         Ok(())
     })?;
-    let pca = moments.and_then(|m| m.finish()).ok_or_else(few)?;
-    let axes = PlaneAxes::of(&pca)?;
-    passes.stage("best-fit plane (convex hull in the plane)");
+    let (axes, mut projection) = moments
+        .unwrap_or_else(|| PlaneMoments::new(Point3::origin()))
+        .finish()?;
+    let plane = match projection.axis {
+        ProjectionAxis::BestFitPlane => "best-fit plane".to_string(),
+        a => format!("plane across the {} axis", a.name()),
+    };
+    passes.stage(&format!("{plane} (convex hull in the plane)"));
     let mut hull = FlatHull::default();
     source.pass(&mut |c| {
         hull.add(&axes, c.points);
         Ok(())
     })?;
-    passes.stage("best-fit plane (extents along the rectangle)");
+    passes.stage(&format!("{plane} (extents along the rectangle)"));
     let mut extents = PlaneExtents::new(&axes, hull.rectangle_direction());
     source.pass(&mut |c| {
         extents.add(c.points);
         Ok(())
     })?;
-    extents.finish()
+    let map = extents.finish()?;
+    projection.extent = map.extent();
+    Ok((map, projection))
 }
 
 /// One least-squares fit to the parameters of `param`: the distribution
