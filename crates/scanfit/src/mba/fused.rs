@@ -20,7 +20,7 @@ use crate::{Point3, Result};
 /// Multilevel B-spline approximation of points in memory, one pass per level
 /// (see the module documentation).
 pub(crate) fn mba(points: &[Point3], config: &MbaConfig) -> Result<Mba> {
-    Ok(run(points, config, false)?.0)
+    Ok(run(points, config, None)?.0)
 }
 
 /// What [`mba_residuals`] returns besides the approximation, per point in
@@ -34,14 +34,21 @@ pub(crate) struct AtPoints {
 
 /// [`mba`] and, at `points` (in their order), the final surface's vertical
 /// residuals `|z - f(x, y)|`: the values the level loop's last pass
-/// measures for the last row, so no second evaluation of the surface; and
-/// the points' parameters, written into the memory of the sorted ones.
-pub(crate) fn mba_residuals(points: &[Point3], config: &MbaConfig) -> Result<(Mba, AtPoints)> {
-    run(points, config, true)
+/// measures for the last row, so no second evaluation of the surface; and,
+/// with `uv`, the points' parameters, written into the memory of the
+/// sorted ones (else empty: a caller about to allocate much first, such as
+/// a KD-tree, computes them afterwards).
+pub(crate) fn mba_residuals(
+    points: &[Point3],
+    config: &MbaConfig,
+    uv: bool,
+) -> Result<(Mba, AtPoints)> {
+    run(points, config, Some(uv))
 }
 
-/// [`mba`], and with `at_points` the residuals and parameters (else empty).
-fn run(points: &[Point3], config: &MbaConfig, at_points: bool) -> Result<(Mba, AtPoints)> {
+/// [`mba`], and with `at_points` the residuals and (`Some(true)`) the
+/// parameters (else empty).
+fn run(points: &[Point3], config: &MbaConfig, at_points: Option<bool>) -> Result<(Mba, AtPoints)> {
     let frame = frame(points)?;
     let run = MbaLevels::new(frame, config)?;
     let c = match config.start {
@@ -54,13 +61,15 @@ fn run(points: &[Point3], config: &MbaConfig, at_points: bool) -> Result<(Mba, A
         vertical: Vec::new(),
         uv: Vec::new(),
     };
-    if at_points {
+    if let Some(uv) = at_points {
         out.vertical = sorted.residuals(delta);
-        out.uv = sorted.into_unit();
-        out.uv
-            .par_iter_mut()
-            .zip(points.par_iter())
-            .for_each(|(u, p)| *u = frame.unit(p));
+        if uv {
+            out.uv = sorted.into_unit();
+            out.uv
+                .par_iter_mut()
+                .zip(points.par_iter())
+                .for_each(|(u, p)| *u = frame.unit(p));
+        }
     }
     Ok((r, out))
 }
