@@ -76,6 +76,10 @@ impl Source for [u8] {
     }
 }
 
+/// A block of records: its number, its slice of the points and of each
+/// extra column.
+type Block<'a> = (usize, &'a mut [Point3], Vec<&'a mut [f64]>);
+
 /// The points of the binary PLY file `source` (named `path` in messages)
 /// when its only element is the vertex element, of fixed-size records that
 /// the file holds; `Ok(None)` for every other file, which the general
@@ -134,7 +138,7 @@ pub(crate) fn read<S: Source + ?Sized>(
     let mut extra: Vec<Vec<f64>> = plan.extra.iter().map(|_| vec![0.0; n]).collect();
     // each block's slices of the points and of every extra column
     let mut columns: Vec<_> = extra.iter_mut().map(|c| c.chunks_mut(BLOCK)).collect();
-    let blocks: Vec<(usize, &mut [Point3], Vec<&mut [f64]>)> = points
+    let blocks: Vec<Block<'_>> = points
         .chunks_mut(BLOCK)
         .enumerate()
         .map(|(b, p)| {
@@ -363,10 +367,11 @@ mod tests {
         // it or reads it: counts the file does not hold (10^12 vertices
         // too: nothing is allocated), a truncated file, no vertices, text,
         // lists, a face element, a bad or cut header
-        let mut not_taken: Vec<Vec<u8>> = Vec::new();
-        not_taken.push(header_replaced(&good, "vertex 100", "vertex 1000000000000"));
-        not_taken.push(good[..good.len() - 5].to_vec());
-        not_taken.push(ply(false, &xyz, 0, value));
+        let mut not_taken: Vec<Vec<u8>> = vec![
+            header_replaced(&good, "vertex 100", "vertex 1000000000000"),
+            good[..good.len() - 5].to_vec(),
+            ply(false, &xyz, 0, value),
+        ];
         not_taken.push(b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n".to_vec());
         let mut list = b"ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nproperty list uchar int n\nend_header\n".to_vec();
         list.extend([0u8; 12]);
