@@ -7,7 +7,7 @@ make_franke.py.
     python3 benches/scale/make_franke.py 1000000 /tmp/franke_1000000.ply
     python3 benches/scale/make_franke.py 1000000 /tmp/franke_uv_1000000.ply --uv
     python3 benches/scale/make_franke.py 10000000 /tmp/franke_10000000.las
-    python3 benches/scale/run.py target/release/scanfit 1000000 [--repeat 3] [--only fit|fit_streamed|fit_plane|fit_plane_streamed|fit_fold|fit_fold_streamed|mba|mba_notrim|mba_las|mba_las_streamed|mba_laz1|mba_laz1_streamed] [--out-dir /tmp] [-- EXTRA...]
+    python3 benches/scale/run.py target/release/scanfit 1000000 [--repeat 3] [--only fit|fit_streamed|fit_plane|fit_plane_streamed|fit_fold|fit_fold_streamed|mba|mba_notrim|mba_peerwork|mba_las|mba_las_streamed|mba_laz1|mba_laz1_streamed] [--out-dir /tmp] [-- EXTRA...]
 
 Each command runs `--repeat` times (default 3) under `/usr/bin/time -v`
 with SCANFIT_TIMINGS=1 (the CLI then prints each stage's wall time); the
@@ -17,7 +17,9 @@ average before and after (the machine is shared). Arguments after `--` are
 added to every command (e.g. `--measure full`). When /tmp/franke_N.las
 exists, `mba` also runs on it in memory (`mba_las`) and streamed in chunks
 of 10^6 points (`mba_las_streamed`, `--chunk-points 1000000`); `mba_notrim` is
-`mba` with `--no-trim` (the trim's cost is the difference). `fit_streamed`
+`mba` with `--no-trim` (the trim's cost is the difference), `mba_peerwork`
+with `--measure none --no-trim` (read, fit, write: what ddemidov/mba's driver
+does, `benches/peers/mba_peer.py`). `fit_streamed`
 is `fit` read in chunks of 10^6 points; `fit_plane` is `fit` with its
 defaults (best-fit plane, distribution knots; untrimmed) on /tmp/franke_N.ply,
 `fit_plane_streamed` the same in chunks of 10^6 points (plane and knots as
@@ -79,6 +81,8 @@ def main():
     }
     # the same without the trim's alpha shape: its cost is the difference
     commands["mba_notrim"] = commands["mba"] + ["--no-trim"]
+    # the peer's work (read, fit, write), as benches/peers/mba_peer.py runs it
+    commands["mba_peerwork"] = commands["mba"] + ["--measure", "none", "--no-trim"]
     commands["fit_streamed"] = commands["fit"] + ["--chunk-points", "1000000"]
     commands["fit_plane"] = [binary, "fit", f"/tmp/franke_xy10_{n}.ply", "--ctrl", "64x64",
                              "--no-trim", "-o", f"{out}/scale_fit_plane.json", "--json", "-q"]

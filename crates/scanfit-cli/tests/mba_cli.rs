@@ -337,3 +337,74 @@ fn a_filled_square_keeps_its_rectangle_whichever_axis_is_up() {
     }
     std::fs::remove_dir_all(&d).ok();
 }
+
+/// The control values and the vertical errors of `mba terrain_50k.xyz
+/// --levels 6 --json -o m.json` as main wrote them before issue 18's
+/// whole-command work (commit 31de548, release build; the command and the
+/// extraction are in the file): the residuals from the level loop, the
+/// binary PLY read straight into the points and the parallel up-axis
+/// percentiles must leave the surface and the figures as they were, with
+/// `--measure none --no-trim` (the peer's work) and the default.
+#[test]
+fn mba_writes_the_surface_it_wrote_before_the_whole_command_work() {
+    let golden: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("tests/data/mba_terrain_golden.json"),
+        )
+        .unwrap(),
+    )
+    .unwrap();
+    let want: Vec<f64> = golden["control_z"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let scale = want.iter().fold(0.0f64, |s, z| s.max(z.abs()));
+    let d = tmpdir("mba", "golden");
+    // the same points as a binary PLY of doubles (the direct reader)
+    let xyz = examples().join("terrain_50k.xyz");
+    let table = scanfit_io::read_points(&xyz).unwrap();
+    let ply = d.join("terrain.ply");
+    std::fs::write(
+        &ply,
+        scanfit_io::ply::points_ply(&table.points, &[], scanfit_io::ply::PlyFormat::Binary),
+    )
+    .unwrap();
+    for input in [&xyz, &ply] {
+        for extra in [&[][..], &["--measure", "none", "--no-trim"][..]] {
+            let out = d.join("m.json");
+            let mut args = vec![
+                "mba",
+                input.to_str().unwrap(),
+                "--levels",
+                "6",
+                "--json",
+                "-o",
+            ];
+            args.push(out.to_str().unwrap());
+            args.extend(extra);
+            let v: serde_json::Value = serde_json::from_str(&ok(&run(&args))).unwrap();
+            let (_, surface) = scanfit_io::json::read_surface(&out).unwrap();
+            let got: Vec<f64> = surface.control_points().iter().map(|p| p.z).collect();
+            assert_eq!(got.len(), want.len());
+            let worst = got
+                .iter()
+                .zip(&want)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            assert!(worst <= 1e-12 * scale, "{input:?} {extra:?}: {worst:e}");
+            for key in ["mean_error", "max_error", "rmse"] {
+                let (a, b) = (
+                    v["quality"][key].as_f64().unwrap(),
+                    golden["quality"][key].as_f64().unwrap(),
+                );
+                assert!((a - b).abs() <= 1e-12 * b, "{key}: {a} vs {b}");
+            }
+            let rows = v["levels"].as_array().unwrap();
+            let last = &rows[rows.len() - 1];
+            assert_eq!(last["vertical_rmse"], v["quality"]["rmse"]);
+        }
+    }
+}

@@ -204,6 +204,68 @@ pub(crate) fn decode_points(x: Column<'_>, y: Column<'_>, z: Column<'_>, n: usiz
     out
 }
 
+/// Decodes the first `out.len()` values of a column into `out` on this
+/// thread (a block of a reader that runs blocks in parallel): one loop per
+/// type, no dispatch per value.
+pub(crate) fn decode_column_into(c: Column<'_>, out: &mut [f64]) {
+    if c.stride == 0 {
+        return;
+    }
+    let records = c.records(out.len()).chunks_exact(c.stride);
+    let off = c.offset;
+    macro_rules! run {
+        ($t:ty) => {{
+            const N: usize = std::mem::size_of::<$t>();
+            if c.big {
+                for (o, r) in out.iter_mut().zip(records) {
+                    *o = <$t>::from_be_bytes(get::<N>(r, off)) as f64;
+                }
+            } else {
+                for (o, r) in out.iter_mut().zip(records) {
+                    *o = <$t>::from_le_bytes(get::<N>(r, off)) as f64;
+                }
+            }
+        }};
+    }
+    by_scalar!(c.ty, run);
+}
+
+/// Decodes the first `out.len()` points of three columns into `out` on
+/// this thread, as [`decode_points`] does: one loop over the records when
+/// x, y and z share their type and byte order, else column by column.
+pub(crate) fn decode_points_into(x: Column<'_>, y: Column<'_>, z: Column<'_>, out: &mut [Point3]) {
+    let same = x.ty == y.ty && x.ty == z.ty && x.big == y.big && x.big == z.big;
+    if !same || x.stride == 0 || x.stride != y.stride || x.stride != z.stride {
+        let mut v = vec![0.0; out.len()];
+        for (k, c) in [x, y, z].into_iter().enumerate() {
+            decode_column_into(c, &mut v);
+            for (p, a) in out.iter_mut().zip(&v) {
+                p.coords[k] = *a;
+            }
+        }
+        return;
+    }
+    let records = x.records(out.len()).chunks_exact(x.stride);
+    let (ox, oy, oz) = (x.offset, y.offset, z.offset);
+    macro_rules! run {
+        ($t:ty) => {{
+            const N: usize = std::mem::size_of::<$t>();
+            if x.big {
+                let rd = |r: &[u8], o| <$t>::from_be_bytes(get::<N>(r, o)) as f64;
+                for (p, r) in out.iter_mut().zip(records) {
+                    *p = Point3::new(rd(r, ox), rd(r, oy), rd(r, oz));
+                }
+            } else {
+                let rd = |r: &[u8], o| <$t>::from_le_bytes(get::<N>(r, o)) as f64;
+                for (p, r) in out.iter_mut().zip(records) {
+                    *p = Point3::new(rd(r, ox), rd(r, oy), rd(r, oz));
+                }
+            }
+        }};
+    }
+    by_scalar!(x.ty, run);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

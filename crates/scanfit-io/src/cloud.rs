@@ -18,14 +18,25 @@ use crate::{las, obj, pcd, ply_read, stl, write_atomic, xyz, Error, Result};
 /// by the first bytes. Errors name the file and the line, byte
 /// offset or point where the content is wrong, and what to change.
 pub fn read_cloud(path: &Path, options: &ReadOptions) -> Result<PointTable> {
-    if options.format.is_none() {
+    let format = match options.format {
+        Some(f) => Some(f),
         // an unknown extension is an error before the file is opened
-        Format::from_path(path)?;
-    }
-    let bytes = std::fs::read(path).map_err(|error| Error::Io {
+        None => Format::from_path(path)?,
+    };
+    let io = |error| Error::Io {
         path: path.to_path_buf(),
         error,
-    })?;
+    };
+    // a binary PLY point file straight into the points (the common layout;
+    // every other file is read whole)
+    #[cfg(unix)]
+    if format == Some(Format::Ply) {
+        let file = std::fs::File::open(path).map_err(io)?;
+        if let Some(table) = ply_read::direct::read(path, &file, options)? {
+            return Ok(table);
+        }
+    }
+    let bytes = std::fs::read(path).map_err(io)?;
     parse_cloud(path, &bytes, options)
 }
 

@@ -23,6 +23,9 @@ mod faces;
 #[path = "ply_chunks.rs"]
 pub(crate) mod chunks;
 
+#[path = "ply_direct.rs"]
+pub(crate) mod direct;
+
 use crate::binary::{decode_column, decode_points, Column, Scalar};
 use crate::mesh::attach_normals;
 use crate::table::{capacity, split_lines, Format, Origin, PointTable, ReadOptions, MAX_COLUMNS};
@@ -373,13 +376,8 @@ pub(crate) fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<
             }
             let spare = bytes.len().saturating_sub(end);
             let stride = vertex.fixed_stride().unwrap_or(1).max(1);
-            if spare >= stride {
-                table.warnings.push(format!(
-                    "{}: {spare} bytes follow the last element the header declares; they were not read (is the vertex count {} too small?)",
-                    path.display(),
-                    vertex.count
-                ));
-            }
+            let warning = spare_warning(path, spare as u128, stride, vertex.count);
+            table.warnings.extend(warning);
             table
         }
     };
@@ -404,6 +402,17 @@ pub(crate) fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<
         }
     }
     table.finish(options.non_finite)
+}
+
+/// The warning for `spare` bytes after the last element the header
+/// declares, when they are at least a vertex record (`stride` bytes).
+fn spare_warning(path: &Path, spare: u128, stride: usize, count: u64) -> Option<String> {
+    (spare >= stride as u128).then(|| {
+        format!(
+            "{}: {spare} bytes follow the last element the header declares; they were not read (is the vertex count {count} too small?)",
+            path.display()
+        )
+    })
 }
 
 fn truncated(path: &Path, offset: usize, message: String) -> Error {
@@ -542,11 +551,31 @@ fn read_binary(
         .iter()
         .map(|&i| decode_column(column(i), n))
         .collect();
-    Ok(PointTable {
+    Ok(records_table(
+        path,
+        points,
+        plan.columns,
+        extra,
+        start,
+        stride,
+    ))
+}
+
+/// The table of fixed-size vertex records from byte `start`, `stride`
+/// bytes each (the general reader's and the direct one's).
+fn records_table(
+    path: &Path,
+    points: Vec<Point3>,
+    columns: Vec<String>,
+    extra: Vec<Vec<f64>>,
+    start: usize,
+    stride: usize,
+) -> PointTable {
+    PointTable {
         path: path.to_path_buf(),
         format: Format::Ply,
         points,
-        columns: plan.columns,
+        columns,
         extra,
         origin: Origin::Records {
             start: start as u64,
@@ -555,7 +584,7 @@ fn read_binary(
         file_index: None,
         dropped_non_finite: 0,
         warnings: Vec::new(),
-    })
+    }
 }
 
 /// Binary vertices with list properties: variable-size records, read one by

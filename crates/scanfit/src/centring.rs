@@ -46,12 +46,11 @@ impl Centring {
     /// assert_eq!(local[1].x + c.centre().x, pts[1].x);
     /// ```
     pub fn of(points: &[Point3]) -> Self {
-        let mut lo = Vector3::repeat(f64::INFINITY);
-        let mut hi = Vector3::repeat(f64::NEG_INFINITY);
-        for p in points {
-            lo = lo.inf(&p.coords);
-            hi = hi.sup(&p.coords);
-        }
+        let Some((lo, hi)) = crate::pipeline::assess::bounding_box(points) else {
+            return Self {
+                centre: Vector3::zeros(),
+            };
+        };
         let mut centre = Vector3::zeros();
         for k in 0..3 {
             let (a, b) = (lo[k], hi[k]);

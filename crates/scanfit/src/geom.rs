@@ -1,5 +1,7 @@
 //! The one point/vector type of the library, and input validation shared by all algorithms.
 
+use rayon::prelude::*;
+
 use crate::wire::{Reader, Writer};
 use crate::{Error, Result};
 
@@ -15,7 +17,11 @@ pub const MAX_COORDINATE: f64 = 1e150;
 /// Checks that every coordinate is finite and of a magnitude whose squared
 /// distances stay representable; the error names the first bad point.
 pub fn validate_points(points: &[Point3]) -> Result<()> {
-    for (index, p) in points.iter().enumerate() {
+    // the first bad point and the extent, in one pass on all threads (at
+    // 10^7 points every pass over them costs about as much as reading a
+    // binary file)
+    let scan = scan(points);
+    if let Some((index, p)) = scan.first_bad.and_then(|i| Some((i, points.get(i)?))) {
         if let Some(v) = p.coords.iter().find(|v| !v.is_finite()) {
             return Err(Error::NonFinite {
                 index,
@@ -32,7 +38,7 @@ pub fn validate_points(points: &[Point3]) -> Result<()> {
         }
     }
     // tiny data: distances would underflow (points that differ would coincide)
-    let extent = bbox_diagonal(points);
+    let extent = scan.bbox.map_or(0.0, |(lo, hi)| (hi - lo).norm());
     if points.len() > 1 && extent > 0.0 && extent < 1e-140 {
         return Err(Error::InvalidInput(format!(
             "the points span only {extent:e}; distances this small underflow, rescale the data"
@@ -68,15 +74,66 @@ pub(crate) fn validate_distinct_consecutive(points: &[Point3], closed: bool) -> 
 
 /// Length of the diagonal of the axis-aligned bounding box (0 for no points).
 pub(crate) fn bbox_diagonal(points: &[Point3]) -> f64 {
+    scan(points).bbox.map_or(0.0, |(lo, hi)| (hi - lo).norm())
+}
+
+/// What one pass over points finds: their axis-aligned bounding box and
+/// the first point with a non-finite coordinate or one beyond
+/// [`MAX_COORDINATE`].
+pub(crate) struct Scan {
+    /// The bounding box (`None` without points), with the comparisons of
+    /// `Point3::inf` and `sup` (a NaN coordinate is kept only when it comes
+    /// last).
+    pub bbox: Option<(Point3, Point3)>,
+    /// The index of the first bad point.
+    pub first_bad: Option<usize>,
+}
+
+/// Points per task of [`scan`].
+const SCAN_CHUNK: usize = 1 << 14;
+
+/// [`Scan`] of `points`, in parallel over chunks (plain arrays, which the
+/// compiler keeps in registers: nalgebra's generic component maps took
+/// several times as long).
+pub(crate) fn scan(points: &[Point3]) -> Scan {
+    type Part = ([f64; 3], [f64; 3], Option<usize>);
     let Some(first) = points.first() else {
-        return 0.0;
+        return Scan {
+            bbox: None,
+            first_bad: None,
+        };
     };
-    let (mut lo, mut hi) = (first.coords, first.coords);
-    for p in points {
-        lo = lo.inf(&p.coords);
-        hi = hi.sup(&p.coords);
+    let first: [f64; 3] = first.coords.into();
+    let grow = |(mut lo, mut hi, bad): Part, p: &[f64; 3], at: Option<usize>| {
+        for k in 0..3 {
+            lo[k] = if lo[k] <= p[k] { lo[k] } else { p[k] };
+            hi[k] = if hi[k] >= p[k] { hi[k] } else { p[k] };
+        }
+        let wrong = p.iter().any(|v| !v.is_finite() || v.abs() > MAX_COORDINATE);
+        (lo, hi, bad.or(at.filter(|_| wrong)))
+    };
+    let (lo, hi, first_bad) = points
+        .par_chunks(SCAN_CHUNK)
+        .enumerate()
+        .map(|(c, chunk)| {
+            chunk
+                .iter()
+                .enumerate()
+                .fold((first, first, None), |s, (i, p)| {
+                    grow(s, &p.coords.into(), Some(c * SCAN_CHUNK + i))
+                })
+        })
+        .reduce(
+            || (first, first, None),
+            |a, b| {
+                let (lo, hi, bad) = grow(grow(a, &b.0, None), &b.1, None);
+                (lo, hi, bad.or(b.2))
+            },
+        );
+    Scan {
+        bbox: Some((lo.into(), hi.into())),
+        first_bad,
     }
-    (hi - lo).norm()
 }
 
 /// Principal component analysis of a point set: centroid, covariance

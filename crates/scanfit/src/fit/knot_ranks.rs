@@ -334,6 +334,22 @@ enum WindowCounts {
     Values(Vec<f64>),
 }
 
+impl WindowCounts {
+    /// Counts `x`, a value inside the window `w`.
+    #[inline]
+    fn add(&mut self, w: &Window, x: f64) {
+        match self {
+            WindowCounts::Values(v) => v.push(x),
+            WindowCounts::Bins { count, min, max } => {
+                let b = w.bin(x);
+                count[b] += 1;
+                min[b] = min[b].min(x);
+                max[b] = max[b].max(x);
+            }
+        }
+    }
+}
+
 /// The counts of some chunks for a [`RankQuery`]: mergeable, exact.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RankCounts {
@@ -347,7 +363,11 @@ impl RankCounts {
         let (Some(ws), Some(cs)) = (query.columns.get(column), self.columns.get_mut(column)) else {
             return;
         };
-        if ws.is_empty() {
+        if let ([w], [c]) = (ws.as_slice(), cs.as_mut_slice()) {
+            // one window (every rank in the first round): no search per value
+            for x in values.filter(|&x| w.lo <= x && x <= w.hi) {
+                c.add(w, x);
+            }
             return;
         }
         for x in values {
@@ -356,15 +376,7 @@ impl RankCounts {
             if k == 0 || x > ws[k - 1].hi {
                 continue;
             }
-            match &mut cs[k - 1] {
-                WindowCounts::Values(v) => v.push(x),
-                WindowCounts::Bins { count, min, max } => {
-                    let b = ws[k - 1].bin(x);
-                    count[b] += 1;
-                    min[b] = min[b].min(x);
-                    max[b] = max[b].max(x);
-                }
-            }
+            cs[k - 1].add(&ws[k - 1], x);
         }
     }
 

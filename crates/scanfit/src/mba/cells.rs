@@ -44,6 +44,8 @@ pub(super) struct Sorted {
     unit: Vec<[f64; 2]>,
     values: Vec<[f64; 2]>,
     index: Vec<u32>,
+    /// The sorted position of each point (the inverse of `index`).
+    pos: Vec<u32>,
     /// `bounds[c]..bounds[c + 1]`: the points of the last level's cell of
     /// key `c` (base cell, then Morton order).
     bounds: Vec<u32>,
@@ -121,20 +123,7 @@ impl Sorted {
                 ((b << (2 * shift)) | morton(i & mask, j & mask, shift)) as u32
             })
             .collect();
-        let mut bounds = vec![0u32; m * n + 1];
-        for &k in &keys {
-            bounds[k as usize + 1] += 1;
-        }
-        for c in 1..bounds.len() {
-            bounds[c] += bounds[c - 1];
-        }
-        let mut at = bounds.clone();
-        let mut index = vec![0u32; points.len()];
-        for (p, &k) in keys.iter().enumerate() {
-            let a = &mut at[k as usize];
-            index[*a as usize] = p as u32;
-            *a += 1;
-        }
+        let (bounds, index, pos) = counting_sort(keys, m * n);
         let (unit, values) = index
             .par_iter()
             .map(|&p| {
@@ -146,6 +135,7 @@ impl Sorted {
             unit,
             values,
             index,
+            pos,
             bounds,
             base,
             shift,
@@ -177,6 +167,60 @@ impl Sorted {
             })
             .collect()
     }
+}
+
+/// Points per chunk of [`counting_sort`] (at least).
+const SORT_CHUNK: usize = 1 << 16;
+
+/// The stable counting sort of the points by `keys` (below `cells`):
+/// `bounds[k]` the number of keys below `k` (`cells + 1` entries), `index`
+/// the points in sorted order, `pos` the sorted position of each point.
+/// In parallel over fixed chunks of the points (of at least `cells` points,
+/// so the chunks' histograms take no more memory than the keys): each
+/// chunk's histogram, the chunks' starts per key in chunk order, then each
+/// chunk writes its points to their places, so the order is the serial
+/// sort's for any thread count.
+fn counting_sort(mut keys: Vec<u32>, cells: usize) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
+    use std::sync::atomic::{AtomicU32, Ordering::Relaxed};
+    let n = keys.len();
+    let chunk = SORT_CHUNK.max(cells).max(n.div_ceil(64)).max(1);
+    let mut starts: Vec<Vec<u32>> = keys
+        .par_chunks(chunk)
+        .map(|ks| {
+            let mut h = vec![0u32; cells];
+            for &k in ks {
+                h[k as usize] += 1;
+            }
+            h
+        })
+        .collect();
+    let mut bounds = vec![0u32; cells + 1];
+    let mut at = 0u32;
+    for (k, b) in bounds.iter_mut().enumerate().take(cells) {
+        *b = at;
+        for h in starts.iter_mut() {
+            let count = h[k];
+            h[k] = at;
+            at += count;
+        }
+    }
+    bounds[cells] = at;
+    // every place is written once, by the chunk whose point goes there
+    let index: Vec<AtomicU32> = (0..n).into_par_iter().map(|_| AtomicU32::new(0)).collect();
+    keys.par_chunks_mut(chunk)
+        .zip(starts.par_iter_mut())
+        .enumerate()
+        .for_each(|(c, (ks, start))| {
+            for (i, k) in ks.iter_mut().enumerate() {
+                let a = &mut start[*k as usize];
+                index[*a as usize].store((c * chunk + i) as u32, Relaxed);
+                // the key's memory becomes the point's position
+                *k = *a;
+                *a += 1;
+            }
+        });
+    let index = index.into_iter().map(AtomicU32::into_inner).collect();
+    (bounds, index, keys)
 }
 
 /// Consecutive runs grouped into blocks of at least `points` points (the
@@ -274,9 +318,30 @@ fn fitted(quad: [f64; 3], count: usize) -> (f64, f64) {
     (sums.start(), sums.start_rmse())
 }
 
+impl Sorted {
+    /// `|r - delta c|` of every point in the input's order: after
+    /// [`level_loop`], the residual `|z - f(x, y)|` of the final surface at
+    /// each point, as the loop's last pass measured it (its last row).
+    pub(super) fn residuals(&self, delta: f64) -> Vec<f64> {
+        self.pos
+            .par_iter()
+            .map(|&a| {
+                let v = self.values[a as usize];
+                (v[0] - delta * v[1]).abs()
+            })
+            .collect()
+    }
+
+    /// The unit coordinates' memory (in cell order), for reuse.
+    pub(super) fn into_unit(self) -> Vec<[f64; 2]> {
+        self.unit
+    }
+}
+
 /// The level loop over `sorted` (see the module documentation); `run` is
-/// fresh.
-pub(super) fn level_loop(mut run: MbaLevels, mut sorted: Sorted) -> Result<Mba> {
+/// fresh. Returns the approximation and the start `delta` of its last row
+/// (the final residuals are then [`Sorted::residuals`] of `delta`).
+pub(super) fn level_loop(mut run: MbaLevels, sorted: &mut Sorted) -> Result<(Mba, f64)> {
     let count = sorted.unit.len();
     let mut ones: Vec<Lattice> = Vec::new();
     let mut deltas: Vec<f64> = Vec::new();
@@ -302,7 +367,7 @@ pub(super) fn level_loop(mut run: MbaLevels, mut sorted: Sorted) -> Result<Mba> 
         // the values before this pass's update are the residuals after the
         // level of the last delta known
         let before = deltas.last().copied();
-        let m = pass(&mut sorted, previous, target, before)?;
+        let m = pass(sorted, previous, target, before)?;
         seconds.push(started.elapsed().as_secs_f64());
         if before.is_some() {
             let mut stats = m.before.stats();
@@ -332,6 +397,7 @@ pub(super) fn level_loop(mut run: MbaLevels, mut sorted: Sorted) -> Result<Mba> 
     }
     // the fitted start of the last level (`MbaLevels::finish` applies it)
     // and the rows
+    let last = deltas.last().copied().unwrap_or(0.0);
     run.deltas = deltas;
     for (rep, stats) in run.reports.iter_mut().zip(&rows) {
         rep.residual = *stats;
@@ -339,7 +405,7 @@ pub(super) fn level_loop(mut run: MbaLevels, mut sorted: Sorted) -> Result<Mba> 
     run.rows = rows.len();
     let mut r = run.finish();
     super::fused::pass_seconds(&mut r, &seconds);
-    Ok(r)
+    Ok((r, last))
 }
 
 /// What one pass does, besides the statistics: the level whose cells are
@@ -722,6 +788,26 @@ mod tests {
             assert_eq!(w[0].end, w[1].start);
             assert!(runs[w[0].end - 1].end - runs[w[0].start].start >= 700);
         }
+    }
+
+    #[test]
+    fn the_parallel_counting_sort_is_the_stable_serial_one() {
+        // keys of 300 cells over 500 000 points (8 chunks), some cells empty
+        let keys: Vec<u32> = (0..500_000u64)
+            .map(|i| ((i * 2_654_435_761) % 997 % 300) as u32)
+            .collect();
+        let mut order: Vec<u32> = (0..keys.len() as u32).collect();
+        order.sort_by_key(|&p| keys[p as usize]);
+        let (bounds, index, pos) = counting_sort(keys.clone(), 300);
+        assert_eq!(index, order);
+        for (a, &p) in index.iter().enumerate() {
+            assert_eq!(pos[p as usize] as usize, a);
+        }
+        for k in 0..300 {
+            let below = keys.iter().filter(|&&x| (x as usize) < k).count();
+            assert_eq!(bounds[k] as usize, below);
+        }
+        assert_eq!(bounds[300] as usize, keys.len());
     }
 
     #[test]

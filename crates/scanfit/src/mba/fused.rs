@@ -20,14 +20,58 @@ use crate::{Point3, Result};
 /// Multilevel B-spline approximation of points in memory, one pass per level
 /// (see the module documentation).
 pub(crate) fn mba(points: &[Point3], config: &MbaConfig) -> Result<Mba> {
+    Ok(run(points, config, None)?.0)
+}
+
+/// What [`mba_residuals`] returns besides the approximation, per point in
+/// the input's order.
+pub(crate) struct AtPoints {
+    /// The vertical residuals `|z - f(x, y)|` of the final surface.
+    pub vertical: Vec<f64>,
+    /// The parameters ([`Frame::unit`]).
+    pub uv: Vec<[f64; 2]>,
+}
+
+/// [`mba`] and, at `points` (in their order), the final surface's vertical
+/// residuals `|z - f(x, y)|`: the values the level loop's last pass
+/// measures for the last row, so no second evaluation of the surface; and,
+/// with `uv`, the points' parameters, written into the memory of the
+/// sorted ones (else empty: a caller about to allocate much first, such as
+/// a KD-tree, computes them afterwards).
+pub(crate) fn mba_residuals(
+    points: &[Point3],
+    config: &MbaConfig,
+    uv: bool,
+) -> Result<(Mba, AtPoints)> {
+    run(points, config, Some(uv))
+}
+
+/// [`mba`], and with `at_points` the residuals and (`Some(true)`) the
+/// parameters (else empty).
+fn run(points: &[Point3], config: &MbaConfig, at_points: Option<bool>) -> Result<(Mba, AtPoints)> {
     let frame = frame(points)?;
     let run = MbaLevels::new(frame, config)?;
     let c = match config.start {
         Start::Mean => 0.0,
         Start::Fitted => 1.0,
     };
-    let sorted = Sorted::new(points, &frame, run.base, run.max_levels, c)?;
-    level_loop(run, sorted)
+    let mut sorted = Sorted::new(points, &frame, run.base, run.max_levels, c)?;
+    let (r, delta) = level_loop(run, &mut sorted)?;
+    let mut out = AtPoints {
+        vertical: Vec::new(),
+        uv: Vec::new(),
+    };
+    if let Some(uv) = at_points {
+        out.vertical = sorted.residuals(delta);
+        if uv {
+            out.uv = sorted.into_unit();
+            out.uv
+                .par_iter_mut()
+                .zip(points.par_iter())
+                .for_each(|(u, p)| *u = frame.unit(p));
+        }
+    }
+    Ok((r, out))
 }
 
 /// [`Frame::of`] with the points summed in blocks on all threads (the

@@ -30,6 +30,7 @@ use crate::bspline::{KnotVector, Surface};
 use crate::metrics::ErrorStats;
 use crate::{Error, Point3, Result};
 
+pub(crate) use fused::mba_residuals;
 pub use lattice::{ControlFormula, Lattice};
 pub use sums::{BaAccumulator, FrameSums, LevelInputs, PassSums, ResidualSums};
 

@@ -333,6 +333,7 @@ pub fn assess_surface(
         AllPoints::Slice(points),
         uv,
         None,
+        Errors::Distance,
         config,
         &NoProgress,
     )
@@ -371,39 +372,69 @@ pub fn assess_cloud(
     config: &AssessConfig,
     progress: &dyn Progress,
 ) -> Result<Assessment> {
-    assess(surface, AllPoints::Cloud(cloud), uv, None, config, progress)
-}
-
-/// [`assess_cloud`] with [MBA18] eq. 17 measured at the points `eq17`
-/// instead of the surface's knot lines (the MBA pipeline measures it at its
-/// lattice's knot grid), in the same pass over the points; the errors at
-/// the parameters are the vertical ones, `|z_i - S_z(u_i, v_i)|`, always
-/// kept per point ([`Assessment::residuals`]).
-pub(crate) fn assess_cloud_eq17(
-    surface: &Surface,
-    cloud: &PointCloud,
-    uv: &[[f64; 2]],
-    eq17: Vec<Point3>,
-    config: &AssessConfig,
-    progress: &dyn Progress,
-) -> Result<Assessment> {
+    let errors = Errors::Distance;
     assess(
         surface,
         AllPoints::Cloud(cloud),
         uv,
-        Some(eq17),
+        None,
+        errors,
         config,
         progress,
     )
 }
 
+/// [`assess_cloud`] with [MBA18] eq. 17 measured at the points `eq17`
+/// instead of the surface's knot lines (the MBA pipeline measures it at its
+/// lattice's knot grid), in the same pass over the points; the errors at
+/// the parameters are the vertical ones, `|z_i - S_z(u_i, v_i)|`: with
+/// `vertical` `None` measured and kept per point
+/// ([`Assessment::residuals`]), else `vertical` are their statistics,
+/// known already (the level loop's last row), and no point is evaluated
+/// for them (nor kept).
+pub(crate) fn assess_cloud_eq17(
+    surface: &Surface,
+    cloud: &PointCloud,
+    uv: &[[f64; 2]],
+    eq17: Vec<Point3>,
+    vertical: Option<ErrorStats>,
+    config: &AssessConfig,
+    progress: &dyn Progress,
+) -> Result<Assessment> {
+    let errors = match vertical {
+        Some(stats) => Errors::Known(stats),
+        None => Errors::Vertical,
+    };
+    assess(
+        surface,
+        AllPoints::Cloud(cloud),
+        uv,
+        Some(eq17),
+        errors,
+        config,
+        progress,
+    )
+}
+
+/// The errors at the parameters an assessment reports.
+#[derive(Clone, Copy)]
+enum Errors {
+    /// `|P_i - S(u_i, v_i)|`.
+    Distance,
+    /// `|z_i - S_z(u_i, v_i)|`, kept per point.
+    Vertical,
+    /// Their statistics, known already: nothing is evaluated for them.
+    Known(ErrorStats),
+}
+
 /// The assessment of the points of `all` at parameters `uv`; with `eq17`
-/// (the MBA pipeline's), the errors at the parameters are vertical.
+/// (the MBA pipeline's) eq. 17 is measured there.
 fn assess(
     surface: &Surface,
     all: AllPoints<'_>,
     uv: &[[f64; 2]],
     eq17: Option<Vec<Point3>>,
+    errors: Errors,
     config: &AssessConfig,
     progress: &dyn Progress,
 ) -> Result<Assessment> {
@@ -421,22 +452,30 @@ fn assess(
         });
     }
     check(config)?;
-    let vertical = eq17.is_some();
     // the error at the parameters by `Surface::point`, as every other
-    // report of it (the fit's correction rounds, the MBA levels, the
-    // streamed pipelines), to the last bit
+    // report of it (the fit's correction rounds, the streamed pipelines),
+    // to the last bit
     let error = |i: usize| {
-        let (p, s) = (&points[i], surface.point(uv[i][0], uv[i][1]));
-        if vertical {
-            (p.z - s.z).abs()
-        } else {
-            (s - p).norm()
+        let (p, at) = (&points[i], || surface.point(uv[i][0], uv[i][1]));
+        match errors {
+            Errors::Distance => (at() - p).norm(),
+            Errors::Vertical => (p.z - at().z).abs(),
+            Errors::Known(_) => 0.0,
         }
     };
-    let keep = (config.per_point || vertical, config.per_point);
-    let (measured, parameterization) = if config.measure == Measure::None {
-        progress.stage("measuring: errors at the parameters", None);
-        let pass = per_point(points.len(), keep, false, || (), |i, _| (error(i), None));
+    let keep = match errors {
+        Errors::Distance => (config.per_point, config.per_point),
+        Errors::Vertical => (true, config.per_point),
+        Errors::Known(_) => (false, config.per_point),
+    };
+    let (mut measured, parameterization) = if config.measure == Measure::None {
+        let pass = match errors {
+            Errors::Known(_) => Measured::default(),
+            _ => {
+                progress.stage("measuring: errors at the parameters", None);
+                per_point(points.len(), keep, false, || (), |i, _| (error(i), None))
+            }
+        };
         (pass, None)
     } else {
         // the parameterization's Delaunay triangulation is serial: it runs
@@ -471,6 +510,9 @@ fn assess(
         );
         (pass, Some(parameterization))
     };
+    if let Errors::Known(stats) = errors {
+        measured.at_parameters = stats;
+    }
     finish(
         surface,
         &all,
@@ -706,6 +748,7 @@ fn check(config: &AssessConfig) -> Result<()> {
 }
 
 /// The per-point measures of an assessment.
+#[derive(Default)]
 struct Measured {
     at_parameters: ErrorStats,
     orthogonal: ErrorStats,
@@ -930,13 +973,7 @@ fn rms(d: &[f64]) -> f64 {
 
 /// The axis-aligned bounding box of `points` (`None` when empty).
 pub(crate) fn bounding_box(points: &[Point3]) -> Option<(Point3, Point3)> {
-    let first = *points.first()?;
-    Some(
-        points
-            .par_iter()
-            .fold(|| (first, first), |(lo, hi), p| (lo.inf(p), hi.sup(p)))
-            .reduce(|| (first, first), |a, b| (a.0.inf(&b.0), a.1.sup(&b.1))),
-    )
+    crate::geom::scan(points).bbox
 }
 
 /// Fold-overs and stretch of the parameters as `config` asks (all zero

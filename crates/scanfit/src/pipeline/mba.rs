@@ -16,7 +16,7 @@ use std::time::Instant;
 
 use crate::bspline::Surface;
 use crate::mba::adjust::{knot_grid, lattice_grid_rmse, mba_adjusted, AdjustConfig};
-use crate::mba::{lattice_surface, mba, Frame, Lattice, MbaConfig};
+use crate::mba::{lattice_surface, mba_residuals, Frame, Lattice, MbaConfig};
 use crate::metrics::ErrorStats;
 use crate::pipeline::assess::{assess_cloud_eq17, AssessConfig, Assessment, Measure};
 use crate::progress::Progress;
@@ -189,7 +189,9 @@ fn run_centred(
         &format!("multilevel B-spline approximation of {} points", pts.len()),
         None,
     );
-    let (result, levels) = match &config.adjust {
+    // the vertical residuals of the final surface: without the adjustment,
+    // the level loop's last pass measures them (its last row)
+    let (result, levels, residuals) = match &config.adjust {
         Some(adjust) => {
             let r = mba_adjusted(pts, &config.mba, adjust)?;
             let rows = r
@@ -209,27 +211,42 @@ fn run_centred(
                     seconds: l.seconds,
                 })
                 .collect();
-            (r.mba, rows)
+            (r.mba, rows, None)
         }
         None => {
-            let r = mba(pts, &config.mba)?;
+            // the parameters in the sorted points' memory, unless eq. 17's
+            // KD-tree is built next (its building would then add to them)
+            let none = config.assess.measure == Measure::None;
+            let (r, at) = mba_residuals(pts, &config.mba, none)?;
             // eq. 17 per level needs a KD-tree of all points, which only the
             // measuring builds anyway (at 10^7 points the tree costs more than
             // the levels): not with `Measure::None`
             let rows = plain_rows(cloud, &r, config.assess.measure != Measure::None)?;
-            (r, rows)
+            (r, rows, Some(at))
         }
     };
     let surface = lattice_surface(&result.frame, &result.lattice)?;
     let seconds = t0.elapsed().as_secs_f64();
     progress.stage("measuring: parameters", None);
     let frame = result.frame;
-    let uv: Vec<[f64; 2]> = pts.par_iter().map(|p| frame.unit(p)).collect();
-    // eq. 17 at the lattice's knot grid, and the vertical errors, in the
-    // assessment's pass
+    let (residuals, uv) = match residuals {
+        Some(at) if !at.uv.is_empty() => (Some(at.vertical), at.uv),
+        at => (
+            at.map(|a| a.vertical),
+            pts.par_iter().map(|p| frame.unit(p)).collect(),
+        ),
+    };
+    // eq. 17 at the lattice's knot grid in the assessment's pass, and the
+    // vertical errors there unless the level loop measured them (its last
+    // row: the same residuals to rounding, 1e-12 of the heights' range)
     let eq17 = knot_grid(&frame, &result.lattice);
-    let mut assessment = assess_cloud_eq17(&surface, cloud, &uv, eq17, &config.assess, progress)?;
-    let vertical = std::mem::take(&mut assessment.residuals);
+    let known = residuals.as_ref().and(levels.last().map(|l| l.vertical));
+    let mut assessment =
+        assess_cloud_eq17(&surface, cloud, &uv, eq17, known, &config.assess, progress)?;
+    let vertical = match residuals {
+        Some(v) if known.is_some() => v,
+        _ => std::mem::take(&mut assessment.residuals),
+    };
     if config.assess.per_point {
         assessment.residuals.clone_from(&vertical);
     }
@@ -317,6 +334,62 @@ mod tests {
         assert!(a.steps > 0);
         assert!(a.grid_rmse < adj.levels[3].grid_rmse, "{a:?}");
         assert!((a.grid_rmse - adj.assessment.quality.grid_rmse).abs() < 1e-12);
+    }
+
+    /// `|z - S_z(u, v)|` of the report's surface at every point, evaluated.
+    fn evaluated(cloud: &PointCloud, r: &MbaReport) -> Vec<f64> {
+        cloud
+            .points()
+            .iter()
+            .zip(&r.uv)
+            .map(|(p, t)| (p.z - r.surface.point(t[0], t[1]).z).abs())
+            .collect()
+    }
+
+    #[test]
+    fn vertical_errors_from_the_level_loop_equal_an_evaluation_of_the_surface() {
+        use crate::mba::Start;
+        use crate::testdata::{franke, scattered};
+        // 60 000 points of Franke's function (several blocks per pass), at
+        // the unit square and far from the origin (the centring)
+        for offset in [[0.0, 0.0, 0.0], [3.0e5, -2.0e5, 800.0]] {
+            let pts = scattered(60_000, 23, [0.0, 0.0, 1.0, 1.0], franke)
+                .into_iter()
+                .map(|p| Point3::new(p.x + offset[0], p.y + offset[1], p.z + offset[2]))
+                .collect();
+            let cloud = PointCloud::new(pts).unwrap();
+            let (lo, hi) = crate::pipeline::assess::bounding_box(cloud.points()).unwrap();
+            let range = hi.z - lo.z;
+            for start in [Start::Fitted, Start::Mean] {
+                for measure in [Measure::None, Measure::Sample] {
+                    let mut cfg = MbaRunConfig::default();
+                    cfg.mba.max_levels = 6;
+                    cfg.mba.start = start;
+                    cfg.assess.measure = measure;
+                    let r = run(&cloud, &cfg, &NoProgress).unwrap();
+                    let direct = evaluated(&cloud, &r);
+                    let worst = r
+                        .vertical
+                        .iter()
+                        .zip(&direct)
+                        .map(|(a, b)| (a - b).abs())
+                        .fold(0.0, f64::max);
+                    assert!(worst <= 1e-12 * range, "{start:?} {measure:?}: {worst:e}");
+                    // the statistics the report prints: the last row's, and
+                    // those of the evaluated residuals to 1e-12
+                    let (q, d) = (r.assessment.quality.at_parameters, ErrorStats::of(&direct));
+                    assert_eq!(q, r.levels[5].vertical);
+                    assert_eq!((q.count, q.max_index), (d.count, d.max_index));
+                    // relative to the heights' range (both round at the
+                    // heights' resolution; at the unit square the mean and
+                    // RMSE also agree to about 1e-12 of themselves)
+                    for (a, b) in [(q.mean, d.mean), (q.max, d.max), (q.rmse, d.rmse)] {
+                        let tol = 1e-12 * range;
+                        assert!((a - b).abs() <= tol, "{start:?} {measure:?}: {q:?} {d:?}");
+                    }
+                }
+            }
+        }
     }
 
     #[test]
