@@ -84,7 +84,8 @@ pub struct TrimRunConfig {
     /// Whether to trim (default [`TrimMode::Default`]).
     pub mode: TrimMode,
     /// The alpha shape when the loops are computed here (default
-    /// [`BoundaryConfig::default`]: alpha 2.5 spacings).
+    /// [`BoundaryConfig::default`]: alpha 2.5 spacings, widened with the
+    /// local spacing where the points are sparser than the median).
     pub boundary: BoundaryConfig,
     /// The trim curves (default [`TrimConfig::default`]).
     pub trim: TrimConfig,

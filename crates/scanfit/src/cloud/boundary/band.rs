@@ -32,7 +32,10 @@
 //! boundary edges, sides of the cells, are the same. Only a circumradius
 //! within rounding, ~1e-15 relative, of `alpha` could be decided apart.)
 //! `REACH` is 14 cells rather than 13 to leave room for the rounding of the
-//! cell index.
+//! cell index. With the local factors of [`super::local`] (at least 1, so
+//! the candidates are the same) a kept triangle reaches `2 alpha F`, `F` its
+//! factor; the candidate cells whose surroundings have factors above 1 are
+//! dilated further, by the reach [`LocalSpacing::bound`] gives.
 //!
 //! Why blocks of small cells: a single empty cell of side `alpha / 2` would
 //! do for the proof, but on a uniform random sample at the default alpha
@@ -44,6 +47,7 @@
 //! outlier stretching the box, or a tiny alpha) is not built and the whole
 //! cloud is triangulated instead.
 
+use super::local::LocalSpacing;
 use super::{Boundary, Frame, Site, SiteTriangulation};
 use crate::Result;
 
@@ -64,10 +68,28 @@ const NEAR_EMPTY: u8 = 4;
 const CANDIDATE: u8 = OCC | NEAR_EMPTY;
 /// A candidate cell lies within `REACH`: its points are triangulated.
 const BAND: u8 = 8;
+/// Bits of a candidate cell's reach class `k` (reach `REACH + CLASS_STEP k` cells)
+/// where the local alpha is wider than the global one.
+const CLASS_SHIFT: u8 = 4;
+/// Reach added per class, in cells.
+const CLASS_STEP: usize = 4;
 
-/// The loops of the alpha shape of radius `alpha` from the triangulation of
-/// the band; `None` when the grid would be too large.
-pub(super) fn band_loops(frame: &Frame, alpha: f64, spacing: f64) -> Result<Option<Boundary>> {
+/// The loops of the alpha shape of radius `alpha` (times the local factors
+/// of `local`) from the triangulation of the band; `None` when the grid
+/// would be too large.
+///
+/// With local factors a kept triangle at a candidate point reaches further
+/// than `2 alpha`; [`LocalSpacing::bound`] bounds how far from the factors
+/// around the point, and the candidate cells are dilated by that reach
+/// (in classes of [`CLASS_STEP`] cells) instead of [`REACH`]. The candidate
+/// cells stay the same: a boundary vertex still lies on an empty disc of
+/// radius at least `alpha` (the factors are at least 1).
+pub(super) fn band_loops(
+    frame: &Frame,
+    alpha: f64,
+    spacing: f64,
+    local: Option<&LocalSpacing>,
+) -> Result<Option<Boundary>> {
     let alpha_unit = alpha / frame.extent;
     let n = frame.len();
     let Some(mut grid) = Grid::new(frame, alpha_unit / CELLS_PER_ALPHA, n) else {
@@ -80,6 +102,15 @@ pub(super) fn band_loops(frame: &Frame, alpha: f64, spacing: f64) -> Result<Opti
     grid.dilate(|f| f & OCC != 0, HALF_BLOCK, NEAR_OCC);
     grid.dilate(|f| f & NEAR_OCC == 0, REACH, NEAR_EMPTY);
     grid.dilate(|f| f & CANDIDATE == CANDIDATE, REACH, BAND);
+    if let Some(l) = local.filter(|l| l.max > 1.0) {
+        let classes = grid.classify(l, alpha_unit);
+        for k in 1..16u8 {
+            if classes & (1 << k) != 0 {
+                let is_k = move |f: u8| f & CANDIDATE == CANDIDATE && f >> CLASS_SHIFT == k;
+                grid.dilate(is_k, REACH + CLASS_STEP * usize::from(k), BAND);
+            }
+        }
+    }
     let mut sites = Vec::new();
     let mut candidates = 0usize;
     for (index, pos) in frame.units().enumerate() {
@@ -92,7 +123,7 @@ pub(super) fn band_loops(frame: &Frame, alpha: f64, spacing: f64) -> Result<Opti
     }
     drop(grid);
     let tri = SiteTriangulation::new(sites, frame)?;
-    let a = tri.alpha_loops(alpha_unit)?;
+    let a = tri.alpha_loops(alpha_unit, local)?;
     // Euler's formula for the kept region with its pinch vertices split
     // (a union of planar domains): T = 2 V_inner + E_loops - 2 chi, where
     // chi = outer loops - hole loops and every point off the candidate
@@ -110,10 +141,14 @@ pub(super) fn band_loops(frame: &Frame, alpha: f64, spacing: f64) -> Result<Opti
         .filter(|&v| tri.sites[v].inner && a.on_kept[v] && !on_loop[v])
         .count();
     let inner = (n - candidates - tri.outer_repeats + inner_candidates) as i64;
-    let b = a.to_boundary(&tri, frame, alpha, spacing, 0)?;
+    let b = a.to_boundary(&tri, frame, (alpha, local), spacing, 0)?;
     let chi: i64 = b.areas.iter().map(|&x| if x > 0.0 { 1 } else { -1 }).sum();
     let triangles = (2 * inner + loop_edges - 2 * chi).max(0) as usize;
-    Ok(Some(Boundary { triangles, ..b }))
+    Ok(Some(super::fill_small_holes(
+        Boundary { triangles, ..b },
+        frame,
+        local,
+    )))
 }
 
 /// One byte of flags per cell of side `h` over the unit bounding box,
@@ -140,6 +175,47 @@ impl Grid {
             dims,
             flags: vec![0; dims[0] * dims[1]],
         })
+    }
+
+    /// The centre of cell `c` in unit coordinates.
+    fn centre(&self, c: usize) -> [f64; 2] {
+        let (i, j) = (c % self.dims[0], c / self.dims[0]);
+        let at = |k: usize, i: usize| self.lo[k] + (i as f64 - REACH as f64 + 0.5) * self.h;
+        [at(0, i), at(1, j)]
+    }
+
+    /// Stores in each candidate cell its reach class (the reach that
+    /// [`LocalSpacing::bound`] asks beyond [`REACH`], in steps of
+    /// [`CLASS_STEP`]); returns the classes present as bits.
+    fn classify(&mut self, local: &LocalSpacing, alpha_unit: f64) -> u16 {
+        let mut present = 0u16;
+        // per coarse cell of `local`: its class, or u8::MAX before it is asked
+        let mut cache = vec![u8::MAX; local.cells()];
+        for c in 0..self.flags.len() {
+            if self.flags[c] & CANDIDATE != CANDIDATE {
+                continue;
+            }
+            let q = self.centre(c);
+            let coarse = local.cell(q);
+            if cache[coarse] == u8::MAX {
+                // kept triangles at the cell's points lie within 2 alpha F
+                // of them: 12 F cells, plus two for the rounding of the
+                // cell indices and one as the cell's points lie within
+                // half a cell of its centre (REACH when F = 1)
+                let f = local.bound(q, alpha_unit);
+                let class = if f > 1.0 {
+                    let reach = (2.0 * alpha_unit * f / self.h).ceil() as usize + 3;
+                    reach.saturating_sub(REACH).div_ceil(CLASS_STEP).min(15)
+                } else {
+                    0
+                };
+                cache[coarse] = class as u8;
+            }
+            let k = cache[coarse];
+            self.flags[c] |= k << CLASS_SHIFT;
+            present |= 1 << k;
+        }
+        present
     }
 
     fn cell(&self, q: [f64; 2]) -> usize {
