@@ -7,13 +7,17 @@
 //!   `alpha` that holds no point: across a boundary edge lies a triangle
 //!   with circumradius `R >= alpha` (its open circumdisc holds no point and
 //!   contains the disc of radius `alpha` tangent to its circle at `p`) or the
-//!   open half-plane beyond the hull (which contains that disc too). The
-//!   disc's inscribed square has side `alpha sqrt(2) = 8.49 h >= 8 h`, so it
-//!   holds an aligned block of 7 x 7 whole cells, which are therefore empty,
-//!   and whose centre cell lies within `2 alpha` (13 cells) of `p`. Hence
+//!   open half-plane beyond the hull (which contains that disc too). Let `c`
+//!   be the cell of the disc's centre `o`. A cell `c + (a, b)` lies within
+//!   `h sqrt((|a| + 1)^2 + (|b| + 1)^2)` of `o`, so the cells with
+//!   `(|a| + 1)^2 + (|b| + 1)^2 < 36` (the *template*: rows of half-width
+//!   4, 4, 4, 3, 2 cells at row offsets 0 to 4, 69 cells, all within
+//!   `0.972 alpha` of `o`, far from the circle beyond any rounding) lie
+//!   inside the disc and are empty. `p` is `alpha` (6 cells) from `o`, so
+//!   within 7 cells of `c`, 8 with the rounding of its cell index. Hence
 //!   every boundary vertex is in a *candidate* cell: an occupied cell with
-//!   the centre of an empty 7 x 7 block within [`REACH`] cells (cells beyond
-//!   the points' bounding box are empty; the grid is padded by `REACH`).
+//!   the centre of an empty template within [`NEAR`] cells (cells beyond the
+//!   points' bounding box are empty; the grid is padded by `REACH`).
 //! * A kept triangle (`R < alpha`) with a vertex `p` has its circumdisc, and
 //!   so its other vertices, within `2R < 2 alpha` of `p`. If the triangulated
 //!   set holds every point within `2 alpha` of `p` (every point of the cells
@@ -37,11 +41,14 @@
 //! factor; the candidate cells whose surroundings have factors above 1 are
 //! dilated further, by the reach [`LocalSpacing::bound`] gives.
 //!
-//! Why blocks of small cells: a single empty cell of side `alpha / 2` would
-//! do for the proof, but on a uniform random sample at the default alpha
-//! such a cell is empty with probability 17%, so nearly every point would
-//! be a candidate; an empty 7 x 7 block (side 1.17 alpha, about 10 points
-//! expected) is rare inside a patch. The grid costs two bytes per cell
+//! Why a template of small cells: a single empty cell of side `alpha / 2`
+//! would do for the proof, but on a uniform random sample at the default
+//! alpha such a cell is empty with probability 17%, so nearly every point
+//! would be a candidate; an empty template (1.92 alpha^2, about 14 points
+//! expected at the default alpha) is rare inside a patch: on 10^7 uniform
+//! points the 7 x 7 blocks used before (1.36 alpha^2, about 10 points)
+//! were empty often enough to put a tenth of the points in the band. The
+//! grid costs two bytes per cell
 //! (flags and one row buffer), about five cells per point on a cloud that
 //! fills its bounding box; a grid of more than `8 n + 2^20` cells (an
 //! outlier stretching the box, or a tiny alpha) is not built and the whole
@@ -53,16 +60,21 @@ use crate::Result;
 
 /// Cells per alpha.
 const CELLS_PER_ALPHA: f64 = 6.0;
-/// Half the side of the empty blocks, in cells (7 x 7 blocks).
+/// Half the side of the square inside the template, in cells (7 x 7).
 const HALF_BLOCK: usize = 3;
+/// Half-widths of the template's rows at row offsets 0 to 4 (see the
+/// module documentation).
+const TEMPLATE: [usize; 5] = [4, 4, 4, 3, 2];
+/// Cells between a candidate and the centre of an empty template.
+const NEAR: usize = 8;
 /// Cells between a point's cell and the cells that decide about it.
 const REACH: usize = 14;
 /// Occupied cell.
 const OCC: u8 = 1;
-/// An occupied cell lies within `HALF_BLOCK` (else the cell is the centre
-/// of an empty block).
+/// The template around the cell holds an occupied cell (else the cell is
+/// the centre of an empty template).
 const NEAR_OCC: u8 = 2;
-/// The centre of an empty block lies within `REACH`.
+/// The centre of an empty template lies within `NEAR`.
 const NEAR_EMPTY: u8 = 4;
 /// A candidate cell (occupied, empty block near).
 const CANDIDATE: u8 = OCC | NEAR_EMPTY;
@@ -100,7 +112,8 @@ pub(super) fn band_loops(
         grid.flags[c] |= OCC;
     }
     grid.dilate(|f| f & OCC != 0, HALF_BLOCK, NEAR_OCC);
-    grid.dilate(|f| f & NEAR_OCC == 0, REACH, NEAR_EMPTY);
+    grid.template_rest();
+    grid.dilate(|f| f & NEAR_OCC == 0, NEAR, NEAR_EMPTY);
     grid.dilate(|f| f & CANDIDATE == CANDIDATE, REACH, BAND);
     if let Some(l) = local.filter(|l| l.max > 1.0) {
         let classes = grid.classify(l, alpha_unit);
@@ -175,6 +188,38 @@ impl Grid {
             dims,
             flags: vec![0; dims[0] * dims[1]],
         })
+    }
+
+    /// Marks `NEAR_OCC` on the cells whose 7 x 7 square is empty but whose
+    /// template is not: the template's cells beyond the square (rows 4
+    /// away, columns 4 away) are checked directly; such centres are rare.
+    fn template_rest(&mut self) {
+        let [nx, ny] = self.dims;
+        let occ = |flags: &[u8], i: isize, j: isize| {
+            i >= 0
+                && j >= 0
+                && (i as usize) < nx
+                && (j as usize) < ny
+                && flags[j as usize * nx + i as usize] & OCC != 0
+        };
+        for c in 0..self.flags.len() {
+            if self.flags[c] & NEAR_OCC != 0 {
+                continue;
+            }
+            let (i, j) = ((c % nx) as isize, (c / nx) as isize);
+            let beyond = (HALF_BLOCK + 1..TEMPLATE.len()).any(|a| {
+                let (a, w) = (a as isize, TEMPLATE[a] as isize);
+                (-w..=w).any(|b| {
+                    occ(&self.flags, i + b, j + a)
+                        || occ(&self.flags, i + b, j - a)
+                        || occ(&self.flags, i + a, j + b)
+                        || occ(&self.flags, i - a, j + b)
+                })
+            });
+            if beyond {
+                self.flags[c] |= NEAR_OCC;
+            }
+        }
     }
 
     /// The centre of cell `c` in unit coordinates.
