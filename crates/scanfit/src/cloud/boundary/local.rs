@@ -119,7 +119,7 @@ impl LocalSpacing {
                 break;
             }
         }
-        if !(median > 0.0) {
+        if median.is_nan() || median <= 0.0 {
             return None;
         }
         grid.factor = raw
