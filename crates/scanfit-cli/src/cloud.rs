@@ -154,7 +154,11 @@ const BOUNDARY_EXAMPLES: &str = "Examples:
 The points are projected onto their best-fit plane and triangulated (Delaunay);
 triangles with a circumradius below alpha form the alpha shape, whose boundary
 edges are chained into loops (outer loop counter-clockwise about the plane
-normal, holes clockwise). alpha defaults to 2.5 x the median Delaunay edge.
+normal, holes clockwise). alpha defaults to 2.5 x the median Delaunay edge;
+where the points are sparser (local spacing over 1.25 x the median, from
+cell counts), alpha grows with the local spacing, up to 5 x, so a scan that
+thins out towards its outline keeps its outline (--global-alpha: one alpha
+everywhere, the PDE paper's alpha shape).
 Corners are the points of the outer loop with the smallest turning angle
 (Coons paper eqs. 10-12) or the largest three-point curvature 4S/(abc) (PDE
 paper 4.1), at least --min-separation of the loop length apart; the loop is
@@ -175,6 +179,9 @@ pub struct BoundaryArgs {
     /// Multiple of the median Delaunay edge used as alpha.
     #[arg(long, default_value_t = 2.5, value_name = "F")]
     pub alpha_factor: f64,
+    /// One alpha everywhere, not widened where the points are sparse.
+    #[arg(long)]
+    pub global_alpha: bool,
     /// Number of corners (4 or 3 for Coons patches; 0 = loop only).
     #[arg(long, default_value_t = 4, value_name = "N")]
     pub corners: usize,
@@ -691,6 +698,7 @@ fn boundary_doc(
         "file": a.input.input.display().to_string(),
         "points": cloud.len(),
         "alpha": b.alpha,
+        "local_factor": b.local_factor,
         "spacing": b.spacing,
         "plane": {
             "origin": [b.plane.origin.x, b.plane.origin.y, b.plane.origin.z],
@@ -722,12 +730,13 @@ fn boundary_picture(a: &BoundaryArgs, cloud: &PointCloud, r: &CloudBoundary) -> 
         .options_or(cloud.points(), DefaultView::Facing(b.plane.normal))?;
     opts.legend = vec![
         format!(
-            "{}: {} points, {} boundary loop(s), outer loop {} points, alpha = {}",
+            "{}: {} points, {} boundary loop(s), outer loop {} points, alpha = {} (x up to {} where sparse)",
             a.input.input.display(),
             cloud.len(),
             b.loops.len(),
             r.outer().len(),
-            num(b.alpha)
+            num(b.alpha),
+            num(b.local_factor)
         ),
         match &r.corners {
             Some(c) => format!(
@@ -794,6 +803,10 @@ fn print_boundary(cloud: &PointCloud, r: &CloudBoundary, secs: f64) -> Result<()
         num(b.spacing),
     ]);
     t.row(vec!["alpha".into(), num(b.alpha)]);
+    t.row(vec![
+        "largest local alpha factor (sparse parts)".into(),
+        num(b.local_factor),
+    ]);
     t.row(vec!["loops".into(), b.loops.len().to_string()]);
     t.row(vec!["outer loop points".into(), outer.len().to_string()]);
     t.row(vec![
@@ -851,6 +864,7 @@ fn boundary(a: BoundaryArgs) -> Result<()> {
     let mut cfg = CloudBoundaryConfig::default();
     cfg.boundary.alpha = a.alpha;
     cfg.boundary.alpha_factor = a.alpha_factor;
+    cfg.boundary.local_alpha = !a.global_alpha;
     cfg.corners.criterion = CornerCriterion::from(a.criterion);
     cfg.corners.count = a.corners;
     cfg.corners.offset = a.corner_offset;

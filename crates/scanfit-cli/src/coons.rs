@@ -38,7 +38,8 @@ const EXAMPLES: &str = "Examples:
   scanfit coons fan.xyz --sides 3 --criterion curvature --pde 10x10 --mesh fan.ply
   scanfit coons patch.ply --corners 0,130,260,390 --params closest --points-out params.ply --json
 
-Pipeline: boundary loop of the points (alpha shape in their best-fit plane),
+Pipeline: boundary loop of the points (alpha shape in their best-fit plane,
+alpha widened where the points are sparse; --global-alpha: one alpha),
 corners (smallest turning angle, Coons paper eqs. 10-12, or three-point
 curvature, PDE paper 4.1; --corners gives loop positions as listed by
 `scanfit cloud boundary`), one B-spline per side (end-pinned least squares on
@@ -151,6 +152,9 @@ pub struct CoonsArgs {
     /// Multiple of the median Delaunay edge used as alpha.
     #[arg(long, default_value_t = 2.5, value_name = "F")]
     pub alpha_factor: f64,
+    /// One alpha everywhere, not widened where the points are sparse.
+    #[arg(long)]
+    pub global_alpha: bool,
     /// Boundary curves: `lsq` (end-pinned least squares) or `interpolate`.
     #[arg(long, default_value = "lsq", value_name = "HOW", value_parser = choice::<CurvesArg>())]
     pub curves: CurvesArg,
@@ -272,6 +276,7 @@ fn config(a: &CoonsArgs) -> Result<CoonsConfig> {
     cfg.base.force_corners = a.force_corners;
     cfg.base.boundary.alpha = a.alpha;
     cfg.base.boundary.alpha_factor = a.alpha_factor;
+    cfg.base.boundary.local_alpha = !a.global_alpha;
     cfg.base.corners.criterion = CornerCriterion::from(a.criterion);
     cfg.base.corners.count = sides;
     cfg.base.corner_positions = match &a.corners {

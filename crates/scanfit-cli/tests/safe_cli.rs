@@ -141,44 +141,64 @@ fn scaled(dir: &Path, factor: f64) -> PathBuf {
 
 #[test]
 fn coons_on_the_nasty_face_says_why_and_what_to_try() {
-    // The alpha shape's outer loop runs into the cloud where the points
-    // thin out (density falls tenfold towards the outline): it touches
-    // itself and bites notches into the outline, which used to pass the
-    // corner check and end in a singular least-squares system. Now: exit 1,
-    // no output, one message naming the ragged boundary and the options to
-    // try, the same in millimetres and x1000, with and without
-    // --remove-outliers, for both routes.
+    // With one alpha (--global-alpha, [PDE23]'s alpha shape) the outer
+    // loop runs into the cloud where the points thin out (density falls
+    // tenfold towards the outline): it touches itself and bites notches
+    // into the outline, which used to pass the corner check and end in a
+    // singular least-squares system. Now: exit 1, no output, one message
+    // naming the ragged boundary and the options to try, the same in
+    // millimetres and x1000, with and without --remove-outliers, for both
+    // routes. With the default alpha, widened where the points are sparse,
+    // the loop follows the outline and no longer touches itself: the true
+    // notch of the sparse cheek (sampled at 3%) is named as such.
     let d = tmp("coons");
     let out = d.join("c.json");
     let f = nasty();
     let big = scaled(&d, 1000.0);
     for input in [&f, &big] {
         for extra in [&[][..], &["--remove-outliers"], &["--pde", "5x5"]] {
-            let mut args = vec![
-                "coons",
-                input.to_str().unwrap(),
-                "-o",
-                out.to_str().unwrap(),
-                "-q",
-            ];
-            args.extend_from_slice(extra);
-            let o = run(&args);
-            let err = String::from_utf8_lossy(&o.stderr);
-            assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
-            assert!(!out.exists());
-            assert!(err.contains("touches itself"), "{args:?}: {err}");
-            assert!(
-                err.contains("--alpha-factor")
-                    && err.contains("--corners")
-                    && err.contains("scanfit mba"),
-                "{args:?}: {err}"
-            );
-            assert!(!err.contains("singular"), "{args:?}: {err}");
+            for global in [true, false] {
+                let mut args = vec![
+                    "coons",
+                    input.to_str().unwrap(),
+                    "-o",
+                    out.to_str().unwrap(),
+                    "-q",
+                ];
+                args.extend_from_slice(extra);
+                if global {
+                    args.push("--global-alpha");
+                }
+                let o = run(&args);
+                let err = String::from_utf8_lossy(&o.stderr);
+                assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+                assert!(!out.exists());
+                let why = if global {
+                    "touches itself"
+                } else {
+                    "notches where the outline turns inward"
+                };
+                assert!(err.contains(why), "{args:?}: {err}");
+                assert!(
+                    err.contains("--alpha-factor")
+                        && err.contains("--corners")
+                        && err.contains("scanfit mba"),
+                    "{args:?}: {err}"
+                );
+                assert!(!err.contains("singular"), "{args:?}: {err}");
+            }
         }
     }
-    // twice the alpha factor: the loop no longer touches itself, and the
-    // true notch of the sparse cheek is named as such
-    let o = run(&["coons", f.to_str().unwrap(), "--alpha-factor", "5", "-q"]);
+    // twice the alpha factor with one alpha: the loop no longer touches
+    // itself, and the true notch of the sparse cheek is named as such
+    let o = run(&[
+        "coons",
+        f.to_str().unwrap(),
+        "--alpha-factor",
+        "5",
+        "--global-alpha",
+        "-q",
+    ]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(

@@ -7,13 +7,17 @@
 //!   `alpha` that holds no point: across a boundary edge lies a triangle
 //!   with circumradius `R >= alpha` (its open circumdisc holds no point and
 //!   contains the disc of radius `alpha` tangent to its circle at `p`) or the
-//!   open half-plane beyond the hull (which contains that disc too). The
-//!   disc's inscribed square has side `alpha sqrt(2) = 8.49 h >= 8 h`, so it
-//!   holds an aligned block of 7 x 7 whole cells, which are therefore empty,
-//!   and whose centre cell lies within `2 alpha` (13 cells) of `p`. Hence
+//!   open half-plane beyond the hull (which contains that disc too). Let `c`
+//!   be the cell of the disc's centre `o`. A cell `c + (a, b)` lies within
+//!   `h sqrt((|a| + 1)^2 + (|b| + 1)^2)` of `o`, so the cells with
+//!   `(|a| + 1)^2 + (|b| + 1)^2 < 36` (the *template*: rows of half-width
+//!   4, 4, 4, 3, 2 cells at row offsets 0 to 4, 69 cells, all within
+//!   `0.972 alpha` of `o`, far from the circle beyond any rounding) lie
+//!   inside the disc and are empty. `p` is `alpha` (6 cells) from `o`, so
+//!   within 7 cells of `c`, 8 with the rounding of its cell index. Hence
 //!   every boundary vertex is in a *candidate* cell: an occupied cell with
-//!   the centre of an empty 7 x 7 block within [`REACH`] cells (cells beyond
-//!   the points' bounding box are empty; the grid is padded by `REACH`).
+//!   the centre of an empty template within [`NEAR`] cells (cells beyond the
+//!   points' bounding box are empty; the grid is padded by `REACH`).
 //! * A kept triangle (`R < alpha`) with a vertex `p` has its circumdisc, and
 //!   so its other vertices, within `2R < 2 alpha` of `p`. If the triangulated
 //!   set holds every point within `2 alpha` of `p` (every point of the cells
@@ -32,42 +36,72 @@
 //! boundary edges, sides of the cells, are the same. Only a circumradius
 //! within rounding, ~1e-15 relative, of `alpha` could be decided apart.)
 //! `REACH` is 14 cells rather than 13 to leave room for the rounding of the
-//! cell index.
+//! cell index. With the local factors of [`super::local`] (at least 1, so
+//! the candidates are the same) a kept triangle reaches `2 alpha F`, `F` its
+//! factor; the candidate cells whose surroundings have factors above 1 are
+//! dilated further, by the reach [`LocalSpacing::bound`] gives.
 //!
-//! Why blocks of small cells: a single empty cell of side `alpha / 2` would
-//! do for the proof, but on a uniform random sample at the default alpha
-//! such a cell is empty with probability 17%, so nearly every point would
-//! be a candidate; an empty 7 x 7 block (side 1.17 alpha, about 10 points
-//! expected) is rare inside a patch. The grid costs two bytes per cell
+//! Why a template of small cells: a single empty cell of side `alpha / 2`
+//! would do for the proof, but on a uniform random sample at the default
+//! alpha such a cell is empty with probability 17%, so nearly every point
+//! would be a candidate; an empty template (1.92 alpha^2, about 14 points
+//! expected at the default alpha) is rare inside a patch: on 10^7 uniform
+//! points the 7 x 7 blocks used before (1.36 alpha^2, about 10 points)
+//! were empty often enough to put a tenth of the points in the band. The
+//! grid costs two bytes per cell
 //! (flags and one row buffer), about five cells per point on a cloud that
 //! fills its bounding box; a grid of more than `8 n + 2^20` cells (an
 //! outlier stretching the box, or a tiny alpha) is not built and the whole
 //! cloud is triangulated instead.
 
+use super::local::LocalSpacing;
 use super::{Boundary, Frame, Site, SiteTriangulation};
 use crate::Result;
 
 /// Cells per alpha.
 const CELLS_PER_ALPHA: f64 = 6.0;
-/// Half the side of the empty blocks, in cells (7 x 7 blocks).
+/// Half the side of the square inside the template, in cells (7 x 7).
 const HALF_BLOCK: usize = 3;
+/// Half-widths of the template's rows at row offsets 0 to 4 (see the
+/// module documentation).
+const TEMPLATE: [usize; 5] = [4, 4, 4, 3, 2];
+/// Cells between a candidate and the centre of an empty template.
+const NEAR: usize = 8;
 /// Cells between a point's cell and the cells that decide about it.
 const REACH: usize = 14;
 /// Occupied cell.
 const OCC: u8 = 1;
-/// An occupied cell lies within `HALF_BLOCK` (else the cell is the centre
-/// of an empty block).
+/// The template around the cell holds an occupied cell (else the cell is
+/// the centre of an empty template).
 const NEAR_OCC: u8 = 2;
-/// The centre of an empty block lies within `REACH`.
+/// The centre of an empty template lies within `NEAR`.
 const NEAR_EMPTY: u8 = 4;
 /// A candidate cell (occupied, empty block near).
 const CANDIDATE: u8 = OCC | NEAR_EMPTY;
 /// A candidate cell lies within `REACH`: its points are triangulated.
 const BAND: u8 = 8;
+/// Bits of a candidate cell's reach class `k` (reach `REACH + CLASS_STEP k` cells)
+/// where the local alpha is wider than the global one.
+const CLASS_SHIFT: u8 = 4;
+/// Reach added per class, in cells.
+const CLASS_STEP: usize = 4;
 
-/// The loops of the alpha shape of radius `alpha` from the triangulation of
-/// the band; `None` when the grid would be too large.
-pub(super) fn band_loops(frame: &Frame, alpha: f64, spacing: f64) -> Result<Option<Boundary>> {
+/// The loops of the alpha shape of radius `alpha` (times the local factors
+/// of `local`) from the triangulation of the band; `None` when the grid
+/// would be too large.
+///
+/// With local factors a kept triangle at a candidate point reaches further
+/// than `2 alpha`; [`LocalSpacing::bound`] bounds how far from the factors
+/// around the point, and the candidate cells are dilated by that reach
+/// (in classes of [`CLASS_STEP`] cells) instead of [`REACH`]. The candidate
+/// cells stay the same: a boundary vertex still lies on an empty disc of
+/// radius at least `alpha` (the factors are at least 1).
+pub(super) fn band_loops(
+    frame: &Frame,
+    alpha: f64,
+    spacing: f64,
+    local: Option<&LocalSpacing>,
+) -> Result<Option<Boundary>> {
     let alpha_unit = alpha / frame.extent;
     let n = frame.len();
     let Some(mut grid) = Grid::new(frame, alpha_unit / CELLS_PER_ALPHA, n) else {
@@ -78,8 +112,18 @@ pub(super) fn band_loops(frame: &Frame, alpha: f64, spacing: f64) -> Result<Opti
         grid.flags[c] |= OCC;
     }
     grid.dilate(|f| f & OCC != 0, HALF_BLOCK, NEAR_OCC);
-    grid.dilate(|f| f & NEAR_OCC == 0, REACH, NEAR_EMPTY);
+    grid.template_rest();
+    grid.dilate(|f| f & NEAR_OCC == 0, NEAR, NEAR_EMPTY);
     grid.dilate(|f| f & CANDIDATE == CANDIDATE, REACH, BAND);
+    if let Some(l) = local.filter(|l| l.max > 1.0) {
+        let classes = grid.classify(l, alpha_unit);
+        for k in 1..16u8 {
+            if classes & (1 << k) != 0 {
+                let is_k = move |f: u8| f & CANDIDATE == CANDIDATE && f >> CLASS_SHIFT == k;
+                grid.dilate(is_k, REACH + CLASS_STEP * usize::from(k), BAND);
+            }
+        }
+    }
     let mut sites = Vec::new();
     let mut candidates = 0usize;
     for (index, pos) in frame.units().enumerate() {
@@ -92,7 +136,7 @@ pub(super) fn band_loops(frame: &Frame, alpha: f64, spacing: f64) -> Result<Opti
     }
     drop(grid);
     let tri = SiteTriangulation::new(sites, frame)?;
-    let a = tri.alpha_loops(alpha_unit)?;
+    let a = tri.alpha_loops(alpha_unit, local)?;
     // Euler's formula for the kept region with its pinch vertices split
     // (a union of planar domains): T = 2 V_inner + E_loops - 2 chi, where
     // chi = outer loops - hole loops and every point off the candidate
@@ -110,10 +154,14 @@ pub(super) fn band_loops(frame: &Frame, alpha: f64, spacing: f64) -> Result<Opti
         .filter(|&v| tri.sites[v].inner && a.on_kept[v] && !on_loop[v])
         .count();
     let inner = (n - candidates - tri.outer_repeats + inner_candidates) as i64;
-    let b = a.to_boundary(&tri, frame, alpha, spacing, 0)?;
+    let b = a.to_boundary(&tri, frame, (alpha, local), spacing, 0)?;
     let chi: i64 = b.areas.iter().map(|&x| if x > 0.0 { 1 } else { -1 }).sum();
     let triangles = (2 * inner + loop_edges - 2 * chi).max(0) as usize;
-    Ok(Some(Boundary { triangles, ..b }))
+    Ok(Some(super::fill_small_holes(
+        Boundary { triangles, ..b },
+        frame,
+        local,
+    )))
 }
 
 /// One byte of flags per cell of side `h` over the unit bounding box,
@@ -140,6 +188,79 @@ impl Grid {
             dims,
             flags: vec![0; dims[0] * dims[1]],
         })
+    }
+
+    /// Marks `NEAR_OCC` on the cells whose 7 x 7 square is empty but whose
+    /// template is not: the template's cells beyond the square (rows 4
+    /// away, columns 4 away) are checked directly; such centres are rare.
+    fn template_rest(&mut self) {
+        let [nx, ny] = self.dims;
+        let occ = |flags: &[u8], i: isize, j: isize| {
+            i >= 0
+                && j >= 0
+                && (i as usize) < nx
+                && (j as usize) < ny
+                && flags[j as usize * nx + i as usize] & OCC != 0
+        };
+        for c in 0..self.flags.len() {
+            if self.flags[c] & NEAR_OCC != 0 {
+                continue;
+            }
+            let (i, j) = ((c % nx) as isize, (c / nx) as isize);
+            let beyond = (HALF_BLOCK + 1..TEMPLATE.len()).any(|a| {
+                let (a, w) = (a as isize, TEMPLATE[a] as isize);
+                (-w..=w).any(|b| {
+                    occ(&self.flags, i + b, j + a)
+                        || occ(&self.flags, i + b, j - a)
+                        || occ(&self.flags, i + a, j + b)
+                        || occ(&self.flags, i - a, j + b)
+                })
+            });
+            if beyond {
+                self.flags[c] |= NEAR_OCC;
+            }
+        }
+    }
+
+    /// The centre of cell `c` in unit coordinates.
+    fn centre(&self, c: usize) -> [f64; 2] {
+        let (i, j) = (c % self.dims[0], c / self.dims[0]);
+        let at = |k: usize, i: usize| self.lo[k] + (i as f64 - REACH as f64 + 0.5) * self.h;
+        [at(0, i), at(1, j)]
+    }
+
+    /// Stores in each candidate cell its reach class (the reach that
+    /// [`LocalSpacing::bound`] asks beyond [`REACH`], in steps of
+    /// [`CLASS_STEP`]); returns the classes present as bits.
+    fn classify(&mut self, local: &LocalSpacing, alpha_unit: f64) -> u16 {
+        let mut present = 0u16;
+        // per coarse cell of `local`: its class, or u8::MAX before it is asked
+        let mut cache = vec![u8::MAX; local.cells()];
+        for c in 0..self.flags.len() {
+            if self.flags[c] & CANDIDATE != CANDIDATE {
+                continue;
+            }
+            let q = self.centre(c);
+            let coarse = local.cell(q);
+            if cache[coarse] == u8::MAX {
+                // kept triangles at the cell's points lie within 2 alpha F
+                // of them: 12 F cells, plus two for the rounding of the
+                // cell indices and one as the cell's points lie within
+                // half a cell of its centre (REACH when F = 1)
+                let f = local.bound(q, alpha_unit);
+                let class = if f > 1.0 {
+                    let reach = (2.0 * alpha_unit * f / self.h).ceil() as usize + 3;
+                    reach.saturating_sub(REACH).div_ceil(CLASS_STEP).min(15)
+                } else {
+                    0
+                };
+                cache[coarse] = class as u8;
+            }
+            let k = cache[coarse];
+            self.flags[c] |= k << CLASS_SHIFT;
+            present |= 1 << k;
+        }
+        present
     }
 
     fn cell(&self, q: [f64; 2]) -> usize {
