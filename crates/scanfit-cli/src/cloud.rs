@@ -710,13 +710,14 @@ fn boundary_doc(
             "area": area,
             "points": l.iter().map(|&i| pt(i)).collect::<Vec<_>>(),
         })).collect::<Vec<_>>(),
-        "corners": r.corners.as_ref().map(|c| c.corners.iter().map(|&k| serde_json::json!({
+        // `--corners 0`: empty lists (a JSON output holds no null)
+        "corners": r.corners.as_ref().map_or_else(Vec::new, |c| c.corners.iter().map(|&k| serde_json::json!({
             "position": k,
             "index": outer[k],
             "point": pt(outer[k]),
             value_name: r.corner_value(k),
         })).collect::<Vec<_>>()),
-        "sides": r.corners.as_ref().map(|c| c.sides.iter().map(|s| s.iter().map(|&k| outer[k]).collect::<Vec<_>>()).collect::<Vec<_>>()),
+        "sides": r.corners.as_ref().map_or_else(Vec::new, |c| c.sides.iter().map(|s| s.iter().map(|&k| outer[k]).collect::<Vec<_>>()).collect::<Vec<_>>()),
         "seconds": secs,
     })
 }

@@ -205,6 +205,20 @@ fn boundary_finds_the_four_corners_of_the_panel() {
     );
 }
 
+/// `--corners 0` asks for the loops only: the JSON document holds empty
+/// corner and side lists (it was refused for the null they were).
+#[test]
+fn boundary_without_corners_writes_empty_lists() {
+    let d = tmpdir("cloud", "boundary_no_corners");
+    let (json, png) = (d.join("b.json"), d.join("b.png"));
+    let input = examples().join("patch_20k.ply");
+    cloud_json("boundary", &input, &["--corners", "0"], &json, &png);
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(v["loops"].as_array().unwrap().len(), 2);
+    assert_eq!(v["corners"].as_array().map(Vec::len), Some(0));
+    assert_eq!(v["sides"].as_array().map(Vec::len), Some(0));
+}
+
 #[test]
 fn cloud_commands_reject_bad_input_without_writing() {
     let d = tmpdir("cloud", "bad");
