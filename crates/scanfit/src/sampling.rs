@@ -313,17 +313,11 @@ mod tests {
     #[test]
     fn kept_triangles_are_the_whole_sets_with_their_circumcentre_in_a_taken_cell() {
         // 40 000 jittered points over [0, 2] x [0, 1], denser on the left
-        let mut state = 7u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::testdata::Lcg::new(7);
         let uv: Vec<[f64; 2]> = (0..40_000)
             .map(|_| {
-                let x = next();
-                [2.0 * x * x.sqrt(), next()]
+                let x = rng.next_f64();
+                [2.0 * x * x.sqrt(), rng.next_f64()]
             })
             .collect();
         let s = CellSample::new(&uv, 8000, 5).unwrap();

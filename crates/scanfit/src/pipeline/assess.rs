@@ -1192,6 +1192,15 @@ mod tests {
         assert!(assess_surface(&s, &p, &uv, &c).is_err());
     }
 
+    /// The bicubic 10 x 10 least-squares surface of `pts` at `uv`.
+    fn fit10(pts: &[Point3], uv: &[[f64; 2]]) -> Surface {
+        let cfg = crate::fit::surface::SurfaceFitConfig {
+            ctrl: (10, 10),
+            ..Default::default()
+        };
+        crate::fit::surface::fit_surface(pts, uv, &cfg).unwrap()
+    }
+
     /// `n` noisy points of a wavy sheet over [0, 2] x [0, 1] at uniform
     /// random parameters (a fixed LCG), and a bicubic 10 x 10 least-squares
     /// surface fitted to them.
@@ -1216,12 +1225,7 @@ mod tests {
             ));
             uv.push([u, v]);
         }
-        let cfg = crate::fit::surface::SurfaceFitConfig {
-            ctrl: (10, 10),
-            ..Default::default()
-        };
-        let s = crate::fit::surface::fit_surface(&pts, &uv, &cfg).unwrap();
-        (s, pts, uv)
+        (fit10(&pts, &uv), pts, uv)
     }
 
     /// Issue 18: the sampled statistics agree with the full computation
@@ -1296,12 +1300,7 @@ mod tests {
                 (Point3::new(x, y, z), uv)
             })
             .unzip();
-        let cfg = crate::fit::surface::SurfaceFitConfig {
-            ctrl: (10, 10),
-            ..Default::default()
-        };
-        let s = crate::fit::surface::fit_surface(&pts, &uv, &cfg).unwrap();
-        (s, pts, uv)
+        (fit10(&pts, &uv), pts, uv)
     }
 
     /// Issue 18: on a noisy scan (noise 0.4 point spacings along the
