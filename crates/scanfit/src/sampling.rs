@@ -90,8 +90,9 @@ pub fn sample_indices(n: usize, k: usize, seed: u64) -> Vec<usize> {
 
 /// A cluster sample of points by their parameters: a grid of about
 /// [`POINTS_PER_CELL`] points per cell over the parameters' bounding box,
-/// of which the share `target / n` of the cells is taken (a uniform random
-/// subset of them).
+/// of which the share `target / n` of the cells is taken (one cell drawn
+/// uniformly from each run of `n / target` consecutive cells), with the
+/// points within a margin of [`HALO`] of each taken cell.
 #[derive(Debug, Clone)]
 pub struct CellSample {
     lo: [f64; 2],
