@@ -16,6 +16,9 @@ Data (numpy, fixed seeds; written once to --dir, not committed):
                      `cloud hpr`.
     sheet_1e7.ply    10^7 points of a jittered terrain-like sheet over [0, 100]^2, float32 x, y, z
                      (a 120 MB binary PLY, as issue 18's `cloud info` row): `cloud info`.
+    face_1e6.ply     10^6 points of examples/data/make_sheet.py's face sheet (dome, nose, eyes,
+                     brow, lips over 160 x 220 mm, noise sigma 0.05 mm = 0.27 point spacings),
+                     float64: `fit` (best-fit plane parameters), for the sampled measures.
 
 Commands timed (outputs go to --dir):
     scanfit cloud segment box_1e6.ply -o seg.ply --quiet
@@ -24,6 +27,12 @@ Commands timed (outputs go to --dir):
     scanfit turntable blob_1e6.ply -o blob.json --quiet
     scanfit cloud hpr blob_1e6.ply --view 0,0,150 -o hpr.ply --quiet   (6 half-depths above the blob)
     scanfit coons patch_1e6.ply --pde 5x5 -o patch.json --quiet
+    scanfit turntable blob_1e6.ply -o blob_full.json --quiet --measure full   (turntable_full)
+    scanfit fit face_1e6.ply -o face.json --quiet [--measure full]            (face, face_full)
+
+`--quality` prints, after the table, the sampled measures of each command's JSON output (L2
+stretch, fold-overs, triangles, sample size): `turntable` against `turntable_full` and `face`
+against `face_full` are issue 18's check that a sample agrees with the full computation.
 
 Run (from the repository root, after `cargo build --release -p scanfit-cli`):
     python3 benches/cloud_commands.py --dir /tmp/cloudperf --repeats 3 [--only segment,info]
@@ -92,6 +101,18 @@ def blob(n, rng):
     return p + rng.normal(0.0, 0.05, p.shape)
 
 
+def face(n, rng):
+    # examples/data/make_sheet.py, height() and its noise, at n points
+    x = (2.0 * rng.random(n) - 1.0) * 80.0
+    y = (2.0 * rng.random(n) - 1.0) * 110.0
+    z = 30.0 - 0.002 * x**2 - 0.0008 * y**2
+    z += 18.0 * np.exp(-((x / 9.0) ** 2 + ((y + 5.0) / 22.0) ** 2))
+    z -= 6.0 * np.exp(-(((np.abs(x) - 30.0) / 12.0) ** 2 + ((y - 25.0) / 8.0) ** 2))
+    z += 3.0 * np.exp(-(((np.abs(x) - 28.0) / 18.0) ** 2 + ((y - 42.0) / 5.0) ** 2))
+    z += 4.0 * np.exp(-((x / 20.0) ** 2 + ((y + 55.0) / 8.0) ** 2))
+    return np.column_stack([x, y, z + rng.normal(0.0, 0.05, n)])
+
+
 def sheet(n, rng):
     side = int(np.ceil(np.sqrt(n)))
     i = np.arange(n)
@@ -106,6 +127,7 @@ INPUTS = {
     "patch_1e6.ply": (patch, 1_000_000, "<f8", 20261122),
     "blob_1e6.ply": (blob, 1_000_000, "<f8", 20261122),
     "sheet_1e7.ply": (sheet, 10_000_000, "<f4", 11),
+    "face_1e6.ply": (face, 1_000_000, "<f8", 20261202),
 }
 
 COMMANDS = {
@@ -118,7 +140,29 @@ COMMANDS = {
     "turntable": ["turntable", "blob_1e6.ply", "-o", "blob.json", "--quiet"],
     "hpr": ["cloud", "hpr", "blob_1e6.ply", "--view", "0,0,150", "-o", "hpr.ply", "--quiet"],
     "coons_pde": ["coons", "patch_1e6.ply", "--pde", "5x5", "-o", "patch.json", "--quiet"],
+    "turntable_full": [
+        "turntable", "blob_1e6.ply", "-o", "blob_full.json", "--quiet", "--measure", "full",
+    ],
+    "face": ["fit", "face_1e6.ply", "-o", "face.json", "--quiet"],
+    "face_full": ["fit", "face_1e6.ply", "-o", "face_full.json", "--quiet", "--measure", "full"],
 }
+
+
+def quality(d, args):
+    """The sampled measures of a command's JSON output (its `-o`), or None."""
+    out = args[args.index("-o") + 1]
+    if not out.endswith(".json"):
+        return None
+    import json
+
+    with open(os.path.join(d, out)) as f:
+        doc = json.load(f)
+    q = doc.get("quality", {})
+    return (
+        f"L2 stretch {q.get('l2_stretch', 0):.4f}, fold-overs {q.get('fold_overs')} of "
+        f"{q.get('triangles')} ({100 * q.get('fold_overs', 0) / max(q.get('triangles', 1), 1):.4f}%), "
+        f"measure {json.dumps(doc.get('measure'))}"
+    )
 
 
 def make_inputs(d):
@@ -150,8 +194,10 @@ def main():
     ap.add_argument("--only", default=",".join(COMMANDS))
     ap.add_argument("--binary", default=os.path.abspath("target/release/scanfit"))
     ap.add_argument("--show", action="store_true", help="print each command's output")
+    ap.add_argument("--quality", action="store_true", help="print the sampled measures of each JSON output")
     a = ap.parse_args()
     make_inputs(a.dir)
+    measured = []
     print("| command | median wall (s) | runs (s) | CPU user+sys (s) | peak RSS (MB) | load average before |")
     print("|---|---:|---|---|---:|---|")
     for key in a.only.split(","):
@@ -167,6 +213,10 @@ def main():
             f"{', '.join(f'{r[2]:.1f}' for r in runs)} |",
             flush=True,
         )
+        if a.quality and quality(a.dir, args):
+            measured.append(f"{key}: {quality(a.dir, args)}")
+    for line in measured:
+        print(line)
 
 
 if __name__ == "__main__":

@@ -470,8 +470,14 @@ fn print_report(a: &FitArgs, r: &FitReport) -> Result<()> {
         outln!("{note}");
     }
     if pq.triangles > 0 {
+        // a sample's largest anisotropy is a lower bound of the whole set's
+        let of = if r.assessment.sample.is_some() {
+            " (in the sample)"
+        } else {
+            ""
+        };
         outln!(
-            "\nparameterization: {} fold-overs in {} triangles, L2 stretch {:.3} (1 = uniform), max anisotropy {}",
+            "\nparameterization: {} fold-overs in {} triangles, L2 stretch {:.3} (1 = uniform), max anisotropy{of} {}",
             pq.fold_overs,
             pq.triangles,
             pq.l2_stretch,

@@ -7,14 +7,20 @@
 //! * [`sample_indices`]: a uniform random `k`-subset of `0..n` (Knuth,
 //!   TAOCP vol. 2, 3.4.2, Algorithm S: every subset equally likely, indices
 //!   in increasing order), for statistics of single points (the spacing).
-//! * [`CellSample`]: whole cells of a grid over the parameters, each taken
-//!   with the same probability (a cluster sample), for statistics of
-//!   triangles: the Delaunay triangles of the sampled points whose
-//!   circumcircle lies inside the taken cells are exactly triangles of the
-//!   Delaunay triangulation of all points (nothing of the whole set lies in
-//!   their circumcircles, or it would be in the sample), so fold-overs and
-//!   stretch are measured on the very triangles the full computation uses,
-//!   at the data's own density.
+//! * [`CellSample`]: whole cells of a grid over the parameters (a
+//!   cluster sample, one cell drawn from each run of consecutive cells),
+//!   with a margin of points around each, for statistics of triangles. A
+//!   Delaunay triangle of the sampled points counts when its circumcentre
+//!   lies in a taken cell and its circumcircle inside that cell's margin:
+//!   it is then exactly a triangle of the Delaunay triangulation of all
+//!   points (nothing of the whole set lies in its circumcircle, or it would
+//!   be in the sample), and every triangle of the whole set belongs to one
+//!   cell by its circumcentre, so each is counted with its cell's
+//!   probability whatever its size or shape. Fold-overs and stretch are
+//!   then measured on the very triangles the full computation uses, at the
+//!   data's own density, without favouring small triangles (the earlier
+//!   rule, a circumcircle inside the taken cells, kept a triangle with a
+//!   probability falling with its circumradius).
 //! * [`HashSample`]: the `k` points whose indices have the smallest seeded
 //!   hash (a bottom-k sketch, Cohen & Kaplan 2007): a uniform random
 //!   `k`-subset like [`sample_indices`], but needing no count in advance
@@ -34,10 +40,12 @@ use rayon::prelude::*;
 use crate::wire::{Reader, Writer};
 use crate::{Error, Point3, Result};
 
-/// Points per cell of a [`CellSample`] on average (32 x 32 points: a
-/// triangle's circumcircle is a few spacings wide, so most triangles of a
-/// taken cell are kept).
-const POINTS_PER_CELL: f64 = 1024.0;
+/// Points per cell of a [`CellSample`] on average (16 x 16 points): small
+/// cells, so that a sample of 50 000 points spreads over about 200 of them
+/// (on the turntable's blob, 16 x 16 cells halve the spread of the sampled
+/// L2 stretch over seeds against 32 x 32), large enough that the margin of
+/// [`HALO`] adds less than their own points.
+const POINTS_PER_CELL: f64 = 256.0;
 
 /// The SplitMix64 generator.
 #[derive(Debug, Clone)]
@@ -94,13 +102,15 @@ pub fn sample_indices(n: usize, k: usize, seed: u64) -> Vec<usize> {
 
 /// A cluster sample of points by their parameters: a grid of about
 /// [`POINTS_PER_CELL`] points per cell over the parameters' bounding box,
-/// of which the share `target / n` of the cells is taken (a uniform random
-/// subset of them).
+/// of which the share `target / n` of the cells is taken (one cell drawn
+/// uniformly from each run of `n / target` consecutive cells), with the
+/// points within a margin of [`HALO`] of each taken cell.
 #[derive(Debug, Clone)]
 pub struct CellSample {
     lo: [f64; 2],
     cell: [f64; 2],
     dims: [usize; 2],
+    halo: [f64; 2],
     taken: Vec<bool>,
     indices: Vec<usize>,
 }
@@ -116,9 +126,10 @@ impl CellSample {
     ///     .map(|k| [(k % 500) as f64 / 499.0, (k / 500) as f64 / 399.0])
     ///     .collect();
     /// let s = CellSample::new(&uv, 20_000, 18).unwrap();
-    /// // about a tenth of the points, whole cells of them
-    /// assert!(s.indices().len() > 10_000 && s.indices().len() < 30_000);
-    /// assert!(s.indices().iter().all(|&i| s.contains(uv[i])));
+    /// // a tenth of the points in whole cells, and the margins around them
+    /// let core = s.indices().iter().filter(|&&i| s.contains(uv[i])).count();
+    /// assert!(core > 17_000 && core < 23_000, "{core}");
+    /// assert!(s.indices().len() > core + 5_000 && s.indices().len() < 2 * core);
     /// ```
     pub fn new(uv: &[[f64; 2]], target: usize, seed: u64) -> Option<Self> {
         let n = uv.len();
@@ -149,28 +160,35 @@ impl CellSample {
         let count = |s: f64| ((s / side).ceil() as usize).clamp(1, 1 << 15);
         let dims = [count(span[0]), count(span[1])];
         let cell = [span[0] / dims[0] as f64, span[1] / dims[1] as f64];
-        // the share target / n of the cells, drawn by Algorithm S
         let cells = dims[0] * dims[1];
         let k = ((cells as f64 * target as f64 / n as f64).round() as usize).clamp(1, cells);
+        // stratified: one cell drawn from each of k runs of consecutive
+        // cells (column by column), so the taken cells spread over the
+        // whole parameter domain; each cell is taken with probability
+        // 1 / (its run's length), k / cells up to one cell in a run
         let mut taken = vec![false; cells];
-        for c in sample_indices(cells, k, seed) {
-            taken[c] = true;
+        let mut rng = SplitMix64(seed);
+        for j in 0..k {
+            let (a, b) = (j * cells / k, (j + 1) * cells / k);
+            taken[a + rng.below((b - a) as u64) as usize] = true;
         }
         let mut s = Self {
             lo,
             cell,
             dims,
+            halo: [HALO * cell[0], HALO * cell[1]],
             taken,
             indices: Vec::new(),
         };
         s.indices = (0..n)
             .into_par_iter()
-            .filter(|&i| s.contains(uv[i]))
+            .filter(|&i| s.near_taken(uv[i]))
             .collect();
         Some(s)
     }
 
-    /// The sampled points (indices into the parameters given, increasing).
+    /// The sampled points (indices into the parameters given, increasing):
+    /// those of the taken cells and of their margins.
     pub fn indices(&self) -> &[usize] {
         &self.indices
     }
@@ -190,27 +208,40 @@ impl CellSample {
         self.taken[self.cell_of(t[0], 0) * self.dims[1] + self.cell_of(t[1], 1)]
     }
 
-    /// Whether the disc of `radius` about `centre` lies inside the taken
-    /// cells (outside the grid there are no points, so that part counts as
-    /// taken): every cell its bounding square meets is taken.
-    pub fn contains_disc(&self, centre: [f64; 2], radius: f64) -> bool {
-        if !(radius.is_finite() && centre[0].is_finite() && centre[1].is_finite()) {
-            return false;
-        }
+    /// Whether parameters `t` lie in a taken cell or in its margin (within
+    /// the halo of its sides): whether the point is in the sample.
+    fn near_taken(&self, t: [f64; 2]) -> bool {
         let (i0, i1) = (
-            self.cell_of(centre[0] - radius, 0),
-            self.cell_of(centre[0] + radius, 0),
+            self.cell_of(t[0] - self.halo[0], 0),
+            self.cell_of(t[0] + self.halo[0], 0),
         );
         let (j0, j1) = (
-            self.cell_of(centre[1] - radius, 1),
-            self.cell_of(centre[1] + radius, 1),
+            self.cell_of(t[1] - self.halo[1], 1),
+            self.cell_of(t[1] + self.halo[1], 1),
         );
-        (i0..=i1).all(|i| (j0..=j1).all(|j| self.taken[i * self.dims[1] + j]))
+        (i0..=i1).any(|i| (j0..=j1).any(|j| self.taken[i * self.dims[1] + j]))
+    }
+
+    /// Whether the disc of `radius` about `centre` lies inside the taken
+    /// cell of `centre` grown by the halo (a side on the grid's border
+    /// grows without bound: no point lies beyond it).
+    fn in_own_cell(&self, centre: [f64; 2], radius: f64) -> bool {
+        (0..2).all(|k| {
+            let c = self.cell_of(centre[k], k);
+            let lo = self.lo[k] + c as f64 * self.cell[k] - self.halo[k];
+            let hi = self.lo[k] + (c + 1) as f64 * self.cell[k] + self.halo[k];
+            (c == 0 || centre[k] - radius >= lo)
+                && (c + 1 == self.dims[k] || centre[k] + radius <= hi)
+        }) && self.contains(centre)
     }
 
     /// Whether the triangle `a, b, c` of the sample's Delaunay triangulation
-    /// is a triangle of the whole set's: its circumcircle lies inside the
-    /// taken cells (a degenerate triangle is not kept).
+    /// counts: its circumcentre lies in a taken cell (so each triangle of
+    /// the whole set belongs to exactly one cell, and is counted with that
+    /// cell's probability whatever its size or shape) and its circumcircle
+    /// inside that cell and its margin, whose points are all in the sample,
+    /// so that the triangle is one of the whole set's Delaunay triangles
+    /// too (a degenerate triangle is not kept).
     pub fn keeps_triangle(&self, a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> bool {
         let (bx, by) = (b[0] - a[0], b[1] - a[1]);
         let (cx, cy) = (c[0] - a[0], c[1] - a[1]);
@@ -221,7 +252,11 @@ impl CellSample {
         let (b2, c2) = (bx * bx + by * by, cx * cx + cy * cy);
         let ux = (cy * b2 - by * c2) / d;
         let uy = (bx * c2 - cx * b2) / d;
-        self.contains_disc([a[0] + ux, a[1] + uy], ux.hypot(uy))
+        let (centre, radius) = ([a[0] + ux, a[1] + uy], ux.hypot(uy));
+        if !(radius.is_finite() && centre[0].is_finite() && centre[1].is_finite()) {
+            return false;
+        }
+        self.in_own_cell(centre, radius)
     }
 }
 
@@ -412,6 +447,15 @@ impl HashSample {
     }
 }
 
+/// The margin around each taken cell whose points join the sample, as a
+/// share of the cell's side: 0.15 x 16 = 2.4 point spacings at
+/// [`POINTS_PER_CELL`]. A Delaunay triangle with its circumcentre in the
+/// cell is verified (and kept) when its circumcircle stays within the
+/// margin; in a uniform random point set of unit density the circumradius
+/// exceeds 2.4 spacings with probability `exp(-pi r^2) (1 + pi r^2)`, about
+/// 3e-7 at r = 2.4, so only slivers along the outline are lost.
+const HALO: f64 = 0.15;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -431,28 +475,84 @@ mod tests {
         assert!(hits.iter().all(|&h| (850..1150).contains(&h)), "{hits:?}");
     }
 
+    /// A vertex of the test triangulations: parameters and point index.
+    #[derive(Clone, Copy)]
+    struct Vertex([f64; 2], usize);
+
+    impl spade::HasPosition for Vertex {
+        type Scalar = f64;
+        fn position(&self) -> spade::Point2<f64> {
+            spade::Point2::new(self.0[0], self.0[1])
+        }
+    }
+
+    /// The Delaunay triangles of the points `idx` of `uv`, as sorted index
+    /// triples (spade, independently of the sample).
+    fn delaunay(uv: &[[f64; 2]], idx: &[usize]) -> Vec<[usize; 3]> {
+        use spade::Triangulation;
+        let v: Vec<Vertex> = idx.iter().map(|&i| Vertex(uv[i], i)).collect();
+        let t = spade::DelaunayTriangulation::<Vertex>::bulk_load(v).unwrap();
+        t.inner_faces()
+            .map(|f| {
+                let mut k = f.vertices().map(|v| v.data().1);
+                k.sort_unstable();
+                k
+            })
+            .collect()
+    }
+
+    /// Circumcentre and circumradius of a triangle.
+    fn circle(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> ([f64; 2], f64) {
+        let (bx, by, cx, cy) = (b[0] - a[0], b[1] - a[1], c[0] - a[0], c[1] - a[1]);
+        let d = 2.0 * (bx * cy - by * cx);
+        let (b2, c2) = (bx * bx + by * by, cx * cx + cy * cy);
+        let (ux, uy) = ((cy * b2 - by * c2) / d, (bx * c2 - cx * b2) / d);
+        ([a[0] + ux, a[1] + uy], ux.hypot(uy))
+    }
+
     #[test]
-    fn circumcircle_test_keeps_inner_triangles_only() {
-        let uv: Vec<[f64; 2]> = (0..100 * 100)
-            .map(|k| [(k % 100) as f64, (k / 100) as f64])
+    fn kept_triangles_are_the_whole_sets_with_their_circumcentre_in_a_taken_cell() {
+        // 40 000 jittered points over [0, 2] x [0, 1], denser on the left
+        let mut rng = crate::testdata::Lcg::new(7);
+        let uv: Vec<[f64; 2]> = (0..40_000)
+            .map(|_| {
+                let x = rng.next_f64();
+                [2.0 * x * x.sqrt(), rng.next_f64()]
+            })
             .collect();
-        let mut s = CellSample::new(&uv, 5000, 1).unwrap();
-        // take exactly the left half of the cells
-        let dims = s.dims;
-        for i in 0..dims[0] {
-            for j in 0..dims[1] {
-                s.taken[i * dims[1] + j] = (i as f64 + 0.5) * s.cell[0] < 49.5;
+        let s = CellSample::new(&uv, 8000, 5).unwrap();
+        // one cell from each stratum
+        let cells = s.dims[0] * s.dims[1];
+        let k = s.taken.iter().filter(|&&t| t).count();
+        assert_eq!(k, ((cells as f64 * 8000.0 / 40_000.0).round() as usize));
+        let full = delaunay(&uv, &(0..uv.len()).collect::<Vec<_>>());
+        let (mut possible, mut certain) = (std::collections::HashSet::new(), 0usize);
+        for t in &full {
+            let (centre, r) = circle(uv[t[0]], uv[t[1]], uv[t[2]]);
+            if s.contains(centre) {
+                possible.insert(*t);
+                certain += usize::from(r <= s.halo[0].min(s.halo[1]));
             }
         }
-        // a small triangle deep in the left half is kept, one at x = 60 is not
-        assert!(s.keeps_triangle([10.0, 10.0], [11.0, 10.0], [10.0, 11.0]));
-        assert!(!s.keeps_triangle([60.0, 10.0], [61.0, 10.0], [60.0, 11.0]));
-        // a flat triangle whose circumcircle reaches into the right half is not
-        assert!(!s.keeps_triangle([10.0, 50.0], [40.0, 50.0], [25.0, 50.5]));
-        // nor a degenerate one
-        assert!(!s.keeps_triangle([1.0, 1.0], [2.0, 2.0], [3.0, 3.0]));
-        // beyond the grid counts as taken: a triangle on the left edge is kept
-        assert!(s.keeps_triangle([0.0, 10.0], [1.0, 10.0], [0.0, 11.0]));
+        let kept: Vec<[usize; 3]> = delaunay(&uv, s.indices())
+            .into_iter()
+            .filter(|t| s.keeps_triangle(uv[t[0]], uv[t[1]], uv[t[2]]))
+            .collect();
+        // every kept triangle is one of the whole set's, with its
+        // circumcentre in a taken cell ...
+        assert!(kept.iter().all(|t| possible.contains(t)));
+        // ... and all of those are kept but the few with a circumcircle
+        // wider than the margin (slivers along the outline)
+        assert!(kept.len() >= certain, "{} < {certain}", kept.len());
+        assert!(
+            kept.len() as f64 >= 0.995 * possible.len() as f64,
+            "{} of {}",
+            kept.len(),
+            possible.len()
+        );
+        // the taken cells hold about their share of the triangles
+        let share = kept.len() as f64 / full.len() as f64;
+        assert!((share - 0.2).abs() < 0.03, "{share}");
     }
 
     fn line(n: usize) -> Vec<Point3> {

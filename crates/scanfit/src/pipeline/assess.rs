@@ -36,8 +36,19 @@
 //! taken on a seeded random sample ([`crate::sampling`]): the median point
 //! spacing over `sample_points / 4` uniformly drawn points (each measured
 //! against all points), fold-overs and stretch over the Delaunay triangles
-//! of a cluster sample of about `sample_points / 4` points that are triangles of
-//! the whole set's triangulation too; [`Assessment::sample`] says so.
+//! of a cluster sample of about `sample_points / 4` points (and a margin
+//! around its cells) that are triangles of the whole set's triangulation
+//! too, each counted by its circumcentre's cell; [`Assessment::sample`]
+//! says so. On realistic data (the turntable's noisy blob, Franke's
+//! function, a noisy face sheet; 10^6 points, 8 to 16 seeds each) the
+//! sampled figures agree with the full ones within: L2 stretch 2%, median
+//! area ratio 4%, its 5th and 95th percentiles 10% and 5%, the fold-over
+//! share within three standard deviations of a count over the sample's
+//! triangles (`3 sqrt(share / triangles)`; none when there are none over
+//! all points, the sample's triangles being some of those); the maximum
+//! anisotropy is the sample's, a lower bound. BENCHMARKS.md has the figures,
+//! `tests::sampled_parameterization_of_a_noisy_scan_agrees_with_the_full_one`
+//! asserts them.
 //! Everything else stays exact over every point: the errors at the
 //! parameters, the orthogonal distances (two Newton steps from the points'
 //! own parameters with an error estimate, on the surface's power form,
@@ -853,10 +864,10 @@ impl<'a> Index<'a> {
 /// [`AssessConfig::sample_points`] (50 000 by default). The median of that
 /// many nearest-neighbour distances is within about 0.5% of the whole
 /// cloud's; the fold-overs and stretch over the triangles of a cluster
-/// sample of that many points agree with the full computation within the
-/// margins of BENCHMARKS.md (measured at 10^6 and 10^7 points), at a
-/// quarter of the serial Delaunay triangulation the whole threshold would
-/// cost.
+/// sample of that many points (about 1.7 times as many with the margins
+/// of its cells) agree with the full computation within the margins of
+/// the module documentation, at a fraction of the serial Delaunay
+/// triangulation the whole threshold would cost.
 fn statistics_sample(config: &AssessConfig) -> usize {
     config.sample_points / 4
 }
@@ -999,9 +1010,11 @@ pub(crate) fn parameterization(
 }
 
 /// Fold-overs and stretch over a cluster sample of about a quarter of
-/// [`AssessConfig::sample_points`] points ([`CellSample`]): only the
-/// Delaunay triangles of the sample that are triangles of the whole set's
-/// triangulation count. Returns the measure and the sample's size.
+/// [`AssessConfig::sample_points`] points and the margins of its cells
+/// ([`CellSample`]): only the Delaunay triangles of the sample that are
+/// triangles of the whole set's triangulation, with their circumcentre in
+/// a taken cell, count. Returns the measure and the sample's size (the
+/// points triangulated, margins included).
 fn sampled_parameterization(
     surface: &Surface,
     points: &[Point3],
@@ -1216,6 +1229,15 @@ mod tests {
         assert!(assess_surface(&s, &p, &uv, &c).is_err());
     }
 
+    /// The bicubic 10 x 10 least-squares surface of `pts` at `uv`.
+    fn fit10(pts: &[Point3], uv: &[[f64; 2]]) -> Surface {
+        let cfg = crate::fit::surface::SurfaceFitConfig {
+            ctrl: (10, 10),
+            ..Default::default()
+        };
+        crate::fit::surface::fit_surface(pts, uv, &cfg).unwrap()
+    }
+
     /// `n` noisy points of a wavy sheet over [0, 2] x [0, 1] at uniform
     /// random parameters (a fixed LCG), and a bicubic 10 x 10 least-squares
     /// surface fitted to them.
@@ -1240,12 +1262,7 @@ mod tests {
             ));
             uv.push([u, v]);
         }
-        let cfg = crate::fit::surface::SurfaceFitConfig {
-            ctrl: (10, 10),
-            ..Default::default()
-        };
-        let s = crate::fit::surface::fit_surface(&pts, &uv, &cfg).unwrap();
-        (s, pts, uv)
+        (fit10(&pts, &uv), pts, uv)
     }
 
     /// Issue 18: the sampled statistics agree with the full computation
@@ -1269,7 +1286,7 @@ mod tests {
         let info = a.sample.unwrap();
         assert_eq!((info.spacing_points, info.seed), (10_000, DEFAULT_SEED));
         assert!(
-            (7_000..13_000).contains(&info.parameterization_points),
+            (12_000..20_000).contains(&info.parameterization_points),
             "{info:?}"
         );
         let (fq, aq) = (f.quality, a.quality);
@@ -1296,6 +1313,77 @@ mod tests {
         assert!(ap.max_anisotropy <= fp.max_anisotropy * (1.0 + 1e-12));
         // the extent's verdict does not change
         assert_eq!(fq.extent.leaves, aq.extent.leaves);
+    }
+
+    /// `n` points of the wavy sheet of [`wavy`] at uniform random
+    /// parameters with Gaussian noise of `normal` point spacings along z (a
+    /// scan's noise along the normal) and parameters off the points'
+    /// positions by Gaussian noise of `tangential` point spacings (which
+    /// folds some triangles over), and the bicubic 10 x 10 least-squares
+    /// surface.
+    fn noisy_sheet(
+        n: usize,
+        normal: f64,
+        tangential: f64,
+    ) -> (Surface, Vec<Point3>, Vec<[f64; 2]>) {
+        let mut rng = crate::testdata::SplitMix64::new(2026);
+        let h = (2.0 / n as f64).sqrt();
+        let (pts, uv): (Vec<Point3>, Vec<[f64; 2]>) = (0..n)
+            .map(|_| {
+                let (x, y) = (2.0 * rng.uniform(), rng.uniform());
+                let z = 0.1 * (3.0 * x).sin() * (2.0 * y).cos() + normal * h * rng.normal();
+                let (dx, dy) = (tangential * h * rng.normal(), tangential * h * rng.normal());
+                let uv = [((x + dx) / 2.0).clamp(0.0, 1.0), (y + dy).clamp(0.0, 1.0)];
+                (Point3::new(x, y, z), uv)
+            })
+            .unzip();
+        (fit10(&pts, &uv), pts, uv)
+    }
+
+    /// Issue 18: on a noisy scan (noise 0.4 point spacings along the
+    /// normal, as the turntable's blob, and parameters off by 0.05
+    /// spacings) the sampled fold-overs and stretch agree with the full
+    /// computation within the margins stated in the module documentation,
+    /// for every seed tried. (Measured in space instead of the tangent
+    /// plane, the L2 stretch of such data is carried by its narrowest
+    /// triangles: on the blob the sampled figure was 18% below to 50% above
+    /// the full one, depending on the seed.)
+    #[test]
+    fn sampled_parameterization_of_a_noisy_scan_agrees_with_the_full_one() {
+        let (s, pts, uv) = noisy_sheet(80_000, 0.4, 0.05);
+        let full = AssessConfig {
+            measure: Measure::Full,
+            ..Default::default()
+        };
+        let (fq, none) = parameterization(&s, &pts, &uv, &full);
+        assert!(none.is_none());
+        assert!(fq.fold_overs > 20, "{fq:?}");
+        let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
+        let share = |q: &ParamQuality| q.fold_overs as f64 / q.triangles as f64;
+        for seed in 1..=4 {
+            let sampled = AssessConfig {
+                sample_points: 79_999,
+                seed,
+                ..Default::default()
+            };
+            let (q, count) = parameterization(&s, &pts, &uv, &sampled);
+            let count = count.unwrap();
+            eprintln!("seed {seed}: {count} points, {q:?} vs {fq:?}");
+            assert!((25_000..40_000).contains(&count), "{count}");
+            assert!(rel(q.l2_stretch, fq.l2_stretch) < 0.02, "{q:?} vs {fq:?}");
+            for (k, margin) in [0.10, 0.04, 0.05].into_iter().enumerate() {
+                let (x, y) = (q.area_ratio_percentiles[k], fq.area_ratio_percentiles[k]);
+                assert!(rel(x, y) < margin, "percentile {k}: {x} vs {y}");
+            }
+            let sd = (share(&fq) / q.triangles as f64).sqrt();
+            assert!(
+                (share(&q) - share(&fq)).abs() <= 3.0 * sd,
+                "{q:?} vs {fq:?}"
+            );
+            // the sample's triangles are some of the whole set's
+            assert!(q.fold_overs <= fq.fold_overs && q.triangles < fq.triangles);
+            assert!(q.max_anisotropy <= fq.max_anisotropy);
+        }
     }
 
     /// The orthogonal distances from the points' own parameters equal the
