@@ -404,7 +404,18 @@ fn mba_writes_the_surface_it_wrote_before_the_whole_command_work() {
             }
             let rows = v["levels"].as_array().unwrap();
             let last = &rows[rows.len() - 1];
-            assert_eq!(last["vertical_rmse"], v["quality"]["rmse"]);
+            // `--measure none`: the report's errors are the level loop's
+            // last row; measuring, the pass beside the orthogonal distances
+            // evaluates them (the same to rounding)
+            if extra.contains(&"none") {
+                assert_eq!(last["vertical_rmse"], v["quality"]["rmse"]);
+            } else {
+                let (a, b) = (
+                    last["vertical_rmse"].as_f64().unwrap(),
+                    v["quality"]["rmse"].as_f64().unwrap(),
+                );
+                assert!((a - b).abs() <= 1e-12 * b, "last row {a} vs {b}");
+            }
         }
     }
 }
