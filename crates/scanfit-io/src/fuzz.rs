@@ -25,7 +25,11 @@ pub fn point_file(name: &str, data: &[u8]) -> bool {
             non_finite,
             ..ReadOptions::default()
         };
-        if let Ok(table) = crate::parse_cloud(Path::new(name), data, &options) {
+        let general = crate::parse_cloud(Path::new(name), data, &options);
+        if name.ends_with(".ply") {
+            same_as_direct(name, data, &options, &general);
+        }
+        if let Ok(table) = general {
             let n = table.points.len();
             for i in [0, n / 2, n.saturating_sub(1)] {
                 let _ = table.locate(i);
@@ -34,6 +38,29 @@ pub fn point_file(name: &str, data: &[u8]) -> bool {
         }
     }
     accepted
+}
+
+/// The direct binary PLY reader ([`crate::read_cloud`]'s path for a
+/// vertex-only file of fixed records) on `data`: where it takes the file,
+/// it must give the general reader's `general` result (the same table, or
+/// an error where the general reader has one); a disagreement panics (a
+/// finding).
+fn same_as_direct(
+    name: &str,
+    data: &[u8],
+    options: &ReadOptions,
+    general: &crate::Result<PointTable>,
+) {
+    let direct = crate::ply_read::direct::read(Path::new(name), data, options);
+    match (direct, general) {
+        (Ok(None), _) | (Err(_), Err(_)) => {}
+        (Ok(Some(d)), Ok(g)) => assert!(d == *g, "direct and general PLY readers disagree"),
+        (d, g) => panic!(
+            "direct PLY reader {} where the general one {}",
+            if d.is_ok() { "accepts" } else { "refuses" },
+            if g.is_ok() { "accepts" } else { "refuses" }
+        ),
+    }
 }
 
 /// Reads `data` as a LAS/LAZ file twice, whole (the in-memory reader) and

@@ -101,3 +101,51 @@ fn regression_inputs_replay_without_a_panic() {
     let total: usize = r.iter().map(|(_, n, _)| n).sum();
     eprintln!("replayed {total} regression inputs: {r:?}");
 }
+
+/// The direct binary PLY reader against the general one on mutants of the
+/// binary PLY seeds (a fixed-seed stand-in for a campaign on stable): bytes
+/// overwritten, header digits changed, files cut short. `point_file` panics
+/// where the two readers disagree.
+#[test]
+fn mutated_binary_ply_seeds_read_alike_directly_and_in_general() {
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut next = |m: usize| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state % m as u64) as usize
+    };
+    let (mut mutants, mut accepted) = (0, 0);
+    for seed in ["sample_binary_le.ply", "sample_binary_be.ply"] {
+        let bytes = std::fs::read(fuzz_dir().join("corpus/ply").join(seed)).expect("seed");
+        let head = bytes
+            .windows(11)
+            .position(|w| w == b"end_header\n")
+            .expect("header")
+            + 11;
+        for _ in 0..1500 {
+            let mut m = bytes.clone();
+            match next(4) {
+                // a byte of the header (counts, types, names)
+                0 => m[next(head)] = b"0123456789 \nxyzfloatdouble"[next(26)],
+                // bytes of the records
+                1 => {
+                    for _ in 0..1 + next(8) {
+                        let i = head + next(m.len() - head);
+                        m[i] = next(256) as u8;
+                    }
+                }
+                // cut short or grown
+                2 => m.truncate(next(m.len())),
+                _ => m.extend(std::iter::repeat_n(0u8, 1 + next(64))),
+            }
+            mutants += 1;
+            accepted += usize::from(scanfit_io::fuzz::point_file("f.ply", &m));
+        }
+    }
+    // the mutants reach both outcomes (so both readers' paths ran)
+    assert!(
+        accepted > 100 && accepted < mutants,
+        "{accepted} of {mutants}"
+    );
+}
