@@ -4,5 +4,8 @@
 #![no_main]
 
 libfuzzer_sys::fuzz_target!(|data: &[u8]| {
-    scanfit_io::fuzz::streamed_las_file(data);
+    // a disagreement between two readers of the bytes is a finding
+    if let Err(e) = scanfit_io::fuzz::streamed_las_file(data) {
+        panic!("{e}");
+    }
 });

@@ -14,5 +14,8 @@ libfuzzer_sys::fuzz_target!(|data: &[u8]| {
     if let Some(path) = LAST.get_or_init(|| std::env::var_os("SCANFIT_FUZZ_LAST").map(Into::into)) {
         let _ = std::fs::write(path, data);
     }
-    scanfit_io::fuzz::point_file("f.laz", data);
+    // a disagreement between two readers of the bytes is a finding
+    if let Err(e) = scanfit_io::fuzz::point_file("f.laz", data) {
+        panic!("{e}");
+    }
 });

@@ -2,5 +2,8 @@
 #![no_main]
 
 libfuzzer_sys::fuzz_target!(|data: &[u8]| {
-    scanfit_io::fuzz::point_file("f.pcd", data);
+    // a disagreement between two readers of the bytes is a finding
+    if let Err(e) = scanfit_io::fuzz::point_file("f.pcd", data) {
+        panic!("{e}");
+    }
 });

@@ -2,7 +2,10 @@
 //! that replays their corpora on stable (`tests/fuzz_corpus.rs`): each feeds
 //! arbitrary bytes to one reader the way the command line does, and returns
 //! whether the reader accepted them. A panic, an abort or an allocation
-//! beyond the harness's limit is a finding; `Ok` and `Err` are both fine.
+//! beyond the harness's limit is a finding; the reader's `Ok` and `Err` are
+//! both fine. Where two readers of the same file are compared, their
+//! disagreement is returned as a [`Disagreement`] (a finding too: the fuzz
+//! targets and the replay test fail on it); nothing here panics.
 
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -10,15 +13,40 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use crate::chunks::PointChunks;
 use crate::table::{NonFinite, PointTable, ReadOptions};
 
+/// Two readers of the same bytes disagree (a finding): what differs.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Disagreement(pub String);
+
+impl std::fmt::Display for Disagreement {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for Disagreement {}
+
+/// `Err(Disagreement)` with `what` unless `same`.
+fn agree(same: bool, what: impl FnOnce() -> String) -> Result<(), Disagreement> {
+    if same {
+        Ok(())
+    } else {
+        Err(Disagreement(what()))
+    }
+}
+
 /// Reads `data` as the point file `name` (its extension picks the reader)
 /// with both non-finite policies, and turns an accepted table into a
-/// `PointCloud` as the commands do. Returns whether the file was accepted.
+/// `PointCloud` as the commands do. A `.ply` name is also read by the
+/// direct binary PLY reader ([`crate::read_cloud`]'s path for a vertex-only
+/// file of fixed records), which must agree with the general one. Returns
+/// whether the file was accepted, or the readers' [`Disagreement`].
 ///
 /// ```
-/// assert!(scanfit_io::fuzz::point_file("f.xyz", b"1 2 3\n4 5 6\n"));
-/// assert!(!scanfit_io::fuzz::point_file("f.ply", b"ply\nformat"));
+/// use scanfit_io::fuzz::point_file;
+/// assert_eq!(point_file("f.xyz", b"1 2 3\n4 5 6\n"), Ok(true));
+/// assert_eq!(point_file("f.ply", b"ply\nformat"), Ok(false));
 /// ```
-pub fn point_file(name: &str, data: &[u8]) -> bool {
+pub fn point_file(name: &str, data: &[u8]) -> Result<bool, Disagreement> {
     let mut accepted = false;
     for non_finite in [NonFinite::Reject, NonFinite::Drop] {
         let options = ReadOptions {
@@ -27,7 +55,7 @@ pub fn point_file(name: &str, data: &[u8]) -> bool {
         };
         let general = crate::parse_cloud(Path::new(name), data, &options);
         if name.ends_with(".ply") {
-            same_as_direct(name, data, &options, &general);
+            same_as_direct(name, data, &options, &general)?;
         }
         if let Ok(table) = general {
             let n = table.points.len();
@@ -37,29 +65,30 @@ pub fn point_file(name: &str, data: &[u8]) -> bool {
             accepted |= table.into_cloud().is_ok();
         }
     }
-    accepted
+    Ok(accepted)
 }
 
 /// The direct binary PLY reader ([`crate::read_cloud`]'s path for a
 /// vertex-only file of fixed records) on `data`: where it takes the file,
 /// it must give the general reader's `general` result (the same table, or
-/// an error where the general reader has one); a disagreement panics (a
-/// finding).
+/// an error where the general reader has one).
 fn same_as_direct(
     name: &str,
     data: &[u8],
     options: &ReadOptions,
     general: &crate::Result<PointTable>,
-) {
+) -> Result<(), Disagreement> {
     let direct = crate::ply_read::direct::read(Path::new(name), data, options);
     match (direct, general) {
-        (Ok(None), _) | (Err(_), Err(_)) => {}
-        (Ok(Some(d)), Ok(g)) => assert!(d == *g, "direct and general PLY readers disagree"),
-        (d, g) => panic!(
-            "direct PLY reader {} where the general one {}",
+        (Ok(None), _) | (Err(_), Err(_)) => Ok(()),
+        (Ok(Some(d)), Ok(g)) => agree(d == *g, || {
+            "direct and general PLY readers give other tables".into()
+        }),
+        (d, g) => Err(Disagreement(format!(
+            "the direct PLY reader {} the file, the general one {} it",
             if d.is_ok() { "accepts" } else { "refuses" },
             if g.is_ok() { "accepts" } else { "refuses" }
-        ),
+        ))),
     }
 }
 
@@ -70,13 +99,13 @@ fn same_as_direct(
 /// allows (so the arithmetic decoder is suspended and resumed every few
 /// points, where the whole read decodes a fuzzer-sized chunk in one go).
 /// The two must agree: both refuse the file, or both give the same points,
-/// columns, point locations and warnings, bit for bit; a disagreement
-/// panics (a finding). Returns whether the file was accepted.
+/// columns, point locations and warnings, bit for bit. Returns whether the
+/// file was accepted, or the reads' [`Disagreement`].
 ///
 /// ```
-/// assert!(!scanfit_io::fuzz::streamed_las_file(b"LASF"));
+/// assert_eq!(scanfit_io::fuzz::streamed_las_file(b"LASF"), Ok(false));
 /// ```
-pub fn streamed_las_file(data: &[u8]) -> bool {
+pub fn streamed_las_file(data: &[u8]) -> Result<bool, Disagreement> {
     static FILES: AtomicUsize = AtomicUsize::new(0);
     let path = std::env::temp_dir().join(format!(
         "scanfit-fuzz-{}-{}.laz",
@@ -84,21 +113,37 @@ pub fn streamed_las_file(data: &[u8]) -> bool {
         FILES.fetch_add(1, Ordering::Relaxed)
     ));
     if std::fs::write(&path, data).is_err() {
-        return false;
+        return Ok(false);
     }
     let options = ReadOptions::default();
     let whole = crate::parse_cloud(&path, data, &options);
-    let streamed = read_streamed(&path, &options, 1 + data.len() % 7);
+    let chunk = 1 + data.len() % 7;
+    let streamed = read_streamed(&path, &options, chunk);
     let _ = std::fs::remove_file(&path);
     match (whole, streamed) {
         (Ok(whole), Ok((chunks, warnings))) => {
-            same_points(&whole, &chunks);
-            assert_eq!(warnings, whole.warnings, "warnings, streamed and whole");
-            true
+            for t in &chunks {
+                let n = t.points.len();
+                agree((1..=chunk).contains(&n), || {
+                    format!("a chunk of {n} points, {chunk} asked for")
+                })?;
+            }
+            same_points(&whole, &chunks)?;
+            agree(warnings == whole.warnings, || {
+                format!(
+                    "warnings, streamed {warnings:?} and whole {:?}",
+                    whole.warnings
+                )
+            })?;
+            Ok(true)
         }
-        (Err(_), Err(_)) => false,
-        (Ok(_), Err(e)) => panic!("the whole read accepts the file, the streamed read fails: {e}"),
-        (Err(e), Ok(_)) => panic!("the streamed read accepts the file, the whole read fails: {e}"),
+        (Err(_), Err(_)) => Ok(false),
+        (Ok(_), Err(e)) => Err(Disagreement(format!(
+            "the whole read accepts the file, the streamed read fails: {e}"
+        ))),
+        (Err(e), Ok(_)) => Err(Disagreement(format!(
+            "the streamed read accepts the file, the whole read fails: {e}"
+        ))),
     }
 }
 
@@ -112,39 +157,41 @@ fn read_streamed(
     reader.set_laz_window(0);
     let mut chunks = Vec::new();
     while let Some(t) = reader.next_chunk()? {
-        assert!(
-            (1..=chunk).contains(&t.points.len()),
-            "a chunk of {} points, {chunk} asked for",
-            t.points.len()
-        );
         chunks.push(t);
     }
     Ok((chunks, reader.warnings().to_vec()))
 }
 
-/// Asserts that `chunks` hold the points of `whole`, bit for bit, with the
-/// same columns and locations.
-fn same_points(whole: &PointTable, chunks: &[PointTable]) {
+/// Whether `chunks` hold the points of `whole`, bit for bit, with the same
+/// columns and locations (else what differs first).
+fn same_points(whole: &PointTable, chunks: &[PointTable]) -> Result<(), Disagreement> {
     let mut k = 0;
     for t in chunks {
-        assert_eq!(t.columns, whole.columns, "columns, streamed and whole");
+        agree(t.columns == whole.columns, || {
+            "columns, streamed and whole".into()
+        })?;
         for (i, p) in t.points.iter().enumerate() {
             let q = whole.points.get(k).copied();
             let bits = |p: &scanfit::Point3| p.coords.map(f64::to_bits);
-            assert_eq!(Some(bits(p)), q.as_ref().map(bits), "point {k}");
+            agree(Some(bits(p)) == q.as_ref().map(bits), || {
+                format!("point {k}")
+            })?;
             for (c, col) in t.extra.iter().enumerate() {
                 let w = whole.extra.get(c).and_then(|w| w.get(k));
-                assert_eq!(
-                    col.get(i).map(|v| v.to_bits()),
-                    w.map(|v| v.to_bits()),
-                    "point {k}, column {c}"
-                );
+                agree(
+                    col.get(i).map(|v| v.to_bits()) == w.map(|v| v.to_bits()),
+                    || format!("point {k}, column {c}"),
+                )?;
             }
-            assert_eq!(t.locate(i), whole.locate(k), "point {k}");
+            agree(t.locate(i) == whole.locate(k), || {
+                format!("location of point {k}")
+            })?;
             k += 1;
         }
     }
-    assert_eq!(k, whole.points.len(), "points, streamed and whole");
+    agree(k == whole.points.len(), || {
+        format!("{k} points streamed, {} whole", whole.points.len())
+    })
 }
 
 /// Parses `data` as a curve document and, when it is accepted, evaluates
