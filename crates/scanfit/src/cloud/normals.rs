@@ -304,20 +304,26 @@ fn finish(
         Rows::Tree { rows, k } => (&rows[..], *k),
         Rows::Input { graph, .. } => (&graph.indices[..], graph.k),
     };
-    let components = count_components(flat_rows, k, cloud.len());
     let normal = |t: usize| per_point[t].normal;
-    let disagreement = match (config.orientation, &rows) {
-        (Orientation::None, _) => None,
-        (_, Rows::Tree { rows, k }) => disagreement(pts, normal, |t| {
-            rows[t * k..(t + 1) * k].iter().map(|&s| s as usize)
-        }),
-        (_, Rows::Input { graph, at }) => disagreement(pts, normal, |t| {
-            let nb = graph.indices_of(order[t] as usize);
-            nb.iter().map(|&j| at[j as usize] as usize)
-        }),
-    };
+    // the components and the input order (serial walks) run beside the
+    // disagreement (parallel): all three only read
+    let ((components, parts), disagreement) = rayon::join(
+        || {
+            let components = count_components(flat_rows, k, cloud.len());
+            (components, into_input_order(&per_point, order))
+        },
+        || match (config.orientation, &rows) {
+            (Orientation::None, _) => None,
+            (_, Rows::Tree { rows, k }) => disagreement(pts, normal, |t| {
+                rows[t * k..(t + 1) * k].iter().map(|&s| s as usize)
+            }),
+            (_, Rows::Input { graph, at }) => disagreement(pts, normal, |t| {
+                let nb = graph.indices_of(order[t] as usize);
+                nb.iter().map(|&j| at[j as usize] as usize)
+            }),
+        },
+    );
     drop(rows);
-    let parts = into_input_order(&per_point, order);
     Ok(Normals::from_parts(parts, components, disagreement))
 }
 
@@ -438,13 +444,12 @@ where
                 if a.dot(&b).abs() <= 0.5 {
                     continue;
                 }
+                // |n . d| < 0.5 |d| for both normals, squared: no square
+                // root, no division (a coincident pair, |d| = 0, fails it)
                 let d = Vector3::from(pts[s]) - p;
-                let len = d.norm();
-                if len == 0.0 {
-                    continue;
-                }
-                let d = d / len;
-                if a.dot(&d).abs() < 0.5 && b.dot(&d).abs() < 0.5 {
+                let quarter = 0.25 * d.norm_squared();
+                let (ad, bd) = (a.dot(&d), b.dot(&d));
+                if ad * ad < quarter && bd * bd < quarter {
                     pairs += 1;
                     bad += usize::from(a.dot(&b) < 0.0);
                 }
@@ -764,6 +769,50 @@ mod tests {
                 assert_eq!(one, two, "k {k}, {orientation:?}");
             }
         }
+    }
+
+    /// The disagreement counts exactly the same-sheet pairs whose normals
+    /// point apart: two 30 x 30 grids 3 apart, each point joined to its
+    /// grid neighbours and to its partner in the other grid. The lower grid
+    /// points up except its first 10 columns, the upper grid points down:
+    /// the partners' pairs are across the sheets (excluded), and of the
+    /// 2 x 2 x 2 x 30 x 29 grid pairs (both directions) the 2 x 30 across
+    /// the lower grid's flip disagree.
+    #[test]
+    fn disagreement_counts_the_flipped_pairs_of_same_sheet_neighbours() {
+        let n = 30;
+        let pts: Vec<[f64; 3]> = (0..2 * n * n)
+            .map(|t| {
+                let i = t % (n * n);
+                [(i % n) as f64, (i / n) as f64, 3.0 * (t / (n * n)) as f64]
+            })
+            .collect();
+        let normal = |t: usize| {
+            if t >= n * n || t % n < 10 {
+                -Vector3::z()
+            } else {
+                Vector3::z()
+            }
+        };
+        let neighbours = |t: usize| {
+            let (layer, i) = (t / (n * n), t % (n * n));
+            let (x, y) = ((i % n) as i64, (i / n) as i64);
+            let mut nb: Vec<usize> = [(1, 0), (-1, 0), (0, 1), (0, -1)]
+                .iter()
+                .map(|(dx, dy)| (x + dx, y + dy))
+                .filter(|&(x, y)| (0..n as i64).contains(&x) && (0..n as i64).contains(&y))
+                .map(|(x, y)| layer * n * n + (y as usize) * n + x as usize)
+                .collect();
+            nb.push((1 - layer) * n * n + i);
+            nb.into_iter()
+        };
+        let share = disagreement(&pts, normal, neighbours).unwrap();
+        let (bad, pairs) = (2 * n, 2 * 2 * 2 * n * (n - 1));
+        assert_eq!(share, bad as f64 / pairs as f64);
+        // every normal the same way: nothing disagrees; across the sheets only: no pairs
+        assert_eq!(disagreement(&pts, |_| Vector3::z(), neighbours), Some(0.0));
+        let across = |t: usize| std::iter::once((t + n * n) % (2 * n * n));
+        assert_eq!(disagreement(&pts, normal, across), None);
     }
 
     #[test]
