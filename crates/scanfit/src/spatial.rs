@@ -154,15 +154,24 @@ impl Visit for Best {
     }
 
     fn bucket(&mut self, tree: &KdTree, lo: usize, hi: usize, q: &[f64; 3]) {
-        // most points of a bucket are farther than the k-th: the test here
-        // spares them the call (`<=`: an equal distance may win by index)
-        let mut worst = self.bound();
-        let (pts, ids) = (&tree.pts[lo..hi], &tree.ids[lo..hi]);
-        for (j, (p, &id)) in (lo as u32..).zip(pts.iter().zip(ids)) {
+        // Most points of a bucket are farther than the k-th, and whether
+        // one is not is a coin toss the processor mispredicts: no branch
+        // per point, but every distance and the places of those within the
+        // bound on entry (`<=`: an equal distance may win by index), then
+        // the offers of those still within it as the offers shrink it.
+        let pts = &tree.pts[lo..hi];
+        let (mut d, mut pass, mut m) = ([0.0; BUCKET], [0u8; BUCKET], 0);
+        let worst = self.bound();
+        for (j, p) in pts.iter().enumerate() {
             let d2 = dist2(p, q);
-            if d2 <= worst {
-                self.offer(d2, id, j);
-                worst = self.bound();
+            d[j] = d2;
+            pass[m] = j as u8;
+            m += usize::from(d2 <= worst);
+        }
+        for &j in &pass[..m] {
+            let j = j as usize;
+            if d[j] <= self.bound() {
+                self.offer(d[j], tree.ids[lo + j], (lo + j) as u32);
             }
         }
     }
