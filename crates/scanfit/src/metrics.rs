@@ -156,7 +156,11 @@ pub struct ParamQuality {
     /// slivers along its hull, whose longest edge exceeds 4x the median).
     pub triangles: usize,
     /// Triangles whose orientation on the surface (data points, signed by the
-    /// surface normal) is opposite to their orientation in `(u, v)`.
+    /// surface normal) is opposite to their orientation in `(u, v)`, among
+    /// all but the slivers along the border (see `l2_stretch`): such a
+    /// sliver joins three nearly collinear outline points, and its sign is
+    /// round-off (a regular 30 x 30 grid of a bump, projected on its
+    /// best-fit plane, had 16 of them "folded").
     pub fold_overs: usize,
     /// Area-weighted L2 stretch of the map `(u, v) -> P` (Sander et al. 2001),
     /// normalised so that a map uniform up to scale gives 1, with each
@@ -311,10 +315,14 @@ pub(crate) fn parameterization_quality_where(
 }
 
 /// The summary of the per-triangle `(folded, 3D area, uv area, L2^2,
-/// anisotropy)` of `count` triangles: fold-overs over all, the stretch
+/// anisotropy)` of `count` triangles: the fold-overs and the stretch
 /// measures over those `inner` marks.
 fn q_from(per: Vec<(bool, f64, f64, f64, f64)>, inner: &[bool], count: usize) -> ParamQuality {
-    let folds = per.iter().filter(|t| t.0).count();
+    let folds = per
+        .iter()
+        .zip(inner)
+        .filter(|(t, &keep)| t.0 && keep)
+        .count();
     let per: Vec<_> = per
         .into_iter()
         .zip(inner)

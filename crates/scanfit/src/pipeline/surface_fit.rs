@@ -270,6 +270,28 @@ mod tests {
         assert!(q.orthogonal.rmse < 1.2e-3, "{:?}", q.orthogonal);
     }
 
+    /// A regular 30 x 30 grid of a bump, fitted with the defaults (best-fit
+    /// plane parameters): no triangle folds. The grid's border rows are
+    /// collinear in the plane; their hull slivers, of a parameter area of
+    /// 1e-9 and a sign set by round-off, were counted as 16 fold-overs.
+    #[test]
+    fn a_regular_grid_has_no_fold_overs_along_its_border() {
+        let pts: Vec<Point3> = (0..900)
+            .map(|k| {
+                let (x, y) = ((k % 30) as f64, (k / 30) as f64);
+                let r2 = (x - 15.0).powi(2) + (y - 15.0).powi(2);
+                Point3::new(x, y, 3.0 * (-r2 / 50.0).exp())
+            })
+            .collect();
+        let mut config = FitConfig::default();
+        config.fit.ctrl = (10, 10);
+        config.ctrl_from_density = false;
+        let r = run(&PointCloud::new(pts).unwrap(), &config, &NoProgress).unwrap();
+        let q = &r.assessment.quality.parameterization;
+        assert_eq!(q.fold_overs, 0, "{q:?}");
+        assert!(q.triangles > 1600, "{q:?}");
+    }
+
     fn wave(n: usize) -> Vec<Point3> {
         (0..n * n)
             .map(|k| {
