@@ -98,6 +98,18 @@ fn same_as_direct(
 /// bit (a NaN in an extra column equals itself), the columns, locations,
 /// record indices, counts and warnings (else what differs first).
 fn same_tables(a: &PointTable, b: &PointTable) -> Result<(), Disagreement> {
+    // (`same_points` walks `a`'s columns and points: the counts first)
+    let lengths = |t: &PointTable| {
+        let columns: Vec<usize> = t.extra.iter().map(Vec::len).collect();
+        (t.points.len(), columns)
+    };
+    agree(lengths(a) == lengths(b), || {
+        format!(
+            "points and column lengths {:?} and {:?}",
+            lengths(a),
+            lengths(b)
+        )
+    })?;
     same_points(b, std::slice::from_ref(a))?;
     agree(a.format == b.format, || "format".into())?;
     agree(a.file_index == b.file_index, || "record indices".into())?;
@@ -188,7 +200,7 @@ fn same_points(whole: &PointTable, chunks: &[PointTable]) -> Result<(), Disagree
     let mut k = 0;
     for t in chunks {
         agree(t.columns == whole.columns, || {
-            "columns, streamed and whole".into()
+            format!("columns {:?} and {:?}", t.columns, whole.columns)
         })?;
         for (i, p) in t.points.iter().enumerate() {
             let q = whole.points.get(k).copied();
